@@ -1,0 +1,43 @@
+// Shared plumbing of the navimpact CLI: command registry and small helpers.
+// Commands stay thin: parse -> load config -> call lib -> print.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace navimpact::cli {
+
+/// A sub-command: setup() declares its options on the CLI11 sub-app and
+/// returns the function to run after parsing (returns the exit code).
+struct Command {
+  std::string name;
+  std::string help;
+  std::function<std::function<int()>(CLI::App&)> setup;
+};
+
+std::vector<Command>& registry();
+
+struct Registrar {
+  explicit Registrar(Command c) { registry().push_back(std::move(c)); }
+};
+
+/// True when stderr is a terminal (progress bars are shown only then).
+bool stderrIsTerminal();
+
+/// Simple progress bar on stderr, shown only on a terminal.
+class Progress {
+ public:
+  Progress(std::string label, std::size_t total);
+  void update(std::size_t done);
+  void finish();
+
+ private:
+  std::string label_;
+  std::size_t total_;
+  bool tty_;
+  int lastPct_ = -1;
+};
+
+}  // namespace navimpact::cli

@@ -1,0 +1,32 @@
+/**
+ * @file text_io.hpp
+ * @brief Whole-file reads (gzip transparent) and small text helpers.
+ */
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace navimpact {
+
+/**
+ * Read a whole file into memory; gzip-compressed files (any name) are
+ * decompressed transparently.
+ * @throws navimpact::Error naming the file if it cannot be opened or is corrupt.
+ */
+std::string readFileMaybeGz(const std::string& path);
+
+/// Split on a delimiter, no trimming; empty fields are kept.
+std::vector<std::string_view> splitView(std::string_view s, char delim);
+
+/// Strip leading and trailing white space.
+std::string_view trim(std::string_view s);
+
+/**
+ * Parse a whole field as a double (std::from_chars, locale independent).
+ * @return false when the field is empty or has trailing garbage.
+ */
+bool parseDouble(std::string_view s, double& out);
+
+}  // namespace navimpact

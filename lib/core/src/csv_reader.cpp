@@ -1,0 +1,220 @@
+#include "navimpact/core/csv_reader.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/text_io.hpp"
+
+namespace navimpact {
+
+void parseAxesSpec(const std::string& spec, int src[3], double sign[3]) {
+  const auto parts = splitView(spec, ',');
+  bool used[3] = {false, false, false};
+  auto bad = [&](const std::string& why) {
+    return Error("axes spec '" + spec + "': " + why +
+                 " (expected a signed permutation of x,y,z such as \"x,-y,-z\")");
+  };
+  if (parts.size() != 3) throw bad("needs three comma-separated axes");
+  for (int i = 0; i < 3; ++i) {
+    std::string_view p = trim(parts[i]);
+    double s = 1.0;
+    if (!p.empty() && (p.front() == '-' || p.front() == '+')) {
+      s = p.front() == '-' ? -1.0 : 1.0;
+      p.remove_prefix(1);
+    }
+    if (p.size() != 1 || p[0] < 'x' || p[0] > 'z') throw bad("unknown axis '" + std::string(parts[i]) + "'");
+    const int a = p[0] - 'x';
+    if (used[a]) throw bad("axis '" + std::string(p) + "' used twice");
+    used[a] = true;
+    src[i] = a;
+    sign[i] = s;
+  }
+}
+
+namespace {
+
+struct Column {
+  int channel = -1;  // canonical index, -1 = ignored, -2 = time
+  double factor = 1.0;
+};
+
+}  // namespace
+
+ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
+  const std::string text = readFileMaybeGz(path);
+  if (trim(text).empty()) throw fileError(path, 0, "file is empty");
+
+  // --- header --------------------------------------------------------------
+  std::size_t pos = text.find('\n');
+  std::string_view header(text.data(), pos == std::string::npos ? text.size() : pos);
+  std::size_t lineNo = 1;
+  const auto names = splitView(header, ',');
+  std::vector<Column> cols(names.size());
+  int timeCol = -1;
+  int present[6] = {-1, -1, -1, -1, -1, -1};
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    std::string_view n = trim(names[c]);
+    std::string unit;
+    const auto lb = n.find('[');
+    if (lb != std::string_view::npos) {
+      const auto rb = n.find(']', lb);
+      if (rb == std::string_view::npos)
+        throw fileError(path, 1, "column " + std::to_string(c + 1) + " '" + std::string(n) +
+                                     "': unit bracket not closed");
+      unit = std::string(trim(n.substr(lb + 1, rb - lb - 1)));
+      n = trim(n.substr(0, lb));
+    }
+    const std::string name(n);
+    if (name == "t" || name == "time_s" || name == "time") {
+      timeCol = static_cast<int>(c);
+      cols[c].channel = -2;
+      continue;
+    }
+    const int idx = channelIndex(name);
+    if (idx < 0) continue;
+    if (present[idx] >= 0)
+      throw fileError(path, 1, "column '" + name + "' appears twice");
+    present[idx] = static_cast<int>(c);
+    const auto q = channelQuantity(name);
+    if (unit.empty())
+      unit = q == units::Quantity::AngularRate ? opt.gyro_unit : opt.acc_unit;
+    if (unit.empty())
+      throw fileError(path, 1,
+                      "unit of column '" + name + "' unknown: pass --" +
+                          (q == units::Quantity::AngularRate ? "gyro" : "acc") +
+                          "-unit or write it in the header as " + name + "[unit]");
+    try {
+      cols[c].factor = units::toSiFactor(q, unit);
+    } catch (const Error& e) {
+      throw fileError(path, 1, "column '" + name + "': " + e.what());
+    }
+    cols[c].channel = idx;
+  }
+  if (std::all_of(std::begin(present), std::end(present), [](int p) { return p < 0; }))
+    throw fileError(path, 1,
+                    "no IMU column in header '" + std::string(trim(header)) +
+                        "' (expected some of gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z and optional t)");
+
+  // --- rows ----------------------------------------------------------------
+  std::vector<std::vector<double>> data(6);
+  const std::size_t approxRows = std::count(text.begin(), text.end(), '\n') + 1;
+  for (int i = 0; i < 6; ++i)
+    if (present[i] >= 0) data[i].reserve(approxRows);
+  std::vector<double> times;
+  if (timeCol >= 0) times.reserve(approxRows);
+
+  const char* p = text.data() + (pos == std::string::npos ? text.size() : pos + 1);
+  const char* end = text.data() + text.size();
+  const std::size_t ncol = cols.size();
+  while (p < end) {
+    ++lineNo;
+    const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
+    if (!eol) eol = end;
+    std::string_view line(p, static_cast<std::size_t>(eol - p));
+    p = eol + 1;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (trim(line).empty()) continue;
+    std::size_t c = 0, start = 0;
+    for (;; ++c) {
+      std::size_t comma = line.find(',', start);
+      const bool last = comma == std::string_view::npos;
+      if (last) comma = line.size();
+      if (c >= ncol)
+        throw fileError(path, lineNo, "more fields than the " + std::to_string(ncol) + " header columns");
+      if (cols[c].channel != -1) {
+        double v;
+        const std::string_view field = line.substr(start, comma - start);
+        if (!parseDouble(field, v))
+          throw fileError(path, lineNo, "column " + std::to_string(c + 1) + " ('" +
+                                            std::string(trim(names[c])) + "'): '" +
+                                            std::string(field) + "' is not a number");
+        if (!std::isfinite(v))
+          throw fileError(path, lineNo, "column " + std::to_string(c + 1) + " ('" +
+                                            std::string(trim(names[c])) + "'): value is " +
+                                            std::string(trim(field)));
+        if (cols[c].channel == -2)
+          times.push_back(v);
+        else
+          data[cols[c].channel].push_back(v * cols[c].factor);
+      }
+      if (last) break;
+      start = comma + 1;
+    }
+    if (c + 1 != ncol)
+      throw fileError(path, lineNo, "missing field: " + std::to_string(c + 1) + " of " +
+                                        std::to_string(ncol) + " columns");
+  }
+  std::size_t n = 0;
+  for (int i = 0; i < 6; ++i)
+    if (present[i] >= 0) n = data[i].size();
+  if (n == 0) throw fileError(path, 0, "header but no data rows");
+
+  // --- time base -------------------------------------------------------------
+  ImuSeries out;
+  out.source = path;
+  if (timeCol >= 0) {
+    if (n < 2) throw fileError(path, 0, "need at least two rows to derive the rate from 't'");
+    std::vector<double> dts(n - 1);
+    for (std::size_t k = 1; k < n; ++k) {
+      dts[k - 1] = times[k] - times[k - 1];
+      if (!(dts[k - 1] > 0.0))
+        throw fileError(path, k + 2, "time " + std::to_string(times[k]) +
+                                         " s is not after the previous " +
+                                         std::to_string(times[k - 1]) + " s");
+    }
+    std::vector<double> sorted = dts;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double med = sorted[sorted.size() / 2];
+    for (std::size_t k = 0; k < dts.size(); ++k)
+      if (std::abs(dts[k] - med) > opt.max_dt_deviation * med)
+        throw fileError(path, k + 3, "time step " + std::to_string(dts[k]) +
+                                         " s differs from the nominal " + std::to_string(med) +
+                                         " s (gap or jitter); resample or split the recording");
+    const double rate = (n - 1) / (times[n - 1] - times[0]);
+    if (opt.rate_hz && std::abs(*opt.rate_hz - rate) > 1e-3 * rate)
+      throw fileError(path, 0, "--rate " + std::to_string(*opt.rate_hz) +
+                                   " Hz disagrees with the time column (" + std::to_string(rate) + " Hz)");
+    out.rate_hz = opt.rate_hz ? *opt.rate_hz : rate;
+    out.t0_s = times[0];
+  } else {
+    if (!opt.rate_hz)
+      throw fileError(path, 1, "no time column 't': the sampling rate must be given (--rate HZ)");
+    if (!(*opt.rate_hz > 0.0) || !std::isfinite(*opt.rate_hz))
+      throw Error("rate must be a positive number of Hz");
+    out.rate_hz = *opt.rate_hz;
+  }
+
+  // --- axes remap -------------------------------------------------------------
+  if (!opt.axes.empty()) {
+    int src[3];
+    double sign[3];
+    parseAxesSpec(opt.axes, src, sign);
+    for (int s = 0; s < 2; ++s) {  // gyro block then acc block
+      const int b = 3 * s;
+      bool all = present[b] >= 0 && present[b + 1] >= 0 && present[b + 2] >= 0;
+      bool none = present[b] < 0 && present[b + 1] < 0 && present[b + 2] < 0;
+      if (!all && !none)
+        throw fileError(path, 1, std::string("--axes needs all three ") + (s ? "acc" : "gyro") + " columns");
+      if (none) continue;
+      std::vector<double> tmp[3] = {std::move(data[b]), std::move(data[b + 1]), std::move(data[b + 2])};
+      for (int i = 0; i < 3; ++i) {
+        data[b + i] = tmp[src[i]];
+        if (sign[i] < 0)
+          for (auto& v : data[b + i]) v = -v;
+      }
+    }
+  }
+  for (int i = 0; i < 6; ++i) {
+    if (present[i] < 0) continue;
+    ImuChannel ch;
+    ch.name = kChannelNames[i];
+    ch.quantity = channelQuantity(ch.name);
+    ch.x = std::move(data[i]);
+    out.channels.push_back(std::move(ch));
+  }
+  return out;
+}
+
+}  // namespace navimpact

@@ -1,0 +1,32 @@
+/**
+ * @file simulate.hpp
+ * @brief Seeded simulation of processes and composite models.
+ *
+ * Every stream is created from an explicit 64-bit seed; the same seed gives
+ * the same samples on every run and thread count.
+ */
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "navimpact/stochastic/process.hpp"
+
+namespace navimpact::stochastic {
+
+/**
+ * Simulate @p n samples of a composite model at its rate_hz.
+ * GM starts from its stationary distribution, RW and DR from 0, SIN with a
+ * uniform random phase, QN as in the R package (difference of uniforms).
+ * @param[in] seed  any 64-bit value; derive sub-seeds with deriveSeed().
+ */
+std::vector<double> simulate(const Model& m, std::size_t n, std::uint64_t seed);
+
+/// Simulate into an existing buffer (added to its content: out[k] += model_k).
+void simulateAdd(const Model& m, std::uint64_t seed, double* out, std::size_t n);
+
+/// Deterministic sub-seed (SplitMix64 of seed and index): independent streams
+/// per run/channel that do not depend on execution order.
+std::uint64_t deriveSeed(std::uint64_t seed, std::uint64_t index);
+
+}  // namespace navimpact::stochastic

@@ -1,0 +1,128 @@
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "navimpact/core/csv_reader.hpp"
+#include "navimpact/core/error.hpp"
+#include "test_support.hpp"
+
+using namespace navimpact;
+
+namespace {
+std::string writeFile(const std::string& name, const std::string& content) {
+  const auto p = test::tempDir() / name;
+  std::ofstream(p) << content;
+  return p.string();
+}
+
+std::string errorOf(const std::string& path, const CsvImuOptions& opt) {
+  try {
+    readImuCsv(path, opt);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+CsvImuOptions degG(double rate = 100.0) {
+  CsvImuOptions o;
+  o.rate_hz = rate;
+  o.gyro_unit = "deg/s";
+  o.acc_unit = "g";
+  return o;
+}
+}  // namespace
+
+TEST(CsvReader, ReadsAndConvertsToSi) {
+  const auto f = writeFile("a.csv", "gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n1,2,3,1,0,-1\n-1,0,0.5,0,0,-1\n");
+  const ImuSeries s = readImuCsv(f, degG());
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.rate_hz, 100.0);
+  EXPECT_DOUBLE_EQ(s.channel("gyro_y").x[0], 2.0 * units::kDeg);
+  EXPECT_DOUBLE_EQ(s.channel("acc_z").x[1], -units::kG0);
+}
+
+TEST(CsvReader, GzipIsTransparentAndTimeColumnGivesRate) {
+  const auto p = test::tempDir() / "b.csv.gz";
+  gzFile g = gzopen(p.string().c_str(), "wb");
+  const std::string txt = "t,gyro_z[rad/s]\n0.0,1\n0.005,2\n0.010,3\n0.015,4\n";
+  gzwrite(g, txt.data(), static_cast<unsigned>(txt.size()));
+  gzclose(g);
+  CsvImuOptions o;  // unit from the header, rate from t
+  const ImuSeries s = readImuCsv(p.string(), o);
+  EXPECT_NEAR(s.rate_hz, 200.0, 1e-9);
+  EXPECT_EQ(s.channel("gyro_z").x.size(), 4u);
+}
+
+TEST(CsvReader, AxesRemapFlipsAndPermutes) {
+  const auto f = writeFile("c.csv", "gyro_x,gyro_y,gyro_z\n1,2,3\n");
+  CsvImuOptions o = degG();
+  o.gyro_unit = "rad/s";
+  o.axes = "y,-x,-z";
+  const ImuSeries s = readImuCsv(f, o);
+  EXPECT_DOUBLE_EQ(s.channel("gyro_x").x[0], 2.0);
+  EXPECT_DOUBLE_EQ(s.channel("gyro_y").x[0], -1.0);
+  EXPECT_DOUBLE_EQ(s.channel("gyro_z").x[0], -3.0);
+  o.axes = "x,x,z";
+  EXPECT_NE(errorOf(f, o).find("used twice"), std::string::npos);
+}
+
+TEST(CsvReader, BadInputsNameFileAndLine) {
+  const CsvImuOptions o = degG();
+  EXPECT_NE(errorOf(writeFile("e.csv", ""), o).find("empty"), std::string::npos);
+  EXPECT_NE(errorOf(writeFile("h.csv", "a,b\n1,2\n"), o).find("no IMU column"), std::string::npos);
+  {
+    const auto m = errorOf(writeFile("nan.csv", "gyro_x,acc_x\n1,2\n3,nan\n"), o);
+    EXPECT_NE(m.find("nan.csv:3"), std::string::npos) << m;
+  }
+  {
+    const auto m = errorOf(writeFile("inf.csv", "gyro_x,acc_x\n1,2\n3,inf\n"), o);
+    EXPECT_NE(m.find("inf.csv:3"), std::string::npos) << m;
+  }
+  {
+    const auto m = errorOf(writeFile("miss.csv", "gyro_x,acc_x\n1,2\n3\n"), o);
+    EXPECT_NE(m.find("miss.csv:3"), std::string::npos) << m;
+    EXPECT_NE(m.find("missing field"), std::string::npos) << m;
+  }
+  {
+    const auto m = errorOf(writeFile("txt.csv", "gyro_x\n1\nabc\n"), o);
+    EXPECT_NE(m.find("txt.csv:3"), std::string::npos) << m;
+  }
+  {
+    CsvImuOptions u;
+    u.rate_hz = 100;
+    const auto m = errorOf(writeFile("nounit.csv", "gyro_x\n1\n"), u);
+    EXPECT_NE(m.find("--gyro-unit"), std::string::npos) << m;
+  }
+  {
+    CsvImuOptions u = o;
+    u.gyro_unit = "furlong/s";
+    EXPECT_NE(errorOf(writeFile("badunit.csv", "gyro_x\n1\n"), u).find("furlong"), std::string::npos);
+  }
+  {
+    CsvImuOptions t = o;
+    t.rate_hz.reset();
+    const auto m = errorOf(writeFile("back.csv", "t,gyro_x\n0,1\n0.01,1\n0.005,1\n"), t);
+    EXPECT_NE(m.find("back.csv:4"), std::string::npos) << m;
+    const auto g = errorOf(writeFile("gap.csv", "t,gyro_x\n0,1\n0.01,1\n0.02,1\n0.05,1\n0.06,1\n"), t);
+    EXPECT_NE(g.find("gap.csv:5"), std::string::npos) << g;
+  }
+  {
+    CsvImuOptions t = o;
+    t.rate_hz.reset();
+    EXPECT_NE(errorOf(writeFile("norate.csv", "gyro_x\n1\n2\n"), t).find("--rate"), std::string::npos);
+  }
+  EXPECT_NE(errorOf("/nonexistent/file.csv", o).find("/nonexistent/file.csv"), std::string::npos);
+}
+
+TEST(CsvReader, ReadsTheFullStaticRecording) {
+  NAVIMPACT_REQUIRE_SHARED();
+  const ImuSeries s = readImuCsv(test::sharedPath("data/imu_static/adis16405_static_1.csv.gz"), degG());
+  ASSERT_EQ(s.size(), 1000000u);
+  ASSERT_EQ(s.channels.size(), 6u);
+  // First row of the file: -0.05,-0.3,0.7,-0.00666,0,-1.01565
+  EXPECT_DOUBLE_EQ(s.channel("gyro_x").x[0], -0.05 * units::kDeg);
+  EXPECT_DOUBLE_EQ(s.channel("acc_z").x[0], -1.01565 * units::kG0);
+}
