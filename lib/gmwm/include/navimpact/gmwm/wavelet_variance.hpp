@@ -12,6 +12,9 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <vector>
+
+#include "navimpact/core/imu_series.hpp"
 
 namespace navimpact::gmwm {
 
@@ -56,9 +59,35 @@ void wvConfidenceInterval(double wv, double eta, double alpha, double& low, doub
 
 /**
  * Overlapping Allan variance (IEEE Std 952) at cluster times @p m_samples
- * (each 1 <= m <= (n-1)/2). AVAR(m) = 1/(2 m^2 (n-2m)) sum_k (theta_{k+2m} - 2 theta_{k+m} + theta_k)^2
- * with theta the cumulative sum / rate (integrated signal).
+ * (each an integer, 1 <= m <= n/2), in sample units (cluster time m / rate_hz):
+ * AVAR(m) = 1/(2 m^2 K) sum_{k=0}^{K-1} (theta_{k+2m} - 2 theta_{k+m} + theta_k)^2,
+ * K = n - 2m + 1, theta_k = sum_{i<k} x_i (integrated signal, theta_0 = 0).
+ * With this count AVAR(m) = 2 nu^2(tau = 2m) exactly (same terms as the WV).
+ * @param[in] x          samples (any unit; AVAR is in its square).
+ * @param[in] n          number of samples, >= 4.
+ * @param[in] m_samples  cluster sizes [samples].
+ * @return AVAR for each m [unit^2].
+ * @throws navimpact::Error for bad data (as waveletVariance) or a bad m.
  */
 Eigen::VectorXd allanVariance(const double* x, std::size_t n, const Eigen::VectorXd& m_samples);
+
+/// Options of the batch computation over the channels of a series.
+struct WvOptions {
+  double alpha = 0.05;  ///< CI level (0.05 for 95 %), in (0, 1)
+  bool robust = false;  ///< Tukey-biweight robust WV instead of the classical one
+  double eff = 0.6;     ///< efficiency of the robust estimator, in (0, 1)
+  int max_j = 0;        ///< largest level for the classical WV (0 = floor(log2 n))
+  int threads = 0;      ///< worker threads (0 = hardware concurrency), channels in parallel
+};
+
+/**
+ * WV of every channel of @p s, in channel order, channels processed in parallel.
+ * @param[in] s    series (SI units); its rate_hz is stored in each result.
+ * @param[in] opt  see WvOptions.
+ * @return one WaveletVariance per channel of @p s.
+ * @throws navimpact::Error "SOURCE: channel NAME: ..." for the first channel
+ *         (in channel order) with bad data.
+ */
+std::vector<WaveletVariance> waveletVariances(const ImuSeries& s, const WvOptions& opt = {});
 
 }  // namespace navimpact::gmwm

@@ -1,0 +1,31 @@
+// Internal helpers shared by the wavelet-variance sources (not installed).
+#pragma once
+
+#include <cstddef>
+#include <functional>
+
+namespace navimpact::gmwm::detail {
+
+/// Largest J with 2^J <= n (floor(log2 n)).
+int maxLevel(std::size_t n);
+
+/// Throws navimpact::Error for n < 4, a non-finite sample or a constant signal.
+void checkSeries(const double* x, std::size_t n);
+
+/// Sum of squares of m values, accurate to ~1e-15 relative.
+double sumSquares(const double* w, std::size_t m);
+
+/**
+ * Tukey-biweight M-estimate of the variance of @p m values (not centred) at
+ * asymptotic Gaussian efficiency @p eff in (0, 1). Returns 0 when all values are equal.
+ */
+double robustScale(const double* w, std::size_t m, double eff);
+
+/**
+ * Haar MODWT pyramid, levels 1..J; calls onLevel(j, W_j, M_j) with the M_j =
+ * n - 2^j + 1 boundary-free coefficients of level j (buffer valid during the call).
+ */
+void haarModwtLevels(const double* x, std::size_t n, int J,
+                     const std::function<void(int, const double*, std::size_t)>& onLevel);
+
+}  // namespace navimpact::gmwm::detail
