@@ -1,0 +1,324 @@
+// The text form of models and structures: a small hand-written recursive
+// descent parser with 1-based character positions in every error message.
+#include "navimpact/stochastic/model_text.hpp"
+
+#include <array>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+
+#include "navimpact/core/error.hpp"
+
+namespace navimpact::stochastic {
+
+namespace {
+
+/// Parameter keys of each process name, in their canonical (print) order.
+struct TermSpec {
+  const char* name;
+  std::array<const char*, 2> keys;
+  int nkeys;
+};
+constexpr TermSpec kSpecs[] = {
+    {"WN", {"sigma", nullptr}, 1},  {"QN", {"Q", nullptr}, 1},
+    {"RW", {"gamma", nullptr}, 1},  {"DR", {"omega", nullptr}, 1},
+    {"GM", {"sigma", "T"}, 2},      {"AR1", {"phi", "sigma2"}, 2},
+    {"SIN", {"amp", "freq"}, 2},
+};
+
+bool iequals(const std::string& a, const char* b) {
+  std::size_t i = 0;
+  for (; i < a.size() && b[i]; ++i)
+    if (std::toupper(static_cast<unsigned char>(a[i])) !=
+        std::toupper(static_cast<unsigned char>(b[i])))
+      return false;
+  return i == a.size() && b[i] == '\0';
+}
+
+std::string namesList() {
+  std::string s;
+  for (const auto& sp : kSpecs) {
+    if (!s.empty()) s += ", ";
+    s += sp.name;
+  }
+  return s;
+}
+
+/// Cursor over the text; positions reported 1-based.
+class Parser {
+ public:
+  Parser(const std::string& text, const char* what) : s_(text), what_(what) {}
+
+  void skipWs() {
+    while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) ++i_;
+  }
+  bool atEnd() {
+    skipWs();
+    return i_ >= s_.size();
+  }
+  char peek() {
+    skipWs();
+    return i_ < s_.size() ? s_[i_] : '\0';
+  }
+  std::size_t pos() const { return i_; }
+
+  /// Description of what is at the cursor, for "found Y".
+  std::string found() {
+    skipWs();
+    if (i_ >= s_.size()) return "end of text";
+    std::size_t j = i_;
+    if (std::isalnum(static_cast<unsigned char>(s_[j])) || s_[j] == '_' || s_[j] == '.' ||
+        s_[j] == '-' || s_[j] == '+') {
+      ++j;
+      while (j < s_.size() && (std::isalnum(static_cast<unsigned char>(s_[j])) || s_[j] == '_' ||
+                               s_[j] == '.'))
+        ++j;
+    } else {
+      ++j;
+    }
+    return "'" + s_.substr(i_, j - i_) + "'";
+  }
+
+  [[noreturn]] void fail(std::size_t at, const std::string& expected, const std::string& found) {
+    throw Error(std::string(what_) + " '" + s_ + "': at position " + std::to_string(at + 1) +
+                ": expected " + expected + ", found " + found);
+  }
+  [[noreturn]] void failHere(const std::string& expected) {
+    skipWs();
+    const std::string f = found();
+    fail(i_, expected, f);
+  }
+
+  void expect(char c, const std::string& expected) {
+    if (peek() != c) failHere(expected);
+    ++i_;
+  }
+
+  /// Identifier [A-Za-z_][A-Za-z0-9_]*; empty if none at the cursor.
+  std::string identifier() {
+    skipWs();
+    std::size_t j = i_;
+    if (j < s_.size() && (std::isalpha(static_cast<unsigned char>(s_[j])) || s_[j] == '_')) {
+      ++j;
+      while (j < s_.size() && (std::isalnum(static_cast<unsigned char>(s_[j])) || s_[j] == '_'))
+        ++j;
+    }
+    std::string id = s_.substr(i_, j - i_);
+    i_ = j;
+    return id;
+  }
+
+  /// A finite number (strtod syntax); the whole token up to a delimiter must parse.
+  double number() {
+    skipWs();
+    const std::size_t start = i_;
+    std::size_t j = i_;
+    while (j < s_.size() && !std::isspace(static_cast<unsigned char>(s_[j])) && s_[j] != ',' &&
+           s_[j] != ')' && s_[j] != '(' && s_[j] != '=') {
+      // '+' separates terms unless it is an exponent or leading sign.
+      if (s_[j] == '+' && j > start && s_[j - 1] != 'e' && s_[j - 1] != 'E') break;
+      ++j;
+    }
+    const std::string tok = s_.substr(start, j - start);
+    if (tok.empty()) failHere("a number");
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(tok.c_str(), &end);
+    if (end != tok.c_str() + tok.size()) fail(start, "a number", "'" + tok + "'");
+    if (!std::isfinite(v)) fail(start, "a finite number", "'" + tok + "'");
+    i_ = j;
+    return v;
+  }
+
+  const std::string& text() const { return s_; }
+  void advanceTo(std::size_t j) { i_ = j; }
+
+ private:
+  const std::string& s_;
+  const char* what_;
+  std::size_t i_ = 0;
+};
+
+Process parseTerm(Parser& P, double rate_hz) {
+  P.skipWs();
+  const std::size_t name_pos = P.pos();
+  const std::string name = P.identifier();
+  if (name.empty()) P.failHere("a process name (" + namesList() + ")");
+  const TermSpec* spec = nullptr;
+  for (const auto& sp : kSpecs)
+    if (iequals(name, sp.name)) spec = &sp;
+  if (!spec) P.fail(name_pos, "a process name (" + namesList() + ")", "'" + name + "'");
+
+  std::string keylist;
+  for (int k = 0; k < spec->nkeys; ++k) keylist += std::string(k ? ", " : "") + spec->keys[k];
+
+  P.expect('(', "'(' after " + std::string(spec->name));
+  std::array<std::optional<double>, 2> values;
+  std::array<std::size_t, 2> value_pos{0, 0};
+  bool first = true;
+  while (true) {
+    if (P.peek() == ')') {
+      if (!first) P.failHere("a key (" + keylist + ")");  // trailing comma
+      break;
+    }
+    P.skipWs();
+    const std::size_t key_pos = P.pos();
+    const std::string key = P.identifier();
+    if (key.empty()) P.failHere("a key (" + keylist + ") of " + spec->name);
+    int idx = -1;
+    for (int k = 0; k < spec->nkeys; ++k)
+      if (iequals(key, spec->keys[k])) idx = k;
+    if (idx < 0)
+      P.fail(key_pos, "a key of " + std::string(spec->name) + " (" + keylist + ")",
+             "unknown key '" + key + "'");
+    if (values[idx])
+      P.fail(key_pos, "each key once (" + keylist + ")",
+             "duplicate key '" + std::string(spec->keys[idx]) + "'");
+    P.expect('=', "'=' after " + std::string(spec->keys[idx]));
+    P.skipWs();
+    value_pos[idx] = P.pos();
+    values[idx] = P.number();
+    first = false;
+    const char c = P.peek();
+    if (c == ',') {
+      P.expect(',', "','");
+      continue;
+    }
+    if (c == ')') break;
+    P.failHere("',' or ')'");
+  }
+  const std::size_t close_pos = P.pos();
+  P.expect(')', "')'");
+  for (int k = 0; k < spec->nkeys; ++k)
+    if (!values[k])
+      P.fail(close_pos, "key '" + std::string(spec->keys[k]) + "' of " + spec->name + "(" +
+                            keylist + ")",
+             "')'");
+
+  const std::string n = spec->name;
+  if (n == "WN") return Process::wn(*values[0]);
+  if (n == "QN") return Process::qn(*values[0]);
+  if (n == "RW") return Process::rw(*values[0]);
+  if (n == "DR") return Process::dr(*values[0]);
+  if (n == "GM") return Process::gm(*values[0], *values[1]);
+  if (n == "SIN") return Process::sin(*values[0], *values[1]);
+  // AR1(phi, sigma2) in the R package's form, stored as GM.
+  const double phi = *values[0], s2 = *values[1];
+  if (!(phi > 0.0 && phi < 1.0))
+    P.fail(value_pos[0], "phi in (0, 1) (an AR1 stored as Gauss-Markov)",
+           "phi=" + std::to_string(phi));
+  if (!(s2 > 0.0)) P.fail(value_pos[1], "sigma2 > 0", "sigma2=" + std::to_string(s2));
+  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
+    P.fail(name_pos, "a model rate (rate_hz > 0) to convert AR1 to GM", "no rate");
+  return Process::ar1(phi, s2, rate_hz);
+}
+
+std::string fmt(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+}  // namespace
+
+std::vector<Process> parseTerms(const std::string& text, double rate_hz) {
+  Parser P(text, "model");
+  std::vector<Process> terms;
+  if (P.atEnd()) P.failHere("'none' or a process term");
+  {
+    // "none" (alone) = no error.
+    Parser Q(text, "model");
+    const std::string id = Q.identifier();
+    if (iequals(id, "none")) {
+      if (!Q.atEnd()) Q.failHere("end of text after 'none'");
+      return terms;
+    }
+  }
+  while (true) {
+    terms.push_back(parseTerm(P, rate_hz));
+    if (P.atEnd()) break;
+    if (P.peek() != '+') P.failHere("'+' or end of text");
+    P.expect('+', "'+'");
+  }
+  return terms;
+}
+
+std::string formatTerms(const std::vector<Process>& terms, int digits) {
+  if (terms.empty()) return "none";
+  std::string s;
+  for (const auto& p : terms) {
+    if (!s.empty()) s += " + ";
+    s += kindName(p.kind);
+    s += "(";
+    switch (p.kind) {
+      case ProcessKind::WN: s += "sigma=" + fmt(p.sigma, digits); break;
+      case ProcessKind::QN: s += "Q=" + fmt(p.Q, digits); break;
+      case ProcessKind::RW: s += "gamma=" + fmt(p.gamma, digits); break;
+      case ProcessKind::DR: s += "omega=" + fmt(p.omega, digits); break;
+      case ProcessKind::GM: s += "sigma=" + fmt(p.sigma, digits) + ", T=" + fmt(p.T, digits); break;
+      case ProcessKind::SIN:
+        s += "amp=" + fmt(p.amp, digits) + ", freq=" + fmt(p.freq_hz, digits);
+        break;
+    }
+    s += ")";
+  }
+  return s;
+}
+
+std::vector<ProcessKind> parseStructure(const std::string& spec) {
+  Parser P(spec, "structure");
+  std::vector<ProcessKind> kinds;
+  if (P.atEnd()) P.failHere("a process name (WN, QN, RW, DR, GM, AR1, SIN)");
+  while (true) {
+    // Optional repetition count: "3GM" or "3*GM".
+    int count = 1;
+    P.skipWs();
+    if (std::isdigit(static_cast<unsigned char>(P.peek()))) {
+      const std::size_t at = P.pos();
+      std::size_t j = at;
+      const std::string& s = P.text();
+      while (j < s.size() && std::isdigit(static_cast<unsigned char>(s[j]))) ++j;
+      count = std::atoi(s.substr(at, j - at).c_str());
+      if (count < 1 || count > 16 || j - at > 2)
+        P.fail(at, "a repetition count 1..16", "'" + s.substr(at, j - at) + "'");
+      P.advanceTo(j);
+      if (P.peek() == '*') P.expect('*', "'*'");
+    }
+    P.skipWs();
+    const std::size_t at = P.pos();
+    const std::string name = P.identifier();
+    ProcessKind k;
+    if (iequals(name, "WN")) k = ProcessKind::WN;
+    else if (iequals(name, "QN")) k = ProcessKind::QN;
+    else if (iequals(name, "RW")) k = ProcessKind::RW;
+    else if (iequals(name, "DR")) k = ProcessKind::DR;
+    else if (iequals(name, "GM") || iequals(name, "AR1")) k = ProcessKind::GM;
+    else if (iequals(name, "SIN")) k = ProcessKind::SIN;
+    else if (name.empty()) P.failHere("a process name (WN, QN, RW, DR, GM, AR1, SIN)");
+    else P.fail(at, "a process name (WN, QN, RW, DR, GM, AR1, SIN)", "'" + name + "'");
+    // Tolerate the R-style empty call "GM()".
+    if (P.peek() == '(') {
+      P.expect('(', "'('");
+      P.expect(')', "')' (a structure has no parameters)");
+    }
+    for (int c = 0; c < count; ++c) kinds.push_back(k);
+    if (P.atEnd()) break;
+    P.expect('+', "'+' or end of text");
+  }
+  return kinds;
+}
+
+std::string formatStructure(const std::vector<ProcessKind>& kinds) {
+  if (kinds.empty()) return "none";
+  std::string s;
+  for (auto k : kinds) {
+    if (!s.empty()) s += "+";
+    s += kindName(k);
+  }
+  return s;
+}
+
+}  // namespace navimpact::stochastic
