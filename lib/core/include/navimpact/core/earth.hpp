@@ -1,0 +1,113 @@
+/**
+ * @file earth.hpp
+ * @brief WGS84 earth model for strapdown navigation in the local NED frame:
+ *        normal gravity, Earth rate, radii of curvature, transport rate and
+ *        geodetic <-> ECEF <-> local NED conversions (via GeographicLib).
+ *
+ * Conventions: angles in radians, heights ellipsoidal in metres, navigation
+ * frame N = local north-east-down at the point, E = ECEF (WGS84).
+ * Equation numbers refer to Groves 2013 (Principles of GNSS, Inertial, and
+ * Multisensor Integrated Navigation Systems, 2nd ed.).
+ */
+#pragma once
+
+#include <Eigen/Core>
+
+namespace navimpact::earth {
+
+constexpr double kA = 6378137.0;                  ///< WGS84 semi-major axis [m]
+constexpr double kF = 1.0 / 298.257223563;        ///< WGS84 flattening [-]
+constexpr double kE2 = kF * (2.0 - kF);           ///< first eccentricity squared [-]
+constexpr double kOmegaIE = 7.292115e-5;          ///< Earth rotation rate [rad/s] (Groves 2.133)
+constexpr double kGM = 3.986004418e14;            ///< WGS84 gravitational constant [m^3/s^2]
+
+/// Geodetic position: latitude, longitude [rad], ellipsoidal height [m].
+struct Geodetic {
+  double lat = 0.0;  ///< latitude [rad], in [-pi/2, pi/2]
+  double lon = 0.0;  ///< longitude [rad], any value (not wrapped)
+  double h = 0.0;    ///< height above the WGS84 ellipsoid [m]
+};
+
+/// Radii of curvature of the ellipsoid.
+struct Radii {
+  double R_N = 0.0;  ///< meridian radius R_N [m] (Groves 2.105)
+  double R_E = 0.0;  ///< transverse (prime vertical) radius R_E [m] (Groves 2.106)
+  double dR_N_dlat = 0.0;  ///< derivative of R_N w.r.t. latitude [m/rad]
+  double dR_E_dlat = 0.0;  ///< derivative of R_E w.r.t. latitude [m/rad]
+};
+
+/**
+ * Meridian and transverse radii of curvature.
+ * @param[in] lat  geodetic latitude [rad], in [-pi/2, pi/2].
+ */
+Radii radii(double lat);
+
+/**
+ * WGS84 normal gravity (gravitation plus centrifugal) resolved in NED at
+ * (lat, h), from GeographicLib::NormalGravity::WGS84(); the north component
+ * is the small deflection of normal gravity above the ellipsoid (0 at h = 0),
+ * east is 0.
+ * @param[in] lat  geodetic latitude [rad].
+ * @param[in] h    ellipsoidal height [m], |h| < 1e5 for meaningful results.
+ * @return g_N [m/s^2], down component positive.
+ */
+Eigen::Vector3d gravity_N(double lat, double h);
+
+/**
+ * Partial derivatives of the down component of normal gravity, for error
+ * models (Somigliana's formula differentiated, and the free-air gradient of
+ * Heiskanen & Moritz 1967 eq. 2-124).
+ * @param[in] lat  geodetic latitude [rad].
+ * @param[in] h    ellipsoidal height [m].
+ * @param[out] dgD_dlat  d g_D / d lat [m/s^2/rad].
+ * @param[out] dgD_dh    d g_D / d h [1/s^2] (negative: gravity weakens upwards).
+ */
+void gravityGradient(double lat, double h, double& dgD_dlat, double& dgD_dh);
+
+/**
+ * Earth rotation resolved in NED, omega_IE_N = Omega [cos lat, 0, -sin lat]
+ * (Groves 5.41).
+ * @param[in] lat  geodetic latitude [rad].
+ * @return [rad/s].
+ */
+Eigen::Vector3d w_IE_N(double lat);
+
+/**
+ * Transport rate, the turn rate of NED with respect to ECEF (Groves 5.44).
+ * @param[in] lat  geodetic latitude [rad], |lat| < pi/2 (singular at the poles).
+ * @param[in] h    ellipsoidal height [m].
+ * @param[in] v_N  velocity w.r.t. the Earth resolved in NED [m/s].
+ * @return omega_EN_N [rad/s].
+ */
+Eigen::Vector3d w_EN_N(double lat, double h, const Eigen::Vector3d& v_N);
+
+/**
+ * Rotation matrix from ECEF to NED at (lat, lon) (Groves 2.150 transposed).
+ * @param[in] lat, lon  geodetic latitude and longitude [rad].
+ */
+Eigen::Matrix3d C_EtoN(double lat, double lon);
+
+/// Geodetic -> ECEF [m] (GeographicLib::Geocentric::WGS84()).
+Eigen::Vector3d geodeticToEcef(const Geodetic& p);
+
+/// ECEF [m] -> geodetic (exact, GeographicLib).
+Geodetic ecefToGeodetic(const Eigen::Vector3d& r_E);
+
+/**
+ * Local Cartesian NED coordinates of @p p in the tangent frame at @p origin
+ * (GeographicLib::LocalCartesian gives ENU; converted to NED here).
+ * @return [north, east, down] [m].
+ */
+Eigen::Vector3d geodeticToNed(const Geodetic& origin, const Geodetic& p);
+
+/// Inverse of geodeticToNed(): local NED [m] at @p origin -> geodetic.
+Geodetic nedToGeodetic(const Geodetic& origin, const Eigen::Vector3d& ned);
+
+/**
+ * Small position difference a - b in metres along local N, E, D at b, using
+ * the curvilinear relations (Groves 2.119): dN = (R_N+h) dlat,
+ * dE = (R_E+h) cos(lat) dlon, dD = -dh. Accurate for differences of a few km.
+ */
+Eigen::Vector3d curvilinearDiffNed(const Geodetic& a, const Geodetic& b);
+
+}  // namespace navimpact::earth

@@ -1,0 +1,64 @@
+/**
+ * @file mechanization.hpp
+ * @brief Strapdown INS mechanization in the local-navigation (NED) frame,
+ *        Groves 2013 §5.4-5.5 (precision form with coning and sculling).
+ *
+ * Usage (emulation / replay):
+ * @code
+ *   ins::Mechanization ins(initial_state);          // NavState at t0
+ *   for (const ins::ImuSample& s : samples) ins.step(s);   // s.t increasing
+ *   const ins::NavState& x = ins.state();
+ * @endcode
+ * The filter (lib/filter) owns a Mechanization, corrects each raw sample by
+ * its estimated IMU errors before step(), and writes closed-loop corrections
+ * back with setState().
+ */
+#pragma once
+
+#include "navimpact/ins/nav_state.hpp"
+
+namespace navimpact::ins {
+
+struct MechanizationOptions {
+  /// Two-sample coning and sculling corrections using the previous interval's
+  /// increments (Groves 5.97-5.98 / Savage 1998). Off = single-sample form.
+  bool coning_sculling = true;
+};
+
+/**
+ * One mechanization step from @p prev over the sample @p cur.
+ * @param[in] prev       state at cur.t - cur.dt.
+ * @param[in] cur        (already error-corrected) increments of this interval.
+ * @param[in] last       increments of the previous interval (for the
+ *                       two-sample corrections); nullptr = none (first step).
+ * @param[in] opt        options.
+ * @return the state at cur.t.
+ */
+NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
+                   const MechanizationOptions& opt = {});
+
+/// Stateful wrapper: keeps the current state and the previous increments.
+class Mechanization {
+ public:
+  Mechanization() = default;
+  /// @param[in] initial  state at the start time initial.t.
+  explicit Mechanization(const NavState& initial, const MechanizationOptions& opt = {})
+      : x_(initial), opt_(opt) {}
+
+  /// Integrate one interval; @p s.dt > 0, s.t = state().t + s.dt (not checked).
+  void step(const ImuSample& s);
+  const NavState& state() const { return x_; }
+  /// Overwrite the state (closed-loop correction); the increment history is kept.
+  void setState(const NavState& x) { x_ = x; }
+  /// Forget the previous increments (after a data gap).
+  void resetHistory() { has_last_ = false; }
+  const MechanizationOptions& options() const { return opt_; }
+
+ private:
+  NavState x_;
+  MechanizationOptions opt_;
+  ImuSample last_;
+  bool has_last_ = false;
+};
+
+}  // namespace navimpact::ins

@@ -1,0 +1,72 @@
+// Local-navigation-frame strapdown mechanization, Groves 2013 §5.4-5.5.
+#include "navimpact/ins/mechanization.hpp"
+
+#include <cmath>
+
+namespace navimpact::ins {
+
+using Eigen::Vector3d;
+
+NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
+                   const MechanizationOptions& opt) {
+  const double tau = cur.dt;
+  const Vector3d& a = cur.dtheta_B;  // alpha_IB_B
+  const Vector3d& u = cur.dv_B;      // upsilon_IB_B
+
+  // Two-sample coning and sculling (Groves 5.97, 5.98; Savage 1998), using
+  // the previous interval's increments.
+  Vector3d a_c = a;
+  Vector3d u_c = u + 0.5 * a.cross(u);  // rotation correction (Groves 5.85 first order)
+  if (opt.coning_sculling && last != nullptr) {
+    a_c += (1.0 / 12.0) * last->dtheta_B.cross(a);
+    u_c += (1.0 / 12.0) * (last->dtheta_B.cross(u) + last->dv_B.cross(a));
+  }
+
+  const earth::Radii r0 = earth::radii(prev.lat);
+  const Vector3d w_ie0 = earth::w_IE_N(prev.lat);
+  const Vector3d w_en0 = earth::w_EN_N(prev.lat, prev.h, prev.v_N);
+  const Eigen::Matrix3d C0 = prev.C_BtoN();
+
+  // Specific-force frame transformation with the mean N-frame rotation (Groves 5.86).
+  const Vector3d dv_f_N = C0 * u_c - 0.5 * (w_ie0 + w_en0).cross(C0 * u_c) * tau;
+
+  // Velocity update (Groves 5.54) with gravity and Coriolis evaluated at the
+  // interval midpoint (predicted, then corrected once).
+  const Vector3d g0 = earth::gravity_N(prev.lat, prev.h);
+  Vector3d v1 = prev.v_N + dv_f_N + (g0 - (2.0 * w_ie0 + w_en0).cross(prev.v_N)) * tau;
+  {
+    const Vector3d v_mid = 0.5 * (prev.v_N + v1);
+    const double h_mid = prev.h - 0.5 * tau * v_mid.z();
+    const double lat_mid = prev.lat + 0.5 * tau * v_mid.x() / (r0.R_N + h_mid);
+    const Vector3d g_mid = earth::gravity_N(lat_mid, h_mid);
+    const Vector3d w_ie_mid = earth::w_IE_N(lat_mid);
+    const Vector3d w_en_mid = earth::w_EN_N(lat_mid, h_mid, v_mid);
+    v1 = prev.v_N + dv_f_N + (g_mid - (2.0 * w_ie_mid + w_en_mid).cross(v_mid)) * tau;
+  }
+
+  // Position update, trapezoidal (Groves 5.56).
+  NavState x;
+  x.t = cur.t;
+  x.h = prev.h - 0.5 * tau * (prev.v_N.z() + v1.z());
+  x.lat = prev.lat + 0.5 * tau * (prev.v_N.x() / (r0.R_N + prev.h) + v1.x() / (r0.R_N + x.h));
+  const earth::Radii r1 = earth::radii(x.lat);
+  x.lon = prev.lon + 0.5 * tau * (prev.v_N.y() / ((r0.R_E + prev.h) * std::cos(prev.lat)) +
+                                  v1.y() / ((r1.R_E + x.h) * std::cos(x.lat)));
+  x.v_N = v1;
+
+  // Attitude update: body rotation (corrected increment) and N-frame rotation
+  // over the interval with the mean omega_IN (Groves 5.73 in quaternion form).
+  const double lat_m = 0.5 * (prev.lat + x.lat), h_m = 0.5 * (prev.h + x.h);
+  const Vector3d w_in_mid =
+      earth::w_IE_N(lat_m) + earth::w_EN_N(lat_m, h_m, 0.5 * (prev.v_N + v1));
+  x.q_BtoN = (quatFromRotVec(-w_in_mid * tau) * prev.q_BtoN * quatFromRotVec(a_c)).normalized();
+  return x;
+}
+
+void Mechanization::step(const ImuSample& s) {
+  x_ = mechanize(x_, s, has_last_ ? &last_ : nullptr, opt_);
+  last_ = s;
+  has_last_ = true;
+}
+
+}  // namespace navimpact::ins

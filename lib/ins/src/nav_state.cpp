@@ -1,0 +1,49 @@
+#include "navimpact/ins/nav_state.hpp"
+
+#include <cmath>
+
+namespace navimpact::ins {
+
+Eigen::Quaterniond quatFromRollPitchYaw(double roll, double pitch, double yaw) {
+  // C_BtoN = Rz(yaw) Ry(pitch) Rx(roll) (Groves 2.22)
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .normalized();
+}
+
+Eigen::Vector3d rollPitchYaw(const Eigen::Matrix3d& C) {
+  // Groves 2.23
+  const double roll = std::atan2(C(2, 1), C(2, 2));
+  const double pitch = -std::asin(std::max(-1.0, std::min(1.0, C(2, 0))));
+  const double yaw = std::atan2(C(1, 0), C(0, 0));
+  return Eigen::Vector3d(roll, pitch, yaw);
+}
+
+Eigen::Vector3d NavState::rollPitchYaw() const { return ins::rollPitchYaw(C_BtoN()); }
+
+void NavState::setRollPitchYaw(double roll, double pitch, double yaw) {
+  q_BtoN = quatFromRollPitchYaw(roll, pitch, yaw);
+}
+
+Eigen::Quaterniond quatFromRotVec(const Eigen::Vector3d& phi) {
+  const double a2 = phi.squaredNorm();
+  double s, c;  // sin(a/2)/a, cos(a/2)
+  if (a2 < 1e-10) {
+    s = 0.5 - a2 / 48.0;
+    c = 1.0 - a2 / 8.0;
+  } else {
+    const double a = std::sqrt(a2);
+    s = std::sin(0.5 * a) / a;
+    c = std::cos(0.5 * a);
+  }
+  return Eigen::Quaterniond(c, s * phi.x(), s * phi.y(), s * phi.z()).normalized();
+}
+
+double wrapAngle(double a) {
+  double r = std::remainder(a, 2.0 * 3.14159265358979323846);
+  if (r <= -3.14159265358979323846) r += 2.0 * 3.14159265358979323846;
+  return r;
+}
+
+}  // namespace navimpact::ins
