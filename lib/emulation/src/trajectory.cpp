@@ -1,0 +1,221 @@
+#include "navimpact/emulation/trajectory.hpp"
+
+#include <cmath>
+#include <map>
+
+#include <Eigen/Geometry>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/text_io.hpp"
+#include "navimpact/core/units.hpp"
+
+namespace navimpact::emulation {
+
+Eigen::Matrix3d eulerToC_NtoB(double roll, double pitch, double yaw) {
+  const double cr = std::cos(roll), sr = std::sin(roll);
+  const double cp = std::cos(pitch), sp = std::sin(pitch);
+  const double cy = std::cos(yaw), sy = std::sin(yaw);
+  Eigen::Matrix3d C;  // Groves 2013 eq. 2.22
+  C << cp * cy, cp * sy, -sp,
+      -cr * sy + sr * sp * cy, cr * cy + sr * sp * sy, sr * cp,
+      sr * sy + cr * sp * cy, -sr * cy + cr * sp * sy, cr * cp;
+  return C;
+}
+
+namespace {
+
+double angleFactor(const std::string& unit, const std::string& key, const std::string& file) {
+  if (unit == "rad") return 1.0;
+  if (unit == "deg") return units::kDeg;
+  throw keyError(file, key, "unit '" + unit + "' is not 'rad' or 'deg'");
+}
+
+}  // namespace
+
+SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
+  const std::string& path = spec.file;
+  const bool geo = spec.system == "geodetic";
+  if (!geo && spec.system != "ned")
+    throw keyError(path, "trajectory.system", "'" + spec.system + "' is not 'geodetic' or 'ned'");
+  if (!geo && !spec.origin)
+    throw keyError(path, "trajectory.origin",
+                   "a local NED trajectory needs a geodetic origin (lat_deg, lon_deg, height_m)");
+  const double kLL = geo ? angleFactor(spec.latlon_unit, "trajectory.latlon_unit", path) : 1.0;
+  const double kAtt = angleFactor(spec.attitude_unit, "trajectory.attitude_unit", path);
+  double kT = 1.0;
+  if (spec.time_unit == "ms") kT = 1e-3;
+  else if (spec.time_unit != "s")
+    throw keyError(path, "trajectory.time_unit", "'" + spec.time_unit + "' is not 's' or 'ms'");
+  if (!(spec.max_gap_s > 0.0)) throw keyError(path, "trajectory.max_gap_s", "must be > 0");
+
+  const std::string text = readFileMaybeGz(path);
+  std::size_t pos = 0, lineNo = 0;
+  auto nextLine = [&](std::string_view& line) {
+    if (pos >= text.size()) return false;
+    std::size_t e = text.find('\n', pos);
+    if (e == std::string::npos) e = text.size();
+    line = std::string_view(text.data() + pos, e - pos);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    pos = e + 1;
+    ++lineNo;
+    return true;
+  };
+  std::string_view header;
+  if (!nextLine(header) || trim(header).empty()) throw fileError(path, 1, "empty file, expected a header line");
+  const auto names = splitView(header, ',');
+  std::map<std::string, int> colIndex;
+  for (std::size_t i = 0; i < names.size(); ++i) colIndex[std::string(trim(names[i]))] = int(i);
+  const std::vector<std::string> want =
+      geo ? std::vector<std::string>{spec.col_time, spec.col_lat, spec.col_lon, spec.col_height,
+                                     spec.col_roll, spec.col_pitch, spec.col_yaw}
+          : std::vector<std::string>{spec.col_time, spec.col_north, spec.col_east, spec.col_down,
+                                     spec.col_roll, spec.col_pitch, spec.col_yaw};
+  int idx[7];
+  for (int k = 0; k < 7; ++k) {
+    auto it = colIndex.find(want[k]);
+    if (it == colIndex.end())
+      throw fileError(path, 1, "column '" + want[k] + "' not found in the header (set it in trajectory.columns)");
+    idx[k] = it->second;
+  }
+
+  SampledTrajectory out;
+  out.source = path;
+  std::vector<std::array<double, 7>> rows;
+  rows.reserve(text.size() / 60);
+  std::vector<std::size_t> lines;
+  std::string_view line;
+  while (nextLine(line)) {
+    if (trim(line).empty()) continue;
+    const auto f = splitView(line, ',');
+    if (f.size() != names.size())
+      throw fileError(path, lineNo, "expected " + std::to_string(names.size()) + " fields, found " +
+                                        std::to_string(f.size()));
+    std::array<double, 7> r{};
+    for (int k = 0; k < 7; ++k) {
+      if (!parseDouble(trim(f[idx[k]]), r[k]))
+        throw fileError(path, lineNo, "column '" + want[k] + "': '" + std::string(f[idx[k]]) + "' is not a number");
+      if (!std::isfinite(r[k]))
+        throw fileError(path, lineNo, "column '" + want[k] + "': value is NaN or infinite");
+    }
+    r[0] *= kT;
+    if (!rows.empty()) {
+      const double dt = r[0] - rows.back()[0];
+      if (dt == 0.0) throw fileError(path, lineNo, "time " + std::to_string(r[0]) + " s repeats the previous line");
+      if (dt < 0.0) throw fileError(path, lineNo, "time goes backwards (" + std::to_string(rows.back()[0]) +
+                                                      " s then " + std::to_string(r[0]) + " s)");
+      if (dt > spec.max_gap_s)
+        throw fileError(path, lineNo, "gap of " + std::to_string(dt) + " s before this line exceeds max_gap_s = " +
+                                          std::to_string(spec.max_gap_s) + " s that the smoothing spline may bridge");
+    }
+    if (spec.start_s && r[0] < *spec.start_s) { rows.push_back(r); lines.push_back(0); continue; }
+    rows.push_back(r);
+    lines.push_back(lineNo);
+  }
+  // window
+  std::size_t first = 0, last = rows.size();
+  while (first < rows.size() && spec.start_s && rows[first][0] < *spec.start_s) ++first;
+  while (last > first && spec.end_s && rows[last - 1][0] > *spec.end_s) --last;
+  if (last - first < 8)
+    throw fileError(path, 0, "only " + std::to_string(last - first) + " samples in the selected window (need >= 8)");
+
+  const auto& r0 = rows[first];
+  if (geo) out.origin = spec.origin ? *spec.origin : earth::Geodetic{r0[1] * kLL, r0[2] * kLL, r0[3]};
+  else out.origin = *spec.origin;
+  out.t.reserve(last - first);
+  out.p_L.reserve(last - first);
+  out.rpy.reserve(last - first);
+  Eigen::Vector3d prev = Eigen::Vector3d::Zero(), offset = Eigen::Vector3d::Zero();
+  for (std::size_t i = first; i < last; ++i) {
+    const auto& r = rows[i];
+    out.t.push_back(r[0]);
+    if (geo) out.p_L.push_back(earth::geodeticToNed(out.origin, earth::Geodetic{r[1] * kLL, r[2] * kLL, r[3]}));
+    else out.p_L.emplace_back(r[1], r[2], r[3]);
+    Eigen::Vector3d a(r[4] * kAtt, r[5] * kAtt, r[6] * kAtt);
+    if (std::abs(a[1]) > 85.0 * units::kDeg)
+      throw fileError(path, lines[i], "|pitch| > 85 deg: Euler-angle smoothing is singular there");
+    if (i > first)  // unwrap roll and yaw (pitch stays in [-pi/2, pi/2])
+      for (int k : {0, 2}) {
+        const double d = a[k] + offset[k] - prev[k];
+        offset[k] -= 2.0 * units::kPi * std::round(d / (2.0 * units::kPi));
+      }
+    a += offset;
+    prev = a;
+    out.rpy.push_back(a);
+  }
+  return out;
+}
+
+SmoothTrajectory::SmoothTrajectory(const SampledTrajectory& s, const SmoothingOptions& opt)
+    : origin_(s.origin), opt_(opt) {
+  const std::size_t n = s.t.size();
+  std::vector<std::vector<double>> p(3, std::vector<double>(n)), a(3, std::vector<double>(n));
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      p[k][i] = s.p_L[i][k];
+      a[k][i] = s.rpy[i][k];
+    }
+  pos_ = PSpline(s.t, p, {opt.position_cutoff_hz, opt.knot_step_s, opt.penalty_order});
+  att_ = PSpline(s.t, a, {opt.attitude_cutoff_hz, opt.knot_step_s, opt.penalty_order});
+  t0_ = s.t.front();
+  t1_ = s.t.back();
+  r0_E_ = earth::geodeticToEcef(origin_);
+  C_LtoE_ = earth::C_EtoN(origin_.lat, origin_.lon).transpose();
+}
+
+void SmoothTrajectory::kinematics(double t, bool full, TruthState& s) const {
+  s.t = t;
+  Eigen::Vector3d v_L, a_L;
+  for (int k = 0; k < 3; ++k) pos_.eval(k, t, &s.p_L[k], &v_L[k], &a_L[k]);
+  s.pos = earth::ecefToGeodetic(r0_E_ + C_LtoE_ * s.p_L);
+  const Eigen::Matrix3d C_LtoN = earth::C_EtoN(s.pos.lat, s.pos.lon) * C_LtoE_;
+  s.v_N = C_LtoN * v_L;
+  s.w_IE_N = earth::w_IE_N(s.pos.lat);
+  s.w_EN_N = earth::w_EN_N(s.pos.lat, s.pos.h, s.v_N);
+  s.a_N = C_LtoN * a_L - s.w_EN_N.cross(s.v_N);
+  Eigen::Vector3d rate;
+  for (int k = 0; k < 3; ++k) att_.eval(k, t, &s.rpy[k], &rate[k], nullptr);
+  const double r = s.rpy[0], p = s.rpy[1];
+  const Eigen::Matrix3d C_NtoB = eulerToC_NtoB(r, p, s.rpy[2]);
+  s.C_BtoN = C_NtoB.transpose();
+  // Body rate from Euler rates (Groves 2013 eq. 2.58 inverted / Titterton & Weston 3.60).
+  const double cr = std::cos(r), sr = std::sin(r), cp = std::cos(p), sp = std::sin(p);
+  s.w_NB_B = Eigen::Vector3d(rate[0] - rate[2] * sp, rate[1] * cr + rate[2] * sr * cp,
+                             -rate[1] * sr + rate[2] * cr * cp);
+  if (!full) return;
+  s.g_N = earth::gravity_N(s.pos.lat, s.pos.h);
+  // Groves 2013 eq. 5.54: dv_N/dt = C_BtoN f_B + g_N - (w_EN_N + 2 w_IE_N) x v_N
+  s.f_B = C_NtoB * (s.a_N - s.g_N + (2.0 * s.w_IE_N + s.w_EN_N).cross(s.v_N));
+  // Groves 2013 eq. 5.45: w_NB_B = w_IB_B - C_NtoB (w_IE_N + w_EN_N)
+  s.w_IB_B = s.w_NB_B + C_NtoB * (s.w_IE_N + s.w_EN_N);
+}
+
+TruthState SmoothTrajectory::at(double t) const {
+  TruthState s;
+  kinematics(t, true, s);
+  return s;
+}
+
+void SmoothTrajectory::increments(double ta, double tb, Eigen::Vector3d& dv_B,
+                                  Eigen::Vector3d& dth_B) const {
+  static const double x3 = std::sqrt(0.6);
+  static const double nodes[3] = {-x3, 0.0, x3};
+  static const double weights[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+  thread_local std::vector<double> knots;
+  pos_.knotsInside(ta, tb, knots);
+  dv_B.setZero();
+  dth_B.setZero();
+  TruthState s;
+  double lo = ta;
+  for (std::size_t k = 0; k <= knots.size(); ++k) {
+    const double hi = k < knots.size() ? knots[k] : tb;
+    const double mid = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
+    for (int q = 0; q < 3; ++q) {
+      kinematics(mid + half * nodes[q], true, s);
+      dv_B += (weights[q] * half) * s.f_B;
+      dth_B += (weights[q] * half) * s.w_IB_B;
+    }
+    lo = hi;
+  }
+}
+
+}  // namespace navimpact::emulation

@@ -1,0 +1,118 @@
+// Trajectory CSV import: both shared trajectories, units, and bad input.
+#include <fstream>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/emulation/trajectory.hpp"
+#include "test_support.hpp"
+
+namespace emu = navimpact::emulation;
+
+namespace {
+std::string writeCsv(const std::string& name, const std::string& body) {
+  const auto p = navimpact::test::tempDir() / name;
+  std::ofstream(p) << body;
+  return p.string();
+}
+std::string errorOf(const emu::TrajectorySpec& s) {
+  try {
+    emu::readTrajectoryCsv(s);
+  } catch (const navimpact::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+emu::TrajectorySpec nedSpec(const std::string& file) {
+  emu::TrajectorySpec s;
+  s.file = file;
+  s.system = "ned";
+  s.col_time = "t"; s.col_north = "n"; s.col_east = "e"; s.col_down = "d";
+  s.col_roll = "r"; s.col_pitch = "p"; s.col_yaw = "y";
+  s.attitude_unit = "deg";
+  s.origin = navimpact::earth::Geodetic{0.8, 0.1, 500};
+  return s;
+}
+std::string nedRows(int n, double dt = 0.01) {
+  std::string s = "t,n,e,d,r,p,y\n";
+  for (int i = 0; i < n; ++i)
+    s += std::to_string(i * dt) + "," + std::to_string(i * 0.1) + ",0,0,1,2," + std::to_string(170 + i * 2) + "\n";
+  return s;
+}
+}  // namespace
+
+TEST(Trajectory, ReadsLocalNedWithDegreesAndUnwrapsYaw) {
+  const auto f = writeCsv("a.csv", nedRows(20));
+  auto s = emu::readTrajectoryCsv(nedSpec(f));
+  ASSERT_EQ(s.t.size(), 20u);
+  EXPECT_NEAR(s.rpy[0][0], 1.0 * M_PI / 180, 1e-12);
+  EXPECT_NEAR(s.p_L[5][0], 0.5, 1e-12);
+  // yaw passes 180 deg: stays continuous after unwrapping (it is continuous already)
+  EXPECT_NEAR(s.rpy[19][2], (170 + 38) * M_PI / 180, 1e-12);
+}
+
+TEST(Trajectory, UnwrapsWrappedYaw) {
+  std::string body = "t,n,e,d,r,p,y\n";
+  for (int i = 0; i < 20; ++i) {
+    double y = 170 + i * 2;
+    if (y > 180) y -= 360;
+    body += std::to_string(i * 0.01) + ",0,0,0,0,0," + std::to_string(y) + "\n";
+  }
+  auto s = emu::readTrajectoryCsv(nedSpec(writeCsv("w.csv", body)));
+  EXPECT_NEAR(s.rpy[19][2], 208 * M_PI / 180, 1e-9);
+}
+
+TEST(Trajectory, BadInputNamesFileAndLine) {
+  std::string rows = nedRows(20);
+  auto replaceLine = [&](int line, const std::string& with) {  // 1-based line
+    std::string out;
+    std::size_t pos = 0;
+    for (int l = 1; pos < rows.size(); ++l) {
+      const auto e = rows.find('\n', pos);
+      out += (l == line ? with : rows.substr(pos, e - pos)) + "\n";
+      pos = e + 1;
+    }
+    return out;
+  };
+  const auto rep = writeCsv("rep.csv", replaceLine(6, "0.03,0,0,0,0,0,0"));
+  EXPECT_NE(errorOf(nedSpec(rep)).find("rep.csv:6: time"), std::string::npos) << errorOf(nedSpec(rep));
+  const auto back = writeCsv("back.csv", replaceLine(6, "0.01,0,0,0,0,0,0"));
+  EXPECT_NE(errorOf(nedSpec(back)).find("back.csv:6: time goes backwards"), std::string::npos);
+  const auto nan = writeCsv("nan.csv", replaceLine(7, "0.05,nan,0,0,0,0,0"));
+  EXPECT_NE(errorOf(nedSpec(nan)).find("nan.csv:7:"), std::string::npos) << errorOf(nedSpec(nan));
+  const auto gap = writeCsv("gap.csv", replaceLine(9, "5.0,0,0,0,0,0,0"));
+  EXPECT_NE(errorOf(nedSpec(gap)).find("gap.csv:9: gap"), std::string::npos) << errorOf(nedSpec(gap));
+  const auto shortRow = writeCsv("short.csv", replaceLine(4, "0.02,0,0"));
+  EXPECT_NE(errorOf(nedSpec(shortRow)).find("short.csv:4:"), std::string::npos);
+  auto noOrigin = nedSpec(writeCsv("ok.csv", rows));
+  noOrigin.origin.reset();
+  EXPECT_NE(errorOf(noOrigin).find("origin"), std::string::npos);
+  auto badCol = nedSpec(writeCsv("ok2.csv", rows));
+  badCol.col_yaw = "heading";
+  EXPECT_NE(errorOf(badCol).find("'heading' not found"), std::string::npos);
+}
+
+TEST(Trajectory, ReadsBothSharedTrajectories) {
+  NAVIMPACT_REQUIRE_SHARED();
+  emu::TrajectorySpec g;
+  g.file = navimpact::test::sharedPath("data/trajectories/uav_flight_600s_ellipsoidal.csv");
+  auto a = emu::readTrajectoryCsv(g);
+  EXPECT_EQ(a.t.size(), 60000u);
+  EXPECT_NEAR(a.origin.lat, 0.81278354095, 1e-12);
+  EXPECT_LT(a.p_L[0].norm(), 1e-6);
+  emu::SmoothTrajectory ta(a, {});
+  const auto s = ta.at(300.0);
+  EXPECT_GT(s.v_N.head<2>().norm(), 1.0);
+  EXPECT_LT(s.v_N.norm(), 60.0);
+
+  emu::TrajectorySpec n;
+  n.file = navimpact::test::sharedPath("data/trajectories/lemniscate_600s_ned.csv");
+  n.system = "ned";
+  n.origin = navimpact::earth::Geodetic{46.5 * M_PI / 180, 6.5 * M_PI / 180, 400};
+  auto b = emu::readTrajectoryCsv(n);
+  EXPECT_EQ(b.t.size(), 60001u);
+  emu::SmoothTrajectory tb(b, {});
+  // x_N = 50 sin(w t): the smooth velocity follows 50 w cos(w t) (spline gain ~1 at 1/60 Hz).
+  const double w = 2 * M_PI / 60;
+  const auto sb = tb.at(100.0);
+  EXPECT_NEAR(sb.v_N[0], 50 * w * std::cos(w * 100.0), 1e-3);
+  EXPECT_NEAR(sb.v_N[1], 25 * 2 * w * std::cos(2 * w * 100.0), 1e-3);
+}
