@@ -25,7 +25,9 @@ Color palette(int i);
 
 enum class LineStyle { Solid, Dashed, Dotted, None };
 enum class Marker { None, Circle, FilledCircle, Square, Cross };
-enum class LegendPos { TopRight, TopLeft, BottomRight, BottomLeft, None };
+/// Legend placement inside the plot area. Best picks the corner covering the
+/// fewest drawn data points (ties: TopRight, TopLeft, BottomLeft, BottomRight).
+enum class LegendPos { TopRight, TopLeft, BottomRight, BottomLeft, None, Best };
 
 struct Series {
   std::string label;            ///< legend text ("" = not in legend)
@@ -67,7 +69,7 @@ struct Axes {
   std::vector<Series> series;
   std::vector<HLine> hlines;
   std::optional<std::pair<double, double>> xlim, ylim;  ///< default: data range
-  LegendPos legend = LegendPos::TopRight;
+  LegendPos legend = LegendPos::Best;  ///< Best: corner hiding the least data
   bool grid = true;
 };
 
@@ -77,6 +79,14 @@ struct Figure {
   std::string title;
   int rows = 1, cols = 1;
   std::vector<Axes> axes;
+  /// TrueType font used for all text (DejaVu Sans from fonts-dejavu-core).
+  std::string font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+};
+
+/// Pixel rectangle of one plot area (inside the axes frame), image coordinates
+/// (x to the right, y downwards, origin at the top-left pixel).
+struct PixelRect {
+  int x = 0, y = 0, width = 0, height = 0;
 };
 
 /**
@@ -85,5 +95,15 @@ struct Figure {
  *         (e.g. non-positive data on a log axis only) or the file cannot be written.
  */
 void savePng(const Figure& fig, const std::string& path);
+
+/**
+ * Layout of @p fig as savePng would draw it, without drawing.
+ * @param[in] fig  the figure.
+ * @return one rectangle per element of fig.axes: the plot area (data region) in
+ *         pixels. A data point (x, y) inside the limits maps linearly (or
+ *         log10-linearly) from the left/bottom edge to the right/top edge.
+ * @throws navimpact::Error as savePng (font, layout), but never writes.
+ */
+std::vector<PixelRect> plotAreas(const Figure& fig);
 
 }  // namespace navimpact::plot
