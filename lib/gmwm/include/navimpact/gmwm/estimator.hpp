@@ -24,6 +24,11 @@ struct FitOptions {
   int bootstrap = 0;             ///< parametric bootstrap replicates for CIs (0 = asymptotic)
   std::uint64_t seed = 20190101; ///< seed of the bootstrap / random starts
   int max_starts = 0;            ///< 0 = automatic multi-start count
+  /// Extra starting points: fitted models of sub-structures (e.g. the same
+  /// structure with one GM less) or of the same structure. Missing terms are
+  /// added on a grid of placements (GM T across the scale range) and with a
+  /// negligible amplitude, so the fit never ends above the warm start's objective.
+  std::vector<stochastic::Model> warm_starts;
 };
 
 /// 95 % interval of one parameter.
@@ -41,7 +46,13 @@ struct FitResult {
   std::string ci_method;                         ///< "asymptotic" or "bootstrap(N)"
   int starts = 0;                                ///< starting points tried
   bool converged = false;
+  /// Parameter covariance in the transformed space (log sigma, log T, ...),
+  /// delta method (Guerrier et al. 2013): (A'WA)^+ A'W V W A (A'WA)^+.
+  Eigen::MatrixXd cov_transformed;
 };
+
+/// Number of parameters of a structure (GM and SIN count 2, the others 1).
+int parameterCount(const std::vector<stochastic::ProcessKind>& structure);
 
 /// The GMWM objective of @p m against @p wv (weights = wv.weights()).
 double objective(const stochastic::Model& m, const WaveletVariance& wv);
@@ -52,6 +63,21 @@ double objective(const stochastic::Model& m, const WaveletVariance& wv);
  */
 FitResult fit(const std::vector<stochastic::ProcessKind>& structure, const WaveletVariance& wv,
               const FitOptions& opt = {});
+
+/**
+ * Asymptotic optimism of a fit, 2 tr(A dTheta V Omega) with
+ * dTheta = (B + D)^+ A' Omega the sensitivity of theta_hat to nu_hat,
+ * B = A' Omega A, D_kl = sum_j d2nu_j/dtheta_k dtheta_l Omega_jj (nu_j(theta_hat) - nu_hat_j),
+ * V = diag(2 nu_j(theta_hat)^2 / eta_j) (chi-square variance of each WV estimate).
+ * (Guerrier et al. 2013 / R gmwm model_score, gmwm_formulas.md §6.)
+ */
+double optimism(const FitResult& f, const WaveletVariance& wv);
+
+/**
+ * Default candidates of the automatic selection: WN + optional QN, RW, DR +
+ * 0..max_gm GM (WN always present: every MEMS channel shows it at the first scales).
+ */
+std::vector<std::vector<stochastic::ProcessKind>> defaultCandidates(int max_gm = 3);
 
 /// One candidate of an automatic model selection.
 struct RankedModel {

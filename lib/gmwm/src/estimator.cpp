@@ -1,0 +1,680 @@
+// GMWM estimator (Guerrier et al. 2013): minimise
+//   (nu_hat - nu(theta))' Omega (nu_hat - nu(theta)),  Omega = diag(1/(CI_hi - CI_lo)^2)
+// with Ceres (Levenberg-Marquardt, autodiff Jacobians) over a transformed
+// parameter vector (fit_internal.hpp), from deterministic multi-start points.
+//
+// Starting values (gmwm_formulas.md §5 describes the R package's random
+// search; this is a deterministic replacement): the model WV is LINEAR in the
+// variance-like parameters (sigma^2, Q^2, gamma^2, omega^2, GM stationary
+// variance, SIN amp^2) once the GM correlation times (and SIN frequencies) are
+// fixed. So every placement of the GM T's on a log2 grid spanning the scale
+// range (one grid point per octave, from tau_1/4 to 2 tau_J) is scored by a
+// non-negative least-squares fit of the amplitudes (variable projection),
+// both on R's unweighted relative criterion sum (1 - nu_j/nu_hat_j)^2 and on
+// the weighted objective. The best placements of each are polished by Ceres
+// (the relative ones first on the relative criterion, as R does), then
+// minimised on the weighted objective; the lowest objective wins.
+#include "navimpact/gmwm/estimator.hpp"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+
+#include "fit_internal.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/simulate.hpp"
+#include "navimpact/stochastic/theoretical_wv.hpp"
+
+namespace navimpact::gmwm {
+
+using stochastic::Model;
+using stochastic::Process;
+using stochastic::ProcessKind;
+
+namespace detail {
+
+Model toModel(const Layout& L, const Eigen::VectorXd& th, double rate_hz) {
+  Model m;
+  m.rate_hz = rate_hz;
+  for (std::size_t i = 0; i < L.kinds.size(); ++i) {
+    const double* t = th.data() + L.offset[i];
+    switch (L.kinds[i]) {
+      case ProcessKind::WN: m.terms.push_back(Process::wn(std::exp(t[0]))); break;
+      case ProcessKind::QN: m.terms.push_back(Process::qn(std::exp(t[0]))); break;
+      case ProcessKind::RW: m.terms.push_back(Process::rw(std::exp(t[0]))); break;
+      case ProcessKind::DR: m.terms.push_back(Process::dr(std::exp(t[0]))); break;
+      case ProcessKind::GM: m.terms.push_back(Process::gm(std::exp(t[0]), std::exp(t[1]) / rate_hz)); break;
+      case ProcessKind::SIN:
+        m.terms.push_back(Process::sin(std::exp(t[0]), std::exp(t[1]) * rate_hz));
+        break;
+    }
+  }
+  return m;
+}
+
+Eigen::VectorXd fromModel(const Layout& L, const Model& m) {
+  Eigen::VectorXd th(L.p);
+  for (std::size_t i = 0; i < L.kinds.size(); ++i) {
+    const Process& q = m.terms.at(i);
+    double* t = th.data() + L.offset[i];
+    switch (L.kinds[i]) {
+      case ProcessKind::WN: t[0] = std::log(q.sigma); break;
+      case ProcessKind::QN: t[0] = std::log(q.Q); break;
+      case ProcessKind::RW: t[0] = std::log(q.gamma); break;
+      case ProcessKind::DR: t[0] = std::log(std::fabs(q.omega)); break;
+      case ProcessKind::GM:
+        t[0] = std::log(q.sigma);
+        t[1] = std::log(q.T * m.rate_hz);
+        break;
+      case ProcessKind::SIN:
+        t[0] = std::log(q.amp);
+        t[1] = std::log(q.freq_hz / m.rate_hz);
+        break;
+    }
+  }
+  return th;
+}
+
+using Jet = ceres::Jet<double, kMaxParams>;
+
+Eigen::MatrixXd jacobian(const Layout& L, const Eigen::VectorXd& th, const Eigen::VectorXd& tau) {
+  std::vector<Jet> x(L.p);
+  for (int k = 0; k < L.p; ++k) x[k] = Jet(th[k], k);
+  std::vector<Jet> nu(tau.size());
+  modelWv(L, x.data(), tau, nu.data());
+  Eigen::MatrixXd A(tau.size(), L.p);
+  for (Eigen::Index j = 0; j < tau.size(); ++j)
+    for (int k = 0; k < L.p; ++k) A(j, k) = nu[j].v[k];
+  return A;
+}
+
+Eigen::VectorXd wvOf(const Layout& L, const Eigen::VectorXd& th, const Eigen::VectorXd& tau) {
+  Eigen::VectorXd nu(tau.size());
+  modelWv(L, th.data(), tau, nu.data());
+  return nu;
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::Jet;
+using detail::kMaxParams;
+using detail::Layout;
+
+/// Residuals r_j = w_j (nu_hat_j - nu_j(theta)), Jacobian by forward-mode autodiff.
+class WvCost final : public ceres::CostFunction {
+ public:
+  WvCost(const Layout& L, const Eigen::VectorXd& tau, const Eigen::VectorXd& nu_hat,
+         const Eigen::VectorXd& w)
+      : L_(L), tau_(tau), nu_hat_(nu_hat), w_(w) {
+    set_num_residuals(static_cast<int>(tau.size()));
+    mutable_parameter_block_sizes()->push_back(L.p);
+  }
+  bool Evaluate(double const* const* params, double* res, double** jac) const override {
+    const double* th = params[0];
+    const Eigen::Index J = tau_.size();
+    if (jac == nullptr || jac[0] == nullptr) {
+      std::vector<double> nu(J);
+      detail::modelWv(L_, th, tau_, nu.data());
+      for (Eigen::Index j = 0; j < J; ++j) res[j] = w_[j] * (nu_hat_[j] - nu[j]);
+    } else {
+      std::vector<Jet> x(L_.p), nu(J);
+      for (int k = 0; k < L_.p; ++k) x[k] = Jet(th[k], k);
+      detail::modelWv(L_, x.data(), tau_, nu.data());
+      for (Eigen::Index j = 0; j < J; ++j) {
+        res[j] = w_[j] * (nu_hat_[j] - nu[j].a);
+        for (int k = 0; k < L_.p; ++k) jac[0][j * L_.p + k] = -w_[j] * nu[j].v[k];
+      }
+    }
+    for (Eigen::Index j = 0; j < J; ++j)
+      if (!std::isfinite(res[j])) return false;
+    return true;
+  }
+
+ private:
+  const Layout& L_;
+  const Eigen::VectorXd& tau_;
+  const Eigen::VectorXd& nu_hat_;
+  const Eigen::VectorXd& w_;
+};
+
+/// Everything one fit needs about the data.
+struct Data {
+  Eigen::VectorXd tau, nu_hat, w_rel, w_obj, omega;
+  double rate = 0;
+  double n = 0;
+  int J = 0;
+};
+
+Data makeData(const WaveletVariance& wv) {
+  Data d;
+  d.J = wv.scales();
+  if (d.J < 1) throw Error("GMWM fit: the wavelet variance has no scales");
+  if (!(wv.rate_hz > 0.0)) throw Error("GMWM fit: the wavelet variance has no sampling rate");
+  if (wv.wv.size() != d.J || wv.ci_low.size() != d.J || wv.ci_high.size() != d.J)
+    throw Error("GMWM fit: wavelet variance vectors of different lengths");
+  for (int j = 0; j < d.J; ++j)
+    if (!(wv.wv[j] > 0.0) || !std::isfinite(wv.wv[j]) || !(wv.ci_high[j] > wv.ci_low[j]))
+      throw Error("GMWM fit: wavelet variance at scale " + std::to_string(j + 1) +
+                  " is not positive and finite or has an empty confidence interval");
+  d.tau = wv.tau;
+  d.nu_hat = wv.wv;
+  d.w_rel = wv.wv.cwiseInverse();
+  d.omega = wv.weights();
+  d.w_obj = d.omega.cwiseSqrt();
+  d.rate = wv.rate_hz;
+  d.n = wv.n > 0 ? double(wv.n) : std::pow(2.0, d.J + 1);
+  return d;
+}
+
+double criterion(const Layout& L, const Eigen::VectorXd& th, const Data& d, const Eigen::VectorXd& w) {
+  const Eigen::VectorXd nu = detail::wvOf(L, th, d.tau);
+  double s = 0;
+  for (int j = 0; j < d.J; ++j) {
+    const double r = w[j] * (d.nu_hat[j] - nu[j]);
+    s += r * r;
+  }
+  return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
+}
+
+// Bounds of the transformed parameters: log amplitudes within +-150 (no
+// overflow of exp(2 x)); GM T between 0.05 samples (white) and 1000 records
+// (indistinguishable from a random walk); SIN below Nyquist.
+void setBounds(ceres::Problem& pb, double* x, const Layout& L, const Data& d) {
+  for (std::size_t i = 0; i < L.kinds.size(); ++i) {
+    const int o = L.offset[i];
+    pb.SetParameterLowerBound(x, o, -150.0);
+    pb.SetParameterUpperBound(x, o, 150.0);
+    if (L.kinds[i] == ProcessKind::GM) {
+      pb.SetParameterLowerBound(x, o + 1, std::log(0.05));
+      pb.SetParameterUpperBound(x, o + 1, std::log(1000.0 * d.n));
+    } else if (L.kinds[i] == ProcessKind::SIN) {
+      pb.SetParameterLowerBound(x, o + 1, std::log(1.0 / (1000.0 * d.n)));
+      pb.SetParameterUpperBound(x, o + 1, std::log(0.499));
+    }
+  }
+}
+
+void clampToBounds(Eigen::VectorXd& th, const Layout& L, const Data& d) {
+  for (std::size_t i = 0; i < L.kinds.size(); ++i) {
+    const int o = L.offset[i];
+    th[o] = std::clamp(th[o], -150.0, 150.0);
+    if (L.kinds[i] == ProcessKind::GM)
+      th[o + 1] = std::clamp(th[o + 1], std::log(0.05), std::log(1000.0 * d.n));
+    else if (L.kinds[i] == ProcessKind::SIN)
+      th[o + 1] = std::clamp(th[o + 1], std::log(1.0 / (1000.0 * d.n)), std::log(0.499));
+  }
+}
+
+/// Minimise sum (w_j (nu_hat_j - nu_j))^2 from @p th (in place); returns the criterion.
+double solve(const Layout& L, Eigen::VectorXd& th, const Data& d, const Eigen::VectorXd& w,
+             bool* converged = nullptr) {
+  clampToBounds(th, L, d);
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem pb(po);
+  pb.AddResidualBlock(new WvCost(L, d.tau, d.nu_hat, w), nullptr, th.data());
+  setBounds(pb, th.data(), L, d);
+  ceres::Solver::Options so;
+  so.minimizer_type = ceres::TRUST_REGION;
+  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = 400;
+  so.function_tolerance = 1e-13;
+  so.gradient_tolerance = 1e-14;
+  so.parameter_tolerance = 1e-12;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  so.num_threads = 1;
+  ceres::Solver::Summary sum;
+  ceres::Solve(so, &pb, &sum);
+  if (converged) *converged = sum.termination_type == ceres::CONVERGENCE;
+  return criterion(L, th, d, w);
+}
+
+/// Unit-amplitude WV profile of term i at the nonlinear parameters in th (amplitude param = 0).
+Eigen::VectorXd unitProfile(const Layout& L, int i, const Eigen::VectorXd& th, const Data& d) {
+  double t[2] = {0.0, 0.0};
+  if (detail::paramCount(L.kinds[i]) == 2) t[1] = th[L.offset[i] + 1];
+  Eigen::VectorXd prof(d.J);
+  for (int j = 0; j < d.J; ++j) prof[j] = detail::termWv(L.kinds[i], t, d.tau[j]);
+  return prof;
+}
+
+/**
+ * Non-negative least squares for the amplitudes (variances) a >= 0 of the
+ * columns of P: min || diag(w) (nu_hat - P a) ||^2. Exact by enumeration of
+ * the active sets for up to 7 columns, greedy (drop the most negative) above.
+ * Zero amplitudes become negligible ones (at most 1e-3 of nu_hat at any scale).
+ * Writes log amplitudes (0.5 log a) into th; returns the criterion.
+ */
+double nnlsAmplitudes(const Layout& L, Eigen::VectorXd& th, const Data& d, const Eigen::VectorXd& w) {
+  const int m = static_cast<int>(L.kinds.size());
+  Eigen::MatrixXd A(d.J, m);
+  for (int i = 0; i < m; ++i) A.col(i) = unitProfile(L, i, th, d).cwiseProduct(w);
+  const Eigen::VectorXd y = d.nu_hat.cwiseProduct(w);
+  Eigen::VectorXd scale(m);
+  for (int i = 0; i < m; ++i) {
+    scale[i] = A.col(i).norm();
+    if (!(scale[i] > 0) || !std::isfinite(scale[i])) scale[i] = 1.0;
+    A.col(i) /= scale[i];
+  }
+  const Eigen::MatrixXd G = A.transpose() * A;
+  const Eigen::VectorXd b = A.transpose() * y;
+  const double yy = y.squaredNorm();
+  auto solveSubset = [&](unsigned mask, Eigen::VectorXd& a) -> bool {
+    std::vector<int> idx;
+    for (int i = 0; i < m; ++i)
+      if (mask & (1u << i)) idx.push_back(i);
+    const int s = static_cast<int>(idx.size());
+    Eigen::MatrixXd Gs(s, s);
+    Eigen::VectorXd bs(s);
+    for (int r = 0; r < s; ++r) {
+      bs[r] = b[idx[r]];
+      for (int c = 0; c < s; ++c) Gs(r, c) = G(idx[r], idx[c]);
+    }
+    Gs.diagonal().array() += 1e-12;
+    const Eigen::VectorXd as = Gs.ldlt().solve(bs);
+    a.setZero(m);
+    bool feasible = true;
+    for (int r = 0; r < s; ++r) {
+      a[idx[r]] = as[r];
+      if (!(as[r] >= 0.0)) feasible = false;
+    }
+    return feasible;
+  };
+  auto value = [&](const Eigen::VectorXd& a) { return yy - 2.0 * a.dot(b) + a.dot(G * a); };
+  Eigen::VectorXd best = Eigen::VectorXd::Zero(m), a;
+  double best_v = yy;
+  const unsigned full = (1u << m) - 1u;
+  if (solveSubset(full, a)) {
+    best = a;
+    best_v = value(a);
+  } else if (m <= 7) {
+    for (unsigned mask = 1; mask < full; ++mask)
+      if (solveSubset(mask, a)) {
+        const double v = value(a);
+        if (v < best_v) {
+          best_v = v;
+          best = a;
+        }
+      }
+  } else {
+    unsigned mask = full;
+    while (mask) {
+      if (solveSubset(mask, a)) {
+        best = a;
+        best_v = value(a);
+        break;
+      }
+      int worst = -1;
+      for (int i = 0; i < m; ++i)
+        if ((mask & (1u << i)) && (worst < 0 || a[i] < a[worst])) worst = i;
+      mask &= ~(1u << worst);
+    }
+  }
+  for (int i = 0; i < m; ++i) {
+    double amp = best[i] / scale[i];  // variance-like amplitude
+    if (!(amp > 0.0)) {
+      // Negligible: at most 1e-3 of nu_hat at every scale.
+      const Eigen::VectorXd prof = unitProfile(L, i, th, d);
+      double mx = 0;
+      for (int j = 0; j < d.J; ++j) mx = std::max(mx, prof[j] / d.nu_hat[j]);
+      amp = mx > 0 ? 1e-3 / mx : 1e-30;
+    }
+    th[L.offset[i]] = 0.5 * std::log(amp);
+  }
+  return std::max(best_v, 0.0);
+}
+
+/// Log2 grid of GM correlation times [samples]: one point per octave, tau_1/4 .. 2 tau_J.
+std::vector<double> gmGrid(const Data& d) {
+  std::vector<double> g;
+  for (int i = -1; i <= d.J + 1; ++i) g.push_back(std::log(std::ldexp(1.0, i)));
+  return g;
+}
+
+/// SIN frequency grid [cycles/sample]: peak of the Haar response at tau = 1/f.
+std::vector<double> sinGrid(const Data& d) {
+  std::vector<double> g;
+  for (int j = 0; j < d.J; ++j) g.push_back(std::log(std::min(0.45, 1.0 / d.tau[j])));
+  return g;
+}
+
+struct Start {
+  Eigen::VectorXd th;
+  double score;
+};
+
+void keepBest(std::vector<Start>& best, Start s, std::size_t k) {
+  if (!std::isfinite(s.score)) return;
+  if (best.size() < k || s.score < best.back().score) {
+    best.push_back(std::move(s));
+    std::sort(best.begin(), best.end(), [](const Start& a, const Start& b) { return a.score < b.score; });
+    if (best.size() > k) best.pop_back();
+  }
+}
+
+/// Enumerate placements of the nonlinear parameters (GM T increasing along
+/// the grid, SIN frequencies likewise) and call f(th) for each.
+template <typename F>
+void forEachPlacement(const Layout& L, const Data& d, F&& f) {
+  std::vector<int> nl;  // terms with a nonlinear parameter
+  for (std::size_t i = 0; i < L.kinds.size(); ++i)
+    if (detail::paramCount(L.kinds[i]) == 2) nl.push_back(static_cast<int>(i));
+  const std::vector<double> gg = gmGrid(d), sg = sinGrid(d);
+  Eigen::VectorXd th = Eigen::VectorXd::Zero(L.p);
+  // Recursive enumeration; same-kind terms take strictly increasing grid indices.
+  std::function<void(std::size_t, int, int)> rec = [&](std::size_t k, int min_gm, int min_sin) {
+    if (k == nl.size()) {
+      f(th);
+      return;
+    }
+    const int i = nl[k];
+    const bool gm = L.kinds[i] == ProcessKind::GM;
+    const std::vector<double>& g = gm ? gg : sg;
+    for (int q = gm ? min_gm : min_sin; q < static_cast<int>(g.size()); ++q) {
+      th[L.offset[i] + 1] = g[q];
+      rec(k + 1, gm ? q + 1 : min_gm, gm ? min_sin : q + 1);
+    }
+  };
+  rec(0, 0, 0);
+}
+
+/// GM terms sorted by T (ascending), SIN by frequency; other terms keep their place.
+void sortTerms(const Layout& L, Eigen::VectorXd& th) {
+  for (ProcessKind k : {ProcessKind::GM, ProcessKind::SIN}) {
+    std::vector<int> idx;
+    for (std::size_t i = 0; i < L.kinds.size(); ++i)
+      if (L.kinds[i] == k) idx.push_back(L.offset[i]);
+    std::vector<std::pair<double, double>> v;
+    for (int o : idx) v.emplace_back(th[o + 1], th[o]);
+    std::sort(v.begin(), v.end());
+    for (std::size_t q = 0; q < idx.size(); ++q) {
+      th[idx[q]] = v[q].second;
+      th[idx[q] + 1] = v[q].first;
+    }
+  }
+}
+
+/// Starting points derived from a warm-start model (a sub-structure or the same structure).
+std::vector<Eigen::VectorXd> warmStarts(const Layout& L, const Model& warm, const Data& d) {
+  std::vector<Eigen::VectorXd> out;
+  if (warm.rate_hz > 0 && std::fabs(warm.rate_hz - d.rate) > 1e-9 * d.rate) return out;
+  Eigen::VectorXd th = Eigen::VectorXd::Zero(L.p);
+  std::vector<bool> used(warm.terms.size(), false);
+  std::vector<int> fresh;  // structure terms without a counterpart in warm
+  for (std::size_t i = 0; i < L.kinds.size(); ++i) {
+    int hit = -1;
+    for (std::size_t q = 0; q < warm.terms.size(); ++q)
+      if (!used[q] && warm.terms[q].kind == L.kinds[i]) {
+        hit = static_cast<int>(q);
+        break;
+      }
+    if (hit < 0) {
+      fresh.push_back(static_cast<int>(i));
+      continue;
+    }
+    used[hit] = true;
+    Layout one({L.kinds[i]});
+    Model mm;
+    mm.rate_hz = d.rate;
+    mm.terms = {warm.terms[hit]};
+    const Eigen::VectorXd t = detail::fromModel(one, mm);
+    th.segment(L.offset[i], t.size()) = t;
+  }
+  if (std::count(used.begin(), used.end(), false) > 0) return out;  // warm is not a sub-structure
+  for (double v : th)
+    if (!std::isfinite(v)) return out;
+  // Negligible new terms (at most 1e-6 of nu_hat at any scale), GM T mid-range:
+  // the objective starts at the warm start's value up to 1e-6.
+  auto negligible = [&](Eigen::VectorXd& t, int i) {
+    const Eigen::VectorXd prof = unitProfile(L, i, t, d);
+    double mx = 0;
+    for (int j = 0; j < d.J; ++j) mx = std::max(mx, prof[j] / d.nu_hat[j]);
+    t[L.offset[i]] = 0.5 * std::log(mx > 0 ? 1e-6 / mx : 1e-30);
+  };
+  for (int i : fresh) {
+    if (L.kinds[i] == ProcessKind::GM) th[L.offset[i] + 1] = std::log(std::sqrt(d.tau[0] * d.tau[d.J - 1]));
+    if (L.kinds[i] == ProcessKind::SIN) th[L.offset[i] + 1] = std::log(0.25);
+    negligible(th, i);
+  }
+  out.push_back(th);
+  if (fresh.empty()) return out;
+  // New terms placed in the largest residual gap: amplitudes of the new terms
+  // only, by NNLS on the weighted residual, with every GM T of the new terms
+  // on the grid (the warm terms keep their values).
+  const Eigen::VectorXd resid = d.nu_hat - detail::wvOf(L, th, d.tau);
+  std::vector<Start> best;
+  const std::vector<double> gg = gmGrid(d), sg = sinGrid(d);
+  std::function<void(std::size_t, Eigen::VectorXd&)> rec = [&](std::size_t k, Eigen::VectorXd& t) {
+    if (k == fresh.size()) {
+      const int m = static_cast<int>(fresh.size());
+      Eigen::MatrixXd A(d.J, m);
+      for (int c = 0; c < m; ++c) A.col(c) = unitProfile(L, fresh[c], t, d).cwiseProduct(d.w_obj);
+      const Eigen::VectorXd y = resid.cwiseProduct(d.w_obj);
+      Eigen::VectorXd a = A.colPivHouseholderQr().solve(y);
+      Eigen::VectorXd tt = t;
+      for (int c = 0; c < m; ++c) {
+        if (a[c] > 0 && std::isfinite(a[c]))
+          tt[L.offset[fresh[c]]] = 0.5 * std::log(a[c]);
+        else
+          negligible(tt, fresh[c]);
+      }
+      keepBest(best, {tt, criterion(L, tt, d, d.w_obj)}, 3);
+      return;
+    }
+    const int i = fresh[k];
+    if (detail::paramCount(L.kinds[i]) == 1) {
+      rec(k + 1, t);
+      return;
+    }
+    const std::vector<double>& g = L.kinds[i] == ProcessKind::GM ? gg : sg;
+    for (double v : g) {
+      t[L.offset[i] + 1] = v;
+      rec(k + 1, t);
+    }
+  };
+  Eigen::VectorXd t = th;
+  if (fresh.size() <= 2) rec(0, t);
+  for (auto& s : best) out.push_back(s.th);
+  return out;
+}
+
+/// Point estimate: multi-start, returns the transformed theta (GMs sorted).
+Eigen::VectorXd fitPoint(const Layout& L, const Data& d, const FitOptions& opt, int* starts,
+                         bool* converged) {
+  const std::size_t k = opt.max_starts > 0 ? std::max<std::size_t>(1, opt.max_starts / 2) : 4;
+  std::vector<Start> best_rel, best_obj;
+  forEachPlacement(L, d, [&](const Eigen::VectorXd& th0) {
+    Eigen::VectorXd t = th0;
+    const double vr = nnlsAmplitudes(L, t, d, d.w_rel);
+    keepBest(best_rel, {t, vr}, k);
+    t = th0;
+    const double vo = nnlsAmplitudes(L, t, d, d.w_obj);
+    keepBest(best_obj, {t, vo}, k);
+  });
+  std::vector<Eigen::VectorXd> cands;
+  for (auto& s : best_rel) {
+    Eigen::VectorXd t = s.th;
+    solve(L, t, d, d.w_rel);  // R's "starting algorithm" on the relative criterion
+    cands.push_back(t);
+  }
+  for (auto& s : best_obj) cands.push_back(s.th);
+  for (const Model& w : opt.warm_starts)
+    for (auto& t : warmStarts(L, w, d)) cands.push_back(t);
+  Eigen::VectorXd best_th;
+  double best_v = std::numeric_limits<double>::infinity();
+  bool best_conv = false;
+  for (auto& t : cands) {
+    bool conv = false;
+    const double v = solve(L, t, d, d.w_obj, &conv);
+    if (v < best_v) {
+      best_v = v;
+      best_th = t;
+      best_conv = conv;
+    }
+  }
+  if (best_th.size() == 0) throw Error("GMWM fit of " + stochastic::formatStructure(L.kinds) +
+                                       ": no starting point gave a finite objective");
+  sortTerms(L, best_th);
+  if (starts) *starts = static_cast<int>(cands.size());
+  if (converged) *converged = best_conv;
+  return best_th;
+}
+
+Eigen::MatrixXd pinvSym(const Eigen::MatrixXd& M) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (M + M.transpose()));
+  const Eigen::VectorXd ev = es.eigenvalues();
+  const double tol = 1e-12 * std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
+  Eigen::VectorXd inv(ev.size());
+  for (Eigen::Index i = 0; i < ev.size(); ++i) inv[i] = std::fabs(ev[i]) > tol ? 1.0 / ev[i] : 0.0;
+  return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+}
+
+/// Names and back-transformed values of the parameters of term i.
+void termParams(ProcessKind k, const double* t, double rate, std::vector<ParamInterval>& out,
+                const double* lo, const double* hi) {
+  auto add = [&](const char* n, double f, int q) {
+    ParamInterval pi;
+    pi.name = n;
+    pi.value = std::exp(t[q]) * f;
+    pi.low = std::exp(lo[q]) * f;
+    pi.high = std::exp(hi[q]) * f;
+    out.push_back(pi);
+  };
+  switch (k) {
+    case ProcessKind::WN: add("sigma", 1.0, 0); break;
+    case ProcessKind::QN: add("Q", 1.0, 0); break;
+    case ProcessKind::RW: add("gamma", 1.0, 0); break;
+    case ProcessKind::DR: add("omega", 1.0, 0); break;
+    case ProcessKind::GM:
+      add("sigma", 1.0, 0);
+      add("T", 1.0 / rate, 1);
+      break;
+    case ProcessKind::SIN:
+      add("amp", 1.0, 0);
+      add("freq_hz", rate, 1);
+      break;
+  }
+}
+
+std::vector<std::vector<ParamInterval>> intervalsFromTheta(const Layout& L, const Eigen::VectorXd& th,
+                                                           const Eigen::VectorXd& lo,
+                                                           const Eigen::VectorXd& hi, double rate) {
+  std::vector<std::vector<ParamInterval>> ci(L.kinds.size());
+  for (std::size_t i = 0; i < L.kinds.size(); ++i)
+    termParams(L.kinds[i], th.data() + L.offset[i], rate, ci[i], lo.data() + L.offset[i],
+               hi.data() + L.offset[i]);
+  return ci;
+}
+
+constexpr double kZ975 = 1.959963984540054;  // standard normal 97.5 % quantile
+
+}  // namespace
+
+int parameterCount(const std::vector<ProcessKind>& structure) {
+  int p = 0;
+  for (ProcessKind k : structure) p += detail::paramCount(k);
+  return p;
+}
+
+double objective(const Model& m, const WaveletVariance& wv) {
+  const Eigen::VectorXd nu = stochastic::haarWv(m, wv.tau);
+  const Eigen::VectorXd w = wv.weights();
+  return ((wv.wv - nu).array().square() * w.array()).sum();
+}
+
+namespace detail {
+/// Asymptotic covariance of theta_hat (transformed space), sandwich form.
+Eigen::MatrixXd sandwich(const Layout& L, const Eigen::VectorXd& th, const WaveletVariance& wv) {
+  const Eigen::MatrixXd A = jacobian(L, th, wv.tau);
+  const Eigen::VectorXd nu = wvOf(L, th, wv.tau);
+  const Eigen::VectorXd om = wv.weights();
+  Eigen::VectorXd V(wv.scales());
+  for (int j = 0; j < wv.scales(); ++j) {
+    const double eta = (wv.eta.size() == wv.scales() && wv.eta[j] > 0) ? wv.eta[j] : 1.0;
+    V[j] = 2.0 * nu[j] * nu[j] / eta;  // chi-square variance of nu_hat_j (eta dof)
+  }
+  const Eigen::MatrixXd B = A.transpose() * om.asDiagonal() * A;
+  const Eigen::MatrixXd Bi = pinvSym(B);
+  const Eigen::VectorXd ovo = om.cwiseProduct(V).cwiseProduct(om);
+  const Eigen::MatrixXd M = A.transpose() * ovo.asDiagonal() * A;
+  return Bi * M * Bi;
+}
+}  // namespace detail
+
+FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& wv, const FitOptions& opt) {
+  if (structure.empty()) throw Error("GMWM fit: the structure is empty (expected e.g. WN+GM)");
+  const int p = parameterCount(structure);
+  const std::string sname = stochastic::formatStructure(structure);
+  if (p > kMaxParams)
+    throw Error("GMWM fit of " + sname + ": " + std::to_string(p) + " parameters, at most " +
+                std::to_string(kMaxParams) + " supported");
+  if (p > wv.scales())
+    throw Error("GMWM fit of " + sname + ": " + std::to_string(p) +
+                " parameters but the wavelet variance has only " + std::to_string(wv.scales()) +
+                " scales (use a longer record or a smaller structure)");
+  const Data d = makeData(wv);
+  const Layout L(structure);
+  FitResult r;
+  const Eigen::VectorXd th = fitPoint(L, d, opt, &r.starts, &r.converged);
+  r.model = detail::toModel(L, th, d.rate);
+  r.objective = objective(r.model, wv);
+  r.cov_transformed = detail::sandwich(L, th, wv);
+  Eigen::VectorXd lo(p), hi(p);
+  if (opt.bootstrap > 0) {
+    // Parametric bootstrap: simulate the fitted model at the data length,
+    // recompute the WV, refit from theta_hat; percentile interval.
+    const std::size_t n = wv.n;
+    if (n < 4) throw Error("GMWM bootstrap: the wavelet variance does not record its sample count");
+#ifdef NAVIMPACT_FIT_HAVE_SIMULATE
+    std::vector<Eigen::VectorXd> reps;
+    for (int b = 0; b < opt.bootstrap; ++b) {
+      const std::vector<double> x =
+          stochastic::simulate(r.model, n, stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(b)));
+      const WaveletVariance wb = waveletVariance(x.data(), n, wv.rate_hz, 0.05, wv.scales());
+      const Data db = makeData(wb);
+      Eigen::VectorXd t = th;
+      solve(L, t, db, db.w_obj);
+      sortTerms(L, t);
+      reps.push_back(t);
+    }
+#else
+    throw Error("GMWM bootstrap: stochastic::simulate is not built yet");
+    std::vector<Eigen::VectorXd> reps;
+#endif
+    for (int k = 0; k < p; ++k) {
+      std::vector<double> v;
+      for (auto& t : reps) v.push_back(t[k]);
+      std::sort(v.begin(), v.end());
+      auto q = [&](double prob) {
+        const double pos = prob * (v.size() - 1);
+        const std::size_t i0 = static_cast<std::size_t>(std::floor(pos));
+        const std::size_t i1 = std::min(i0 + 1, v.size() - 1);
+        return v[i0] + (pos - i0) * (v[i1] - v[i0]);
+      };
+      lo[k] = q(0.025);
+      hi[k] = q(0.975);
+    }
+    r.ci_method = "bootstrap(" + std::to_string(opt.bootstrap) + ")";
+  } else {
+    for (int k = 0; k < p; ++k) {
+      const double se = std::sqrt(std::max(r.cov_transformed(k, k), 0.0));
+      lo[k] = th[k] - kZ975 * se;
+      hi[k] = th[k] + kZ975 * se;
+    }
+    r.ci_method = "asymptotic";
+  }
+  r.ci = intervalsFromTheta(L, th, lo, hi, d.rate);
+  return r;
+}
+
+}  // namespace navimpact::gmwm

@@ -1,0 +1,203 @@
+// Model selection by the wavelet information criterion (WIC):
+// criterion = objective + optimism (Guerrier et al. 2013; R gmwm
+// model_score / asympt_calc, gmwm_formulas.md §6), optimism asymptotic.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include "fit_internal.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/gmwm/estimator.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+
+namespace navimpact::gmwm {
+
+using stochastic::Model;
+using stochastic::ProcessKind;
+
+namespace {
+
+Eigen::MatrixXd pinvSym(const Eigen::MatrixXd& M) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (M + M.transpose()));
+  const Eigen::VectorXd ev = es.eigenvalues();
+  const double tol = 1e-12 * std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
+  Eigen::VectorXd inv(ev.size());
+  for (Eigen::Index i = 0; i < ev.size(); ++i) inv[i] = std::fabs(ev[i]) > tol ? 1.0 / ev[i] : 0.0;
+  return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+}
+
+std::vector<ProcessKind> kindsOf(const Model& m) {
+  std::vector<ProcessKind> k;
+  for (const auto& t : m.terms) k.push_back(t.kind);
+  return k;
+}
+
+/// Counts per kind (multiset of a structure).
+std::map<ProcessKind, int> counts(const std::vector<ProcessKind>& s) {
+  std::map<ProcessKind, int> c;
+  for (ProcessKind k : s) ++c[k];
+  return c;
+}
+
+/// True if @p a is a sub-multiset of @p b with exactly one term less; @p extra gets that term.
+bool oneLess(const std::vector<ProcessKind>& a, const std::vector<ProcessKind>& b, ProcessKind* extra) {
+  if (a.size() + 1 != b.size()) return false;
+  auto ca = counts(a), cb = counts(b);
+  int diff = 0;
+  for (auto& [k, n] : cb) {
+    const int na = ca.count(k) ? ca[k] : 0;
+    if (na > n) return false;
+    if (n - na == 1) {
+      ++diff;
+      if (extra) *extra = k;
+    } else if (n != na) {
+      return false;
+    }
+  }
+  for (auto& [k, n] : ca)
+    if (!cb.count(k)) return false;
+  return diff == 1;
+}
+
+std::string fmt(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
+}  // namespace
+
+double optimism(const FitResult& f, const WaveletVariance& wv) {
+  const detail::Layout L(kindsOf(f.model));
+  const Eigen::VectorXd th = detail::fromModel(L, f.model);
+  const Eigen::MatrixXd A = detail::jacobian(L, th, wv.tau);
+  const Eigen::VectorXd nu = detail::wvOf(L, th, wv.tau);
+  const Eigen::VectorXd om = wv.weights();
+  const int J = wv.scales(), p = L.p;
+  Eigen::VectorXd V(J);
+  for (int j = 0; j < J; ++j) {
+    const double eta = (wv.eta.size() == J && wv.eta[j] > 0) ? wv.eta[j] : 1.0;
+    V[j] = 2.0 * nu[j] * nu[j] / eta;
+  }
+  const Eigen::MatrixXd B = A.transpose() * om.asDiagonal() * A;
+  // D_kl = sum_j d2nu_j/dth_k dth_l * Omega_jj (nu_j - nu_hat_j): second
+  // derivatives by central differences of the (exact, autodiff) Jacobian.
+  const Eigen::VectorXd c = om.cwiseProduct(nu - wv.wv);
+  Eigen::MatrixXd D(p, p);
+  const double h = 1e-4;
+  for (int l = 0; l < p; ++l) {
+    Eigen::VectorXd tp = th, tm = th;
+    tp[l] += h;
+    tm[l] -= h;
+    const Eigen::MatrixXd dA = (detail::jacobian(L, tp, wv.tau) - detail::jacobian(L, tm, wv.tau)) / (2 * h);
+    D.col(l) = dA.transpose() * c;
+  }
+  D = 0.5 * (D + D.transpose());
+  // Hessian of the objective / 2 = B + D; d theta_hat / d nu_hat = (B + D)^+ A' Omega.
+  const Eigen::MatrixXd dTheta = pinvSym(B + D) * A.transpose() * om.asDiagonal();
+  const Eigen::MatrixXd S = A * dTheta;  // d nu(theta_hat) / d nu_hat
+  double tr = 0;
+  for (int j = 0; j < J; ++j) tr += S(j, j) * V[j] * om[j];
+  return 2.0 * tr;
+}
+
+std::vector<std::vector<ProcessKind>> defaultCandidates(int max_gm) {
+  std::vector<std::vector<ProcessKind>> out;
+  for (int g = 0; g <= max_gm; ++g)
+    for (int mask = 0; mask < 8; ++mask) {
+      std::vector<ProcessKind> s{ProcessKind::WN};
+      if (mask & 1) s.push_back(ProcessKind::QN);
+      for (int i = 0; i < g; ++i) s.push_back(ProcessKind::GM);
+      if (mask & 2) s.push_back(ProcessKind::RW);
+      if (mask & 4) s.push_back(ProcessKind::DR);
+      out.push_back(s);
+    }
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+    return parameterCount(a) < parameterCount(b);
+  });
+  return out;
+}
+
+std::vector<RankedModel> selectModel(const std::vector<std::vector<ProcessKind>>& candidates,
+                                     const WaveletVariance& wv, const FitOptions& opt, std::string* why) {
+  if (candidates.empty()) throw Error("model selection: no candidate structures");
+  // Fit the smaller structures first; each candidate is warm-started from the
+  // fitted candidates with one term less, so a larger nested model never ends
+  // with a higher objective than its sub-model.
+  std::vector<std::size_t> order(candidates.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return candidates[a].size() < candidates[b].size();
+  });
+  std::vector<RankedModel> out;
+  std::vector<std::vector<ProcessKind>> fitted_kinds;
+  for (std::size_t i : order) {
+    const auto& s = candidates[i];
+    if (parameterCount(s) > wv.scales()) continue;  // not identifiable at this length
+    FitOptions o = opt;
+    o.bootstrap = 0;  // intervals of the pick only (below)
+    for (std::size_t q = 0; q < out.size(); ++q)
+      if (oneLess(fitted_kinds[q], s, nullptr)) o.warm_starts.push_back(out[q].fit.model);
+    RankedModel rm;
+    rm.fit = fit(s, wv, o);
+    rm.optimism = optimism(rm.fit, wv);
+    rm.criterion = rm.fit.objective + rm.optimism;
+    out.push_back(rm);
+    fitted_kinds.push_back(s);
+  }
+  if (out.empty())
+    throw Error("model selection: every candidate has more parameters than the " +
+                std::to_string(wv.scales()) + " scales of the wavelet variance");
+  std::stable_sort(out.begin(), out.end(), [](const RankedModel& a, const RankedModel& b) {
+    if (a.criterion != b.criterion) return a.criterion < b.criterion;
+    return a.fit.model.terms.size() < b.fit.model.terms.size();
+  });
+  if (opt.bootstrap > 0) {
+    // Bootstrap intervals for the selected model only.
+    FitOptions o = opt;
+    o.warm_starts = {out.front().fit.model};
+    const double crit = out.front().criterion, opt0 = out.front().optimism;
+    out.front().fit = fit(kindsOf(out.front().fit.model), wv, o);
+    out.front().optimism = opt0;
+    out.front().criterion = crit;
+  }
+  if (why) {
+    const RankedModel& b = out.front();
+    const auto bk = kindsOf(b.fit.model);
+    std::ostringstream os;
+    os << "picked " << stochastic::formatStructure(bk) << ": criterion " << fmt(b.criterion)
+       << " (objective " << fmt(b.fit.objective) << " + optimism " << fmt(b.optimism) << ")";
+    // Best simpler neighbour (one term less) and best richer one (one term more).
+    for (const auto& r : out) {
+      ProcessKind extra{};
+      const auto rk = kindsOf(r.fit.model);
+      if (oneLess(rk, bk, &extra)) {
+        os << "; without " << stochastic::kindName(extra) << " (" << stochastic::formatStructure(rk)
+           << ") the criterion is " << fmt(r.criterion) << ": the objective rises by "
+           << fmt(r.fit.objective - b.fit.objective) << " while the optimism falls only by "
+           << fmt(b.optimism - r.optimism);
+        break;
+      }
+    }
+    for (const auto& r : out) {
+      ProcessKind extra{};
+      const auto rk = kindsOf(r.fit.model);
+      if (oneLess(bk, rk, &extra)) {
+        os << "; adding " << stochastic::kindName(extra) << " (" << stochastic::formatStructure(rk)
+           << ") lowers the objective by " << fmt(b.fit.objective - r.fit.objective) << " but costs "
+           << fmt(r.optimism - b.optimism) << " in optimism (criterion " << fmt(r.criterion) << ")";
+        break;
+      }
+    }
+    if (out.size() > 1)
+      os << "; runner-up " << stochastic::formatStructure(kindsOf(out[1].fit.model)) << " at "
+         << fmt(out[1].criterion);
+    *why = os.str();
+  }
+  return out;
+}
+
+}  // namespace navimpact::gmwm

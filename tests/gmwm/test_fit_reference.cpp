@@ -1,0 +1,193 @@
+// GMWM estimator against the R package gmwm 3.0.0 on the ADIS16405 recordings:
+// objective spot checks and the acceptance criterion "our objective is at or
+// below the package's on every (acquisition x axis x model)".
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "navimpact/core/csv_reader.hpp"
+#include "navimpact/gmwm/estimator.hpp"
+#include "navimpact/gmwm/wavelet_variance.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/theoretical_wv.hpp"
+#include "test_support.hpp"
+
+using namespace navimpact;
+using stochastic::Model;
+using stochastic::Process;
+using stochastic::ProcessKind;
+
+namespace {
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> f;
+  std::string cur;
+  bool q = false;
+  for (char c : line) {
+    if (c == '"') q = !q;
+    else if (c == ',' && !q) {
+      f.push_back(cur);
+      cur.clear();
+    } else cur += c;
+  }
+  f.push_back(cur);
+  return f;
+}
+
+std::vector<std::map<std::string, std::string>> readCsv(const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << path;
+  std::string line;
+  std::getline(in, line);
+  const auto head = splitCsvLine(line);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    const auto f = splitCsvLine(line);
+    std::map<std::string, std::string> r;
+    for (std::size_t i = 0; i < head.size() && i < f.size(); ++i) r[head[i]] = f[i];
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+std::vector<double> splitNums(const std::string& s) {
+  std::vector<double> v;
+  std::stringstream ss(s);
+  std::string t;
+  while (std::getline(ss, t, ';')) v.push_back(std::stod(t));
+  return v;
+}
+
+/// R's structure name ("WN+AR1+AR1", "M4a_WN+3AR1+DR") -> kinds.
+std::vector<ProcessKind> rStructure(std::string name) {
+  const auto us = name.find('_');
+  if (us != std::string::npos && name[0] == 'M') name = name.substr(us + 1);
+  std::vector<ProcessKind> k;
+  std::stringstream ss(name);
+  std::string t;
+  while (std::getline(ss, t, '+')) {
+    int rep = 1;
+    if (!t.empty() && std::isdigit(static_cast<unsigned char>(t[0]))) {
+      rep = t[0] - '0';
+      t = t.substr(1);
+    }
+    for (int i = 0; i < rep; ++i) {
+      if (t == "WN") k.push_back(ProcessKind::WN);
+      else if (t == "AR1") k.push_back(ProcessKind::GM);
+      else if (t == "DR") k.push_back(ProcessKind::DR);
+      else if (t == "RW") k.push_back(ProcessKind::RW);
+      else if (t == "QN") k.push_back(ProcessKind::QN);
+      else ADD_FAILURE() << "unknown R term " << t;
+    }
+  }
+  return k;
+}
+
+/// R's per-sample estimate vector -> our Model at rate_hz.
+Model rModel(const std::vector<ProcessKind>& k, const std::vector<double>& th, double rate_hz) {
+  Model m;
+  m.rate_hz = rate_hz;
+  std::size_t i = 0;
+  for (ProcessKind q : k) {
+    switch (q) {
+      case ProcessKind::WN: m.terms.push_back(Process::wn(std::sqrt(th[i++]))); break;
+      case ProcessKind::GM: m.terms.push_back(Process::ar1(th[i], th[i + 1], rate_hz)); i += 2; break;
+      case ProcessKind::DR: m.terms.push_back(Process::dr(th[i++])); break;
+      case ProcessKind::RW: m.terms.push_back(Process::rw(std::sqrt(th[i++]))); break;
+      case ProcessKind::QN: m.terms.push_back(Process::qn(std::sqrt(th[i++]))); break;
+      default: break;
+    }
+  }
+  return m;
+}
+
+/// The six WVs of one acquisition, in R's units (deg/s, g): values read as-is.
+std::map<std::string, gmwm::WaveletVariance> loadWvs(int acq) {
+  CsvImuOptions o;
+  o.rate_hz = 100.0;
+  o.gyro_unit = "rad/s";  // keep the numbers as recorded (deg/s, g), as R does
+  o.acc_unit = "m/s2";
+  const ImuSeries s =
+      readImuCsv(test::sharedPath("data/imu_static/adis16405_static_" + std::to_string(acq) + ".csv.gz"), o);
+  std::map<std::string, gmwm::WaveletVariance> out;
+  for (const auto& c : s.channels) out[c.name] = gmwm::waveletVariance(c.x.data(), c.x.size(), s.rate_hz);
+  return out;
+}
+
+}  // namespace
+
+// The objective of R's parameter vectors, evaluated on our WV, equals R's value.
+TEST(GmwmReference, ObjectiveSpotChecks) {
+  NAVIMPACT_REQUIRE_SHARED();
+  const auto rows = readCsv(test::sharedPath("reference/gmwm_r_reference/objective_spot_checks.csv"));
+  ASSERT_EQ(rows.size(), 3u);
+  const auto wvs = loadWvs(1);
+  for (const auto& r : rows) {
+    const auto k = rStructure(r.at("model"));
+    const Model m = rModel(k, splitNums(r.at("theta")), 100.0);
+    const double ours = gmwm::objective(m, wvs.at(r.at("axis")));
+    const double ref = std::stod(r.at("obj_fun"));
+    EXPECT_NEAR(ours, ref, 1e-6 * ref) << r.at("model");
+    std::printf("spot check %-22s ours %.12g  R %.12g  rel %.2e\n", r.at("model").c_str(), ours, ref,
+                (ours - ref) / ref);
+  }
+}
+
+// Acceptance: on every (acquisition 1..3 x axis x model) of the package's
+// fits, our objective is at or below the package's (slack 1e-9 for rounding).
+TEST(GmwmReference, ObjectiveAtOrBelowRPackage) {
+  NAVIMPACT_REQUIRE_SHARED();
+  const auto fits = readCsv(test::sharedPath("reference/gmwm_r_reference/gmwm_fits_acq123.csv"));
+  const auto refined = readCsv(test::sharedPath("reference/gmwm_r_reference/gmwm_refined_optimum_acq123.csv"));
+  ASSERT_EQ(fits.size(), 108u);
+  std::map<std::string, double> ref_opt;
+  for (const auto& r : refined) ref_opt[r.at("dataset") + r.at("axis") + r.at("model")] = std::stod(r.at("obj_refined"));
+  int n = 0, at_or_below = 0, at_or_below_refined = 0;
+  std::vector<double> improvement;
+  double fit_time = 0;
+  std::printf("%-16s %-7s %-16s %14s %14s %14s\n", "dataset", "axis", "model", "ours", "R package",
+              "R refined");
+  for (int acq = 1; acq <= 3; ++acq) {
+    const auto wvs = loadWvs(acq);
+    const std::string ds = "adis_16405_imu" + std::to_string(acq);
+    for (const char* axis : {"gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z"}) {
+      const auto& wv = wvs.at(axis);
+      // Fit the package's models in nested order; each larger model is also
+      // started from the smaller fitted ones (FitOptions::warm_starts).
+      std::vector<Model> fitted;
+      for (const auto& r : fits) {
+        if (r.at("dataset") != ds || r.at("axis") != axis) continue;
+        const auto k = rStructure(r.at("model"));
+        gmwm::FitOptions o;
+        o.warm_starts = fitted;
+        const auto t0 = std::chrono::steady_clock::now();
+        const gmwm::FitResult f = gmwm::fit(k, wv, o);
+        fit_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        fitted.push_back(f.model);
+        const double pkg = std::stod(r.at("obj_fun"));
+        const double rr = ref_opt.at(ds + axis + r.at("model"));
+        ++n;
+        if (f.objective <= pkg * (1 + 1e-9)) ++at_or_below;
+        if (f.objective <= rr * (1 + 1e-9)) ++at_or_below_refined;
+        improvement.push_back((pkg - f.objective) / pkg);
+        EXPECT_LE(f.objective, pkg * (1 + 1e-9))
+            << ds << " " << axis << " " << r.at("model") << ": " << stochastic::formatTerms(f.model.terms);
+        std::printf("%-16s %-7s %-16s %14.6f %14.6f %14.6f%s\n", ds.c_str(), axis, r.at("model").c_str(),
+                    f.objective, pkg, rr, f.objective <= rr * (1 + 1e-9) ? "  <= refined" : "");
+      }
+    }
+  }
+  std::sort(improvement.begin(), improvement.end());
+  std::printf("at or below R package: %d of %d; at or below R refined: %d of %d; median relative "
+              "improvement over the package %.4f; mean fit time %.3f s\n",
+              at_or_below, n, at_or_below_refined, n, improvement[improvement.size() / 2], fit_time / n);
+  EXPECT_EQ(n, 108);
+}
