@@ -1,6 +1,6 @@
 // plot_examples [outdir]: sample figures of the kinds navimpact produces, to be
 // looked at by a person (not a test). Writes wv_loglog.png, nav_errors.png,
-// nav_3x3.png and dense.png into outdir (default: current folder).
+// nav_3x3.png, dense.png and edge_cases.png into outdir (default: current folder).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -149,6 +149,54 @@ Figure denseFigure() {
   return f;
 }
 
+Figure edgeCases() {
+  // Small figure, 2x2: sub-decade log axis, large and tiny linear values,
+  // markers of every kind, an empty panel, NaN gaps.
+  Figure f;
+  f.width = 900;
+  f.height = 600;
+  f.rows = f.cols = 2;
+  f.title = "Edge cases";
+  Axes a;
+  a.title = "log y over half a decade";
+  a.logy = true;
+  a.xlabel = "x";
+  Series s{"y = 2 + x", {}, {}, palette(0), LineStyle::Solid, Marker::Circle, 1.5};
+  for (int i = 0; i <= 10; ++i) {
+    s.x.push_back(i * 0.3);
+    s.y.push_back(2.0 + i * 0.3);
+  }
+  a.series = {s};
+  Axes b;
+  b.title = "large values, markers";
+  b.ylabel = "counts";
+  const Marker ms[4] = {Marker::Circle, Marker::FilledCircle, Marker::Square, Marker::Cross};
+  for (int k = 0; k < 4; ++k) {
+    Series m{"marker " + std::to_string(k), {}, {}, palette(k), k % 2 ? LineStyle::Dashed : LineStyle::None,
+             ms[k], 1.5};
+    for (int i = 0; i < 8; ++i) {
+      m.x.push_back(1e6 + i * 2.5e5);
+      m.y.push_back(123456.0 * (1 + k) + 20000.0 * i);
+    }
+    b.series.push_back(m);
+  }
+  Axes c;
+  c.title = "tiny values with gaps";
+  c.xlabel = "t [s]";
+  c.ylabel = "bias [rad/s]";
+  Series g{"", {}, {}, palette(4), LineStyle::Solid, Marker::None, 2};
+  for (int i = 0; i <= 100; ++i) {
+    g.x.push_back(i);
+    g.y.push_back(i % 30 < 5 ? std::nan("") : 3e-5 * std::sin(i * 0.2));
+  }
+  c.series = {g};
+  c.hlines = {HLine{"limit", 2.5e-5, {213, 94, 0}, LineStyle::Dashed}};
+  Axes d;
+  d.title = "empty axes";
+  f.axes = {a, b, c, d};
+  return f;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -165,6 +213,7 @@ int main(int argc, char** argv) {
     run(navFigure(), "nav_errors.png");
     run(nav3x3(), "nav_3x3.png");
     run(denseFigure(), "dense.png");
+    run(edgeCases(), "edge_cases.png");
   } catch (const navimpact::Error& e) {
     std::fprintf(stderr, "plot_examples: %s\n", e.what());
     return 1;

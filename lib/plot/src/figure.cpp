@@ -41,13 +41,14 @@ using detail::Tick;
 using detail::VAlign;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kPi = 3.14159265358979323846;
 constexpr int kShift = 4;  // fixed-point bits for sub-pixel drawing
 constexpr double kOne = 1 << kShift;
 
 cv::Scalar bgr(const Color& c) { return cv::Scalar(c.b, c.g, c.r); }
 const cv::Scalar kInk(34, 34, 34);
 const cv::Scalar kGridMajor(222, 222, 222);
-const cv::Scalar kGridMinor(240, 240, 240);
+const cv::Scalar kGridMinor(243, 243, 243);
 
 std::string axesName(const Axes& ax, std::size_t i) {
   std::string s = "plot: axes " + std::to_string(i);
@@ -229,14 +230,14 @@ std::vector<Tick> chooseTicks(const Scale& sc, double len, bool isX, const TextR
       const double pos = u.px(t.value);
       const double half = isX ? 0.5 * tr.labelWidth(t.label, px)
                               : 0.5 * (tr.labelAscent(t.label, px) + TextRenderer::descent(px));
-      const double need = isX ? prevHalf + half + 0.9 * px : prevHalf + half + 0.6 * px;
+      const double need = isX ? prevHalf + half + 1.0 * px : prevHalf + half + 1.1 * px;
       if (std::isfinite(prevPos) && std::abs(pos - prevPos) < need) return false;
       prevPos = pos;
       prevHalf = half;
     }
     return true;
   };
-  const int nMax = std::clamp(static_cast<int>(len / (isX ? 60.0 : 38.0)), 2, isX ? 12 : 10);
+  const int nMax = std::clamp(static_cast<int>(len / (isX ? 55.0 : 30.0)), 2, isX ? 12 : 10);
   if (sc.log && std::floor(std::log10(sc.hi) + 1e-9) - std::ceil(std::log10(sc.lo) - 1e-9) >= 1) {
     const double decades = std::log10(sc.hi / sc.lo);
     const bool minor = len / decades >= 30.0;
@@ -532,24 +533,51 @@ void blendFill(cv::Mat& roi, const std::vector<std::vector<cv::Point>>& polys,
   cv::addWeighted(overlay, alpha, dst, 1.0 - alpha, 0.0, dst);
 }
 
-int thicknessOf(double width) { return std::max(1, static_cast<int>(std::lround(width))); }
+/// Segment a-b as an anti-aliased quad of exact width @p w [px] (butt caps).
+/// OpenCV's own thick AA lines only come in ~2 px steps (1.4, 3.4, 5.4 px).
+void thickSegment(cv::Mat& img, const cv::Point2d& a, const cv::Point2d& b, double w,
+                  const cv::Scalar& color) {
+  const cv::Point2d d = b - a;
+  const double len = cv::norm(d);
+  if (len < 1e-9) return;
+  const cv::Point2d n = cv::Point2d(-d.y, d.x) * (0.5 * w / len);
+  const cv::Point q[4] = {fixedPt(a + n), fixedPt(b + n), fixedPt(b - n), fixedPt(a - n)};
+  cv::fillConvexPoly(img, q, 4, color, cv::LINE_AA, kShift);
+}
 
-/// Stroke a polyline with a solid, dashed or dotted pattern laid out along
-/// its length in pixel space (the pattern continues across vertices).
-void stroke(cv::Mat& img, const Run& run, const cv::Scalar& color, double width, LineStyle style) {
-  if (style == LineStyle::None || run.size() < 2) return;
-  const int th = thicknessOf(width);
-  if (style == LineStyle::Solid) {
+void dot(cv::Mat& img, const cv::Point2d& c, double diameter, const cv::Scalar& color) {
+  cv::circle(img, fixedPt(c), static_cast<int>(std::lround(0.5 * diameter * kOne)), color, cv::FILLED,
+             cv::LINE_AA, kShift);
+}
+
+/// Solid polyline of width @p w with round joins.
+void solidPolyline(cv::Mat& img, const Run& run, double w, const cv::Scalar& color) {
+  if (w <= 1.3) {  // hairline: OpenCV's 1-px anti-aliased line
     std::vector<cv::Point> pts;
     pts.reserve(run.size());
     for (const auto& p : run) pts.push_back(fixedPt(p));
-    cv::polylines(img, pts, false, color, th, cv::LINE_AA, kShift);
+    cv::polylines(img, pts, false, color, 1, cv::LINE_AA, kShift);
     return;
   }
-  // Round caps of thick AA lines add ~th/2 at each end: compensate in the gaps.
+  for (std::size_t i = 1; i < run.size(); ++i) {
+    thickSegment(img, run[i - 1], run[i], w, color);
+    if (i + 1 < run.size()) dot(img, run[i], w, color);
+  }
+}
+
+/// Stroke a polyline with a solid, dashed or dotted pattern laid out along
+/// its length in pixel space (the pattern continues across vertices).
+/// Dash lengths follow matplotlib's scaled patterns: dashed 3.7w on, 1.6w off.
+void stroke(cv::Mat& img, const Run& run, const cv::Scalar& color, double width, LineStyle style) {
+  if (style == LineStyle::None || run.size() < 2) return;
   const double w = std::max(1.0, width);
-  const double on = style == LineStyle::Dashed ? std::max(5.0, 3.7 * w) : 0.01;
-  const double off = style == LineStyle::Dashed ? std::max(3.5, 1.6 * w) + w : std::max(3.0, 2.4 * w);
+  if (style == LineStyle::Solid) {
+    solidPolyline(img, run, w, color);
+    return;
+  }
+  const bool dotted = style == LineStyle::Dotted;
+  const double on = dotted ? 0.0 : std::max(4.0, 3.7 * w);
+  const double off = dotted ? std::max(3.5, 2.3 * w) : std::max(3.0, 1.6 * w);
   double phase = 0;  // distance into the current on+off period
   for (std::size_t i = 1; i < run.size(); ++i) {
     const cv::Point2d a = run[i - 1], b = run[i];
@@ -558,12 +586,23 @@ void stroke(cv::Mat& img, const Run& run, const cv::Scalar& color, double width,
     const cv::Point2d dir = (b - a) / len;
     double s = 0;
     while (s < len) {
+      if (dotted) {
+        if (phase == 0) dot(img, a + dir * s, std::max(1.6, 1.15 * w), color);
+        const double step = std::min(off - phase, len - s);
+        s += step;
+        phase += step;
+        if (phase >= off - 1e-12) phase = 0;
+        continue;
+      }
       const bool drawing = phase < on;
       const double remain = drawing ? on - phase : on + off - phase;
       const double step = std::min(remain, len - s);
-      if (drawing)
-        cv::line(img, fixedPt(a + dir * s), fixedPt(a + dir * (s + step)), color, th, cv::LINE_AA,
-                 kShift);
+      if (drawing) {
+        if (w <= 1.3)
+          cv::line(img, fixedPt(a + dir * s), fixedPt(a + dir * (s + step)), color, 1, cv::LINE_AA, kShift);
+        else
+          thickSegment(img, a + dir * s, a + dir * (s + step), w, color);
+      }
       s += step;
       phase += step;
       if (phase >= on + off - 1e-12) phase = 0;
@@ -572,23 +611,32 @@ void stroke(cv::Mat& img, const Run& run, const cv::Scalar& color, double width,
 }
 
 void drawMarker(cv::Mat& img, const cv::Point2d& c, Marker m, const cv::Scalar& color, double width) {
-  const double r = std::max(3.0, 1.5 * width + 1.5);
-  const int th = std::max(1, static_cast<int>(std::lround(std::max(1.0, 0.75 * width))));
-  const cv::Point pc = fixedPt(c);
-  const int rf = static_cast<int>(std::lround(r * kOne));
+  const double r = std::max(3.0, 1.4 * width + 1.5);
+  const double lw = std::max(1.3, 0.75 * width);
   switch (m) {
     case Marker::None: break;
-    case Marker::Circle: cv::circle(img, pc, rf, color, th, cv::LINE_AA, kShift); break;
-    case Marker::FilledCircle: cv::circle(img, pc, rf, color, cv::FILLED, cv::LINE_AA, kShift); break;
+    case Marker::Circle: {
+      // Ring of exact width lw, as a closed thick polyline.
+      Run ring;
+      for (int k = 0; k <= 25; ++k) {
+        const double t = 2 * kPi * k / 24;
+        ring.push_back(c + cv::Point2d(std::cos(t), std::sin(t)) * (r - 0.5 * lw));
+      }
+      solidPolyline(img, ring, lw, color);
+      break;
+    }
+    case Marker::FilledCircle: dot(img, c, 2 * r, color); break;
     case Marker::Square: {
-      const int q = static_cast<int>(std::lround(0.85 * r * kOne));
-      cv::rectangle(img, pc - cv::Point(q, q), pc + cv::Point(q, q), color, th, cv::LINE_AA, kShift);
+      const double q = 0.85 * r - 0.5 * lw;
+      const Run sq{c + cv::Point2d(-q, -q), c + cv::Point2d(q, -q), c + cv::Point2d(q, q),
+                   c + cv::Point2d(-q, q), c + cv::Point2d(-q, -q), c + cv::Point2d(q, -q)};
+      solidPolyline(img, sq, lw, color);
       break;
     }
     case Marker::Cross: {
-      const int q = static_cast<int>(std::lround(0.8 * r * kOne));
-      cv::line(img, pc - cv::Point(q, q), pc + cv::Point(q, q), color, th, cv::LINE_AA, kShift);
-      cv::line(img, pc + cv::Point(-q, q), pc + cv::Point(q, -q), color, th, cv::LINE_AA, kShift);
+      const double q = 0.8 * r;
+      thickSegment(img, c + cv::Point2d(-q, -q), c + cv::Point2d(q, q), lw, color);
+      thickSegment(img, c + cv::Point2d(-q, q), c + cv::Point2d(q, -q), lw, color);
       break;
     }
   }
@@ -750,8 +798,9 @@ class PanelPainter {
       const double y = Y(h.y);
       if (y < -4 || y > roi_.rows + 4) continue;
       const double w = std::max(1.0, 1.5 * sz_.s);
-      stroke(roi_, Run{{0, y}, {roi_.cols - 1.0, y}}, bgr(h.color), w,
-             h.style == LineStyle::None ? LineStyle::Solid : h.style);
+      const Run r{{0, y}, {roi_.cols - 1.0, y}};
+      stroke(roi_, r, bgr(h.color), w, h.style == LineStyle::None ? LineStyle::Solid : h.style);
+      if (!occupancy_.empty()) stroke(occupancy_, r, cv::Scalar(20), 3.0, LineStyle::Solid);
     }
   }
 
