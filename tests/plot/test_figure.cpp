@@ -361,6 +361,30 @@ TEST(Plot, GridOfPanelsIsRowMajorAndAligned) {
   EXPECT_EQ(img.cols, f.width);
 }
 
+TEST(Plot, DegenerateDataStillRenders) {
+  // Each panel holds data that commonly breaks naive plotting code; all must
+  // render (and the constant series must land on the middle row).
+  np::Figure f;
+  f.rows = 2;
+  f.cols = 3;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  np::Axes constant, single, allNan, huge, tinyRange, farOut;
+  constant.series = {line({0, 1, 2}, {3.0, 3.0, 3.0})};
+  single.series = {line({1.0}, {2.0})};
+  single.series[0].marker = np::Marker::Square;
+  allNan.series = {line({nan, nan}, {nan, inf})};
+  huge.series = {line({1e20, 1e20 + 5e5}, {-1e300, 1e300})};
+  tinyRange.series = {line({0, 1}, {1.0, 1.0 + 1e-13})};
+  farOut.ylim = std::make_pair(0.0, 1.0);
+  farOut.series = {line({0, 0.5, 1}, {0.5, 1e15, 0.5})};
+  farOut.bands = {np::Band{"", {0, 1}, {-1e200, -1e200}, {1e200, 1e200}, {0, 0, 255}, 0.2}};
+  f.axes = {constant, single, allNan, huge, tinyRange, farOut};
+  const cv::Mat img = renderAndRead(f);
+  const auto a = np::plotAreas(f)[0];
+  EXPECT_NEAR(redRowMean(img, a.x + a.width / 2, a.y, a.y + a.height), a.y + 0.5 * a.height, 2.0);
+}
+
 TEST(Plot, MissingFontIsAnErrorNamingThePath) {
   np::Figure f = bare();
   f.font = "/nonexistent/dir/NoSuchFont.ttf";

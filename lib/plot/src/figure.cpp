@@ -561,7 +561,12 @@ void solidPolyline(cv::Mat& img, const Run& run, double w, const cv::Scalar& col
   }
   for (std::size_t i = 1; i < run.size(); ++i) {
     thickSegment(img, run[i - 1], run[i], w, color);
-    if (i + 1 < run.size()) dot(img, run[i], w, color);
+    if (i + 1 == run.size()) break;
+    // Round join where the direction turns by more than ~10 degrees (smaller
+    // turns leave no visible notch between the butt ends).
+    const cv::Point2d d1 = run[i] - run[i - 1], d2 = run[i + 1] - run[i];
+    const double n1 = cv::norm(d1), n2 = cv::norm(d2);
+    if (n1 * n2 == 0 || d1.dot(d2) < 0.985 * n1 * n2) dot(img, run[i], w, color);
   }
 }
 
@@ -780,8 +785,8 @@ class PanelPainter {
         }
         const double x = X(b.x[i]);
         const double yl = validOn(b.lo[i], ax_.logy) ? Y(b.lo[i]) : below;
-        up.push_back({x, std::clamp(Y(b.hi[i]), -1e6, 1e6)});
-        dn.push_back({x, std::clamp(yl, -1e6, 1e6)});
+        up.push_back({x, std::clamp(Y(b.hi[i]), -1e12, 1e12)});
+        dn.push_back({x, std::clamp(yl, -1e12, 1e12)});
       }
       flush();
       blendFill(roi_, polys, bgr(b.color), b.alpha);

@@ -2,7 +2,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include <filesystem>
 #include <fstream>
 
 #include "navimpact/core/error.hpp"
@@ -24,8 +23,15 @@ TextRenderer::TextRenderer(const std::string& fontPath) {
 
 int TextRenderer::width(const std::string& s, int px) const {
   if (s.empty()) return 0;
+  std::string key = std::to_string(px);
+  key += '\x1f';
+  key += s;
+  const auto it = widthCache_.find(key);
+  if (it != widthCache_.end()) return it->second;
   int base = 0;
-  return ft_->getTextSize(s, px, -1, &base).width;
+  const int w = ft_->getTextSize(s, px, -1, &base).width;
+  widthCache_.emplace(std::move(key), w);
+  return w;
 }
 
 void TextRenderer::draw(cv::Mat& img, const std::string& s, cv::Point at, int px,

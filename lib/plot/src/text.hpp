@@ -7,6 +7,7 @@
 #include <opencv2/freetype.hpp>
 
 #include <string>
+#include <unordered_map>
 
 #include "ticks.hpp"
 
@@ -50,6 +51,9 @@ class TextRenderer {
 
  private:
   cv::Ptr<cv::freetype::FreeType2> ft_;
+  // getTextSize shapes the text with HarfBuzz (~0.2 ms a call); layout asks
+  // for the same label widths many times.
+  mutable std::unordered_map<std::string, int> widthCache_;
 };
 
 }  // namespace navimpact::plot::detail

@@ -41,7 +41,9 @@ std::string formatLinear(double v, double step, double maxAbs) {
   } else if (v == 0.0) {
     std::snprintf(buf, sizeof buf, "0");
   } else {
-    const int e = static_cast<int>(std::floor(std::log10(std::abs(v)) + 1e-9));
+    // One exponent for the whole axis (that of the largest magnitude) so that
+    // all labels share the same mantissa format: 0.5e6, 1.0e6, 1.5e6.
+    const int e = static_cast<int>(std::floor(std::log10(maxAbs) + 1e-9));
     const int ks = static_cast<int>(std::floor(std::log10(step) + 1e-9));
     const int dec = std::clamp(e - ks, 0, 6);
     const double m = v / std::pow(10.0, e);
@@ -56,9 +58,11 @@ std::vector<Tick> linearTicks(double lo, double hi, int maxTicks) {
   const double step = niceStep((hi - lo) / std::max(1, maxTicks));
   const double i0 = std::ceil(lo / step - 1e-9), i1 = std::floor(hi / step + 1e-9);
   const double maxAbs = std::max(std::abs(lo), std::abs(hi));
-  for (double i = i0; i <= i1; i += 1.0) {
+  // Count-bounded loop: with huge offsets (1e20 + small range) i += 1 would stall.
+  const double count = std::min(i1 - i0, 200.0);
+  for (double k = 0; k <= count; k += 1.0) {
     Tick t;
-    t.value = i * step;
+    t.value = (i0 + k) * step;
     t.major = true;
     t.labeled = true;
     t.label.base = formatLinear(t.value, step, maxAbs);
