@@ -676,6 +676,13 @@ std::vector<LegendEntry> legendEntries(const Axes& ax) {
 
 // ---------------------------------------------------------------- drawing --
 
+/// Font size <= @p px (down to 60 %) at which @p s fits in @p maxWidth pixels.
+int fitPx(const TextRenderer& tr, const std::string& s, int px, int maxWidth) {
+  const int minPx = std::max(8, static_cast<int>(0.6 * px));
+  while (px > minPx && tr.width(s, px) > maxWidth) --px;
+  return px;
+}
+
 class PanelPainter {
  public:
   PanelPainter(cv::Mat& canvas, const Panel& p, const Sizes& sz, const TextRenderer& tr)
@@ -867,14 +874,15 @@ class PanelPainter {
     const cv::Rect& a = p_.area;
     const cv::Rect& c = p_.cell;
     if (!ax_.title.empty())
-      tr_.draw(canvas_, ax_.title, {a.x + a.width / 2, a.y - 1 - sz_.labelGap}, sz_.title, kInk,
-               HAlign::Center, VAlign::Bottom);
+      tr_.draw(canvas_, ax_.title, {a.x + a.width / 2, a.y - 1 - sz_.labelGap},
+               fitPx(tr_, ax_.title, sz_.title, c.width - sz_.pad), kInk, HAlign::Center, VAlign::Bottom);
     if (!ax_.xlabel.empty()) {
       int xh = 0;
       for (const auto& t : p_.xt)
         if (t.labeled) xh = std::max(xh, tr_.labelAscent(t.label, sz_.tick));
       const int y = a.y + a.height + sz_.tickLen + sz_.gap + xh + TextRenderer::descent(sz_.tick) + sz_.labelGap;
-      tr_.draw(canvas_, ax_.xlabel, {a.x + a.width / 2, y}, sz_.label, kInk, HAlign::Center, VAlign::Top);
+      tr_.draw(canvas_, ax_.xlabel, {a.x + a.width / 2, y}, fitPx(tr_, ax_.xlabel, sz_.label, c.width - sz_.pad),
+               kInk, HAlign::Center, VAlign::Top);
     }
     if (!ax_.ylabel.empty()) {
       int yw = 0;
@@ -882,7 +890,8 @@ class PanelPainter {
         if (t.labeled) yw = std::max(yw, tr_.labelWidth(t.label, sz_.tick));
       const int labelH = TextRenderer::capHeight(sz_.label) + TextRenderer::descent(sz_.label);
       const int x = std::max(c.x + sz_.pad / 2, a.x - 1 - sz_.tickLen - sz_.gap - yw - sz_.labelGap - labelH);
-      tr_.drawVertical(canvas_, ax_.ylabel, {x, a.y + a.height / 2}, sz_.label, kInk);
+      tr_.drawVertical(canvas_, ax_.ylabel, {x, a.y + a.height / 2},
+                       fitPx(tr_, ax_.ylabel, sz_.label, a.height + a.height / 4), kInk);
     }
   }
 
@@ -976,7 +985,8 @@ cv::Mat render(const Figure& fig) {
   cv::Mat canvas(fig.height, fig.width, CV_8UC3, cv::Scalar(255, 255, 255));
   for (const auto& p : L.panels) PanelPainter(canvas, p, L.sz, tr).draw();
   if (!fig.title.empty())
-    tr.draw(canvas, fig.title, {fig.width / 2, L.sz.pad}, L.sz.sup, kInk, HAlign::Center, VAlign::Top);
+    tr.draw(canvas, fig.title, {fig.width / 2, L.sz.pad}, fitPx(tr, fig.title, L.sz.sup, fig.width - 2 * L.sz.pad),
+            kInk, HAlign::Center, VAlign::Top);
   return canvas;
 }
 

@@ -6,6 +6,26 @@
  * (confidence intervals, +-sigma envelopes), shaded x-spans (GNSS outages)
  * and horizontal reference lines, on linear or log10 axes, with a legend.
  * This module is the only one that includes OpenCV.
+ *
+ * Conventions: data in any unit (the caller converts to the unit it labels);
+ * sizes in pixels; text is UTF-8 (Greek letters, superscripts and U+2212 are
+ * in DejaVu Sans). Drawing order inside an axes: grid, spans, bands, hlines,
+ * series (in vector order), frame and ticks, legend. Automatic limits cover
+ * every finite point (positive only on a log axis) of series, bands, spans and
+ * hlines, padded by 5 % on y (log10 space on log axes), 0 % on linear x and
+ * 3 % on log x; y limits only consider points whose x is inside the x limits.
+ * Dense series (more than 4 points per pixel column) are decimated to first /
+ * min / max / last per column, which is visually lossless.
+ *
+ * Example (log-log wavelet variance with a 95 % CI band):
+ * @code
+ *   plot::Axes ax;  ax.logx = ax.logy = true;
+ *   ax.xlabel = "scale τ [s]";  ax.ylabel = "ν² [(rad/s)²]";
+ *   ax.bands.push_back({"95% CI", tau, lo, hi, plot::palette(0), 0.2});
+ *   ax.series.push_back({"empirical", tau, nu2, plot::palette(0),
+ *                        plot::LineStyle::Solid, plot::Marker::FilledCircle});
+ *   plot::Figure fig;  fig.axes = {ax};  plot::savePng(fig, "wv.png");
+ * @endcode
  */
 #pragma once
 
@@ -17,16 +37,28 @@
 
 namespace navimpact::plot {
 
+/// 8-bit sRGB colour.
 struct Color {
   std::uint8_t r = 0, g = 0, b = 0;
 };
-/// Colour-blind-safe qualitative palette (Okabe-Ito), cycled by index.
+/**
+ * Colour-blind-safe qualitative palette (Okabe & Ito 2008), cycled by index:
+ * blue, vermillion, bluish green, orange, reddish purple, sky blue, black,
+ * yellow (yellow last: it is weak on white).
+ * @param[in] i  any integer (negative values wrap too).
+ */
 Color palette(int i);
 
+/// Stroke pattern, laid out along the line in pixel space (matplotlib's
+/// dashed 3.7w on / 1.6w off, dotted round dots every ~2.3w). None: markers only.
 enum class LineStyle { Solid, Dashed, Dotted, None };
+/// Marker drawn at every data point (radius ~1.4 width + 1.5 px).
 enum class Marker { None, Circle, FilledCircle, Square, Cross };
-/// Legend placement inside the plot area. Best picks the corner covering the
-/// fewest drawn data points (ties: TopRight, TopLeft, BottomLeft, BottomRight).
+/// Legend placement inside the plot area. Best (the default) picks, among the
+/// four corners and then the four edge centres, the place hiding the fewest
+/// drawn series/hline pixels (bands count little); ties go to TopRight,
+/// TopLeft, BottomLeft, BottomRight. Entries: series, hlines, bands, spans
+/// with a non-empty label, in that order.
 enum class LegendPos { TopRight, TopLeft, BottomRight, BottomLeft, None, Best };
 
 struct Series {
@@ -35,50 +67,58 @@ struct Series {
   Color color{0, 114, 178};
   LineStyle style = LineStyle::Solid;
   Marker marker = Marker::None;
-  double width = 2.0;           ///< line width [px]
+  double width = 2.0;           ///< line width [px], exact (anti-aliased); <= 1.3 draws a hairline
 };
 
-/// Filled region between lo(x) and hi(x).
+/// Filled region between lo(x) and hi(x), alpha-blended over what is below.
+/// Non-finite x or hi breaks the band; on a log y axis a non-positive lo
+/// extends the band to the bottom edge.
 struct Band {
-  std::string label;
-  std::vector<double> x, lo, hi;
+  std::string label;               ///< legend text ("" = not in legend)
+  std::vector<double> x, lo, hi;   ///< same length
   Color color{0, 114, 178};
   double alpha = 0.2;           ///< opacity 0..1
 };
 
-/// Shaded vertical span x0..x1 (e.g. a GNSS outage).
+/// Shaded vertical span x0..x1 over the full height (e.g. a GNSS outage).
 struct Span {
-  std::string label;
-  double x0 = 0, x1 = 0;
+  std::string label;       ///< legend text ("" = not in legend)
+  double x0 = 0, x1 = 0;   ///< x data units, either order
   Color color{128, 128, 128};
   double alpha = 0.15;
 };
 
+/// Horizontal reference line across the plot area (width 1.5 px at 1400x900).
 struct HLine {
-  std::string label;
-  double y = 0;
+  std::string label;   ///< legend text ("" = not in legend)
+  double y = 0;        ///< y data units
   Color color{0, 0, 0};
   LineStyle style = LineStyle::Dashed;
 };
 
+/// One plot panel.
 struct Axes {
-  std::string title, xlabel, ylabel;
-  bool logx = false, logy = false;
+  std::string title, xlabel, ylabel;  ///< "" = none (no space is reserved)
+  bool logx = false, logy = false;    ///< log10 axes: decades labelled 10^k, minor ticks 2..9
   std::vector<Span> spans;      ///< drawn first
   std::vector<Band> bands;
   std::vector<Series> series;
   std::vector<HLine> hlines;
-  std::optional<std::pair<double, double>> xlim, ylim;  ///< default: data range
+  /// Limits (lower < upper; > 0 on log axes); default: data range, see @file.
+  std::optional<std::pair<double, double>> xlim, ylim;
   LegendPos legend = LegendPos::Best;  ///< Best: corner hiding the least data
-  bool grid = true;
+  bool grid = true;  ///< light grid at major ticks (and log minor ticks)
 };
 
 /// Grid of axes, row-major; rows * cols == axes.size() (or axes fewer: empty cells).
+/// Margins are computed from the text sizes and aligned per row and column.
 struct Figure {
-  int width = 1400, height = 900;  ///< pixels
-  std::string title;
-  int rows = 1, cols = 1;
-  std::vector<Axes> axes;
+  /// Pixels, 100..20000. Fonts scale with sqrt(area / (1400*900)), never below
+  /// 0.78: tick labels 17 px, axis labels 18 px, titles 19 px, suptitle 24 px at 1400x900.
+  int width = 1400, height = 900;
+  std::string title;        ///< figure super-title ("" = none)
+  int rows = 1, cols = 1;   ///< grid shape, >= 1
+  std::vector<Axes> axes;   ///< row-major, at most rows * cols, at least one
   /// TrueType font used for all text (DejaVu Sans from fonts-dejavu-core).
   std::string font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 };
@@ -90,9 +130,13 @@ struct PixelRect {
 };
 
 /**
- * Render @p fig and write it as PNG to @p path.
+ * Render @p fig and write it as PNG to @p path (PNG whatever the extension).
+ * @param[in] fig   the figure.
+ * @param[in] path  output file; its folder must exist. Overwritten.
  * @throws navimpact::Error if the font is missing, the layout is invalid
- *         (e.g. non-positive data on a log axis only) or the file cannot be written.
+ *         (no axes, too many axes for the grid, bad limits, mismatched vector
+ *         lengths, figure too small, non-positive data only on a log axis) or
+ *         the file cannot be written; each message names the axes or the path.
  */
 void savePng(const Figure& fig, const std::string& path);
 
