@@ -151,7 +151,7 @@ Figure denseFigure() {
 
 Figure edgeCases() {
   // Small figure, 2x2: sub-decade log axis, large and tiny linear values,
-  // markers of every kind, an empty panel, NaN gaps.
+  // markers of every kind, a log-log panel over 1.5 decades, NaN gaps.
   Figure f;
   f.width = 900;
   f.height = 600;
@@ -192,7 +192,15 @@ Figure edgeCases() {
   c.series = {g};
   c.hlines = {HLine{"limit", 2.5e-5, {213, 94, 0}, LineStyle::Dashed}};
   Axes d;
-  d.title = "empty axes";
+  d.title = "log-log over 1.5 decades";
+  d.logx = d.logy = true;
+  Series p{"power law", {}, {}, palette(2), LineStyle::Solid, Marker::None, 2};
+  for (int i = 0; i <= 50; ++i) {
+    const double x = 0.05 * std::pow(30.0, i / 50.0);
+    p.x.push_back(x);
+    p.y.push_back(3.0 * std::sqrt(x));
+  }
+  d.series = {p};
   f.axes = {a, b, c, d};
   return f;
 }

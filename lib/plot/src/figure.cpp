@@ -241,6 +241,11 @@ std::vector<Tick> chooseTicks(const Scale& sc, double len, bool isX, const TextR
   if (sc.log && std::floor(std::log10(sc.hi) + 1e-9) - std::ceil(std::log10(sc.lo) - 1e-9) >= 1) {
     const double decades = std::log10(sc.hi / sc.lo);
     const bool minor = len / decades >= 30.0;
+    // Few decades in plain-number territory: label 2 and 5 x 10^k as well.
+    if (decades <= 2.5 && sc.lo >= 1e-3 && sc.hi <= 1e4) {
+      auto t = detail::logTicks(sc.lo, sc.hi, 1, true, nMax, true);
+      if (fits(t)) return t;
+    }
     for (int stride : {1, 2, 3, 4, 5, 10, 20, 50, 100}) {
       auto t = detail::logTicks(sc.lo, sc.hi, stride, minor, nMax);
       if (fits(t)) return t;

@@ -71,8 +71,16 @@ std::vector<Tick> linearTicks(double lo, double hi, int maxTicks) {
   return ticks;
 }
 
+namespace {
+std::string plainDecimal(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+}  // namespace
+
 std::vector<Tick> logTicks(double lo, double hi, int labelStride, bool withMinor,
-                           int maxLinearTicks) {
+                           int maxLinearTicks, bool labelMinor) {
   std::vector<Tick> ticks;
   if (!(lo > 0) || !(hi > lo)) return ticks;
   const double l0 = std::log10(lo), l1 = std::log10(hi);
@@ -93,18 +101,23 @@ std::vector<Tick> logTicks(double lo, double hi, int labelStride, bool withMinor
       t.value = p;
       t.major = true;
       t.labeled = (e % labelStride) == 0;
-      t.label.base = "10";
-      t.label.sup = typographicMinus(std::to_string(e));
+      if (labelMinor) {
+        t.label.base = plainDecimal(p);
+      } else {
+        t.label.base = "10";
+        t.label.sup = typographicMinus(std::to_string(e));
+      }
       ticks.push_back(t);
     }
-    if (withMinor)
+    if (withMinor || labelMinor)
       for (int m = 2; m <= 9; ++m) {
         const double v = m * p;
         if (v < lo * (1 - 1e-12) || v > hi * (1 + 1e-12)) continue;
         Tick t;
         t.value = v;
         t.major = false;
-        t.labeled = false;
+        t.labeled = labelMinor && (m == 2 || m == 5);
+        if (t.labeled) t.label.base = plainDecimal(v);
         ticks.push_back(t);
       }
   }

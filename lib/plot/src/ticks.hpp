@@ -32,10 +32,13 @@ std::vector<Tick> linearTicks(double lo, double hi, int maxTicks);
  * Log10 ticks on [lo, hi] (0 < lo < hi): decades as majors, labelled every
  * @p labelStride-th decade (exponent divisible by the stride), minor ticks at
  * 2..9 x 10^k when @p withMinor. Falls back to linear nice ticks (placed on the
- * log scale) when the range spans less than one full decade.
+ * log scale) when the range spans less than one full decade. With
+ * @p labelMinor (for axes spanning only about one or two decades, where values
+ * lie in 1e-3..1e4) all labels are plain decimals and the minor ticks at 2 and
+ * 5 x 10^k are labelled too.
  */
 std::vector<Tick> logTicks(double lo, double hi, int labelStride, bool withMinor,
-                           int maxLinearTicks);
+                           int maxLinearTicks, bool labelMinor = false);
 
 /// Format @p v for a linear axis whose tick step is @p step ("0.25", "1e-5").
 std::string formatLinear(double v, double step, double maxAbs);
