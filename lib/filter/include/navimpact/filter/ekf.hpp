@@ -1,0 +1,205 @@
+/**
+ * @file ekf.hpp
+ * @brief Error-state (indirect, closed-loop) EKF for GNSS/baro-aided INS with
+ *        IMU error states built at run time from a stochastic::ImuModel.
+ *
+ * API in the spirit of KF-GINS's GIEngine: predict() per IMU sample (runs the
+ * mechanization on error-corrected increments and propagates the covariance),
+ * update*() per aiding measurement (Kalman update, Joseph form, closed-loop
+ * feedback into the navigation state and the IMU-error estimates, error
+ * state reset). Measurements apply at the current filter time state().t:
+ * the caller predicts up to the measurement epoch first.
+ *
+ * Typical use (emulation / rawlog replay):
+ * @code
+ *   filter::EkfConfig cfg;                       // defaults: series discretisation, every sample
+ *   filter::ErrorStateEkf ekf(x0, P0_nav, model, cfg);
+ *   for (const ins::ImuSample& s : imu) {
+ *     ekf.predict(s);
+ *     if (gnss_at(s.t)) ekf.updateGnssPosition(z_geodetic, sigma_ned, lever_B);
+ *   }
+ *   ekf.state(); ekf.sigmas(); ekf.lastUpdate().nis;
+ * @endcode
+ * Covariance-only analysis (no sensor data): construct, then call
+ * predictCovariance() along a nominal trajectory and updateCovariance*()
+ * for the aiding epochs.
+ *
+ * Innovation convention: dz = h(x_est) - z (predicted minus measured; with
+ * estimate-minus-truth errors dz = H dx - noise). The NIS is dz' S^-1 dz.
+ */
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "navimpact/filter/error_model.hpp"
+#include "navimpact/filter/state_layout.hpp"
+#include "navimpact/ins/mechanization.hpp"
+
+namespace navimpact::filter {
+
+/// How the continuous model is discretised over one IMU interval.
+enum class Discretization {
+  Series,   ///< Phi = I + F dt + F^2 dt^2/2, Qd = Q dt + (FQ + QF') dt^2/2 + F Q F' dt^3/3
+  VanLoan,  ///< exact matrix exponential of the Van Loan (1978) block matrix
+};
+/// "series" or "vanloan"; throws navimpact::Error naming the accepted values.
+Discretization parseDiscretization(const std::string& s);
+
+struct EkfConfig {
+  Discretization discretization = Discretization::Series;
+  /// Propagate the covariance every k IMU samples (k >= 1) with the product of
+  /// the k transitions and the summed process noise; pending propagation is
+  /// always flushed before an update and on request.
+  int propagate_every = 1;
+  /// Chi-square innovation gate: reject when NIS > quantile(gate_probability, m).
+  /// 0 = off (default); else in (0, 1), e.g. 0.999.
+  double gate_probability = 0.0;
+  ImuErrorOptions imu;                 ///< turn-on bias states
+  ins::MechanizationOptions mechanization;
+};
+
+/// Result of one measurement update.
+struct UpdateResult {
+  bool accepted = true;         ///< false when rejected by the chi-square gate
+  Eigen::VectorXd innovation;   ///< dz = h(x_est) - z (metres NED / m/s / m)
+  Eigen::MatrixXd S;            ///< innovation covariance H P H' + R
+  double nis = 0.0;             ///< dz' S^-1 dz
+  double t = 0.0;               ///< filter time [s]
+};
+
+class ErrorStateEkf {
+ public:
+  /**
+   * @param[in] x0      initial navigation state (its t is the start time).
+   * @param[in] P0_nav  9x9 initial covariance of [dp (m NED), dv (m/s), psi (rad)],
+   *                    symmetric positive semi-definite (zero allowed).
+   * @param[in] model   IMU error model of the six axes (empty axis = perfect).
+   * @param[in] cfg     options.
+   * @throws navimpact::Error for invalid options or a non-symmetric/negative P0_nav.
+   */
+  ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
+                const stochastic::ImuModel& model, const EkfConfig& cfg = {});
+
+  // ---- prediction -------------------------------------------------------
+  /**
+   * One raw IMU sample: correct it by the estimated sensor errors, run the
+   * mechanization, propagate the IMU-error estimates and the covariance.
+   * @param[in] raw  increments over (t - dt, t], dt > 0.
+   */
+  void predict(const ins::ImuSample& raw);
+
+  /**
+   * Covariance-only propagation over @p dt along a given nominal state (the
+   * navigation state is set to @p nominal and not integrated).
+   * @param[in] nominal  linearisation point at the end of the interval.
+   * @param[in] w_IB_B   nominal angular rate [rad/s].
+   * @param[in] f_B      nominal specific force [m/s^2].
+   * @param[in] dt       interval [s], > 0.
+   */
+  void predictCovariance(const ins::NavState& nominal, const Eigen::Vector3d& w_IB_B,
+                         const Eigen::Vector3d& f_B, double dt);
+
+  /// Apply any pending (accumulated) covariance propagation now.
+  void flushPropagation();
+
+  // ---- measurement updates ----------------------------------------------
+  /**
+   * GNSS position of the antenna (Groves 14.? loosely coupled, lever arm 14.110).
+   * @param[in] z          measured antenna position (geodetic).
+   * @param[in] sigma_NED  1-sigma noise along N, E, D [m], > 0.
+   * @param[in] lever_B    antenna position w.r.t. the IMU in body axes [m].
+   */
+  UpdateResult updateGnssPosition(const earth::Geodetic& z, const Eigen::Vector3d& sigma_NED,
+                                  const Eigen::Vector3d& lever_B = Eigen::Vector3d::Zero());
+  /**
+   * GNSS velocity of the antenna in NED (lever arm: v + C (w_IB_B x l) - w_IE_N x (C l), Groves 14.111).
+   * @param[in] z_N        measured velocity [m/s].
+   * @param[in] sigma_NED  1-sigma noise [m/s], > 0.
+   * @param[in] lever_B    lever arm [m].
+   */
+  UpdateResult updateGnssVelocity(const Eigen::Vector3d& z_N, const Eigen::Vector3d& sigma_NED,
+                                  const Eigen::Vector3d& lever_B = Eigen::Vector3d::Zero());
+  /**
+   * Barometric altitude, taken as ellipsoidal height of the IMU.
+   * @param[in] h_meas  measured height [m].
+   * @param[in] sigma   1-sigma noise [m], > 0.
+   */
+  UpdateResult updateBaro(double h_meas, double sigma);
+
+  /**
+   * Generic linear update dz = H dx - noise with the caller's residual (used
+   * by the updates above, by covariance-only analysis and by tests).
+   * @param[in] dz  residual h(x_est) - z (size m).
+   * @param[in] H   m x size() Jacobian.
+   * @param[in] R   m x m noise covariance, positive definite.
+   * @param[in] feedback  apply closed-loop correction (false: covariance only).
+   */
+  UpdateResult update(const Eigen::VectorXd& dz, const Eigen::MatrixXd& H,
+                      const Eigen::MatrixXd& R, bool feedback = true);
+
+  // ---- residuals dz = h(x_est) - z at the current state (public for tests) --
+  /// GNSS position residual in metres N, E, D (antenna, lever arm @p lever_B [m]).
+  Eigen::VectorXd residualGnssPosition(const earth::Geodetic& z,
+                                       const Eigen::Vector3d& lever_B) const;
+  /// GNSS velocity residual [m/s] (antenna, lever arm @p lever_B [m]).
+  Eigen::VectorXd residualGnssVelocity(const Eigen::Vector3d& z_N,
+                                       const Eigen::Vector3d& lever_B) const;
+
+  // ---- Jacobians (public for tests and covariance-only analysis) --------
+  Eigen::MatrixXd H_gnssPosition(const Eigen::Vector3d& lever_B) const;  ///< 3 x size()
+  Eigen::MatrixXd H_gnssVelocity(const Eigen::Vector3d& lever_B) const;  ///< 3 x size()
+  Eigen::MatrixXd H_baro() const;                                        ///< 1 x size()
+  /// Continuous F (size() square) at the current state and last f_B.
+  Eigen::MatrixXd F() const;
+  /// Continuous driving-noise PSD matrix (size() square) at the current state.
+  Eigen::MatrixXd Qc() const;
+  /// Discrete Phi, Qd over dt with the configured method at the current state.
+  void discretize(double dt, Eigen::MatrixXd& Phi, Eigen::MatrixXd& Qd) const;
+
+  // ---- outputs ----------------------------------------------------------
+  const ins::NavState& state() const { return mech_.state(); }
+  const Eigen::MatrixXd& P() const { return P_; }
+  Eigen::VectorXd sigmas() const { return P_.diagonal().cwiseSqrt(); }
+  /// Estimated IMU error states (size imuSize()).
+  const Eigen::VectorXd& imuStates() const { return x_imu_; }
+  /// Estimated sensor errors now, gyro_x..acc_z [rad/s, m/s^2].
+  Eigen::Matrix<double, 6, 1> sensorErrors() const;
+  const StateLayout& layout() const { return layout_; }
+  int size() const { return layout_.size(); }
+  const UpdateResult& lastUpdate() const { return last_; }
+  int rejections() const { return rejections_; }
+  const EkfConfig& config() const { return cfg_; }
+  /// Overwrite the navigation state (e.g. alignment); P is unchanged.
+  void setState(const ins::NavState& x) { mech_.setState(x); }
+  /// Last corrected angular rate and specific force [rad/s, m/s^2].
+  const Eigen::Vector3d& w_IB_B() const { return w_IB_B_; }
+  const Eigen::Vector3d& f_B() const { return f_B_; }
+
+ private:
+  struct Transition;  // structured Phi: [A B; 0 D], D block-diagonal
+  void buildTransition(double dt, Transition& T) const;
+  void accumulate(const Transition& T);
+  void applyTransition();
+  void checkP(const char* where) const;
+
+  EkfConfig cfg_;
+  StateLayout layout_;
+  ins::Mechanization mech_;
+  Eigen::MatrixXd P_;
+  Eigen::VectorXd x_imu_;
+  Eigen::Vector3d w_IB_B_ = Eigen::Vector3d::Zero(), f_B_ = Eigen::Vector3d::Zero();
+  // accumulated transition
+  Eigen::Matrix<double, 9, 9> A_acc_;
+  Eigen::MatrixXd B_acc_, D_acc_, Q_acc_;
+  int pending_ = 0;
+  UpdateResult last_;
+  int rejections_ = 0;
+  // cache for covariance-only propagation along a constant nominal
+  struct Cache;
+  std::shared_ptr<Cache> cache_;
+};
+
+}  // namespace navimpact::filter

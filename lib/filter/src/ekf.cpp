@@ -1,0 +1,461 @@
+// Error-state EKF: structured covariance propagation, Joseph-form updates,
+// closed-loop feedback. Equation numbers: Groves 2013 ch. 3 and 14.
+#include "navimpact/filter/ekf.hpp"
+
+#include <boost/math/distributions/chi_squared.hpp>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include <cmath>
+#include <sstream>
+
+#include "navimpact/core/error.hpp"
+
+namespace navimpact::filter {
+
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+using ins::skew;
+
+Discretization parseDiscretization(const std::string& s) {
+  if (s == "series") return Discretization::Series;
+  if (s == "vanloan") return Discretization::VanLoan;
+  throw Error("unknown discretization '" + s + "' (expected 'series' or 'vanloan')");
+}
+
+/// Structured transition Phi = [A B; 0 D] (D block-diagonal over process
+/// blocks) and the discrete process noise Q (full).
+struct ErrorStateEkf::Transition {
+  Matrix9d A;
+  MatrixXd B, D, Q;
+};
+
+struct ErrorStateEkf::Cache {
+  double dt = -1.0;                 // dt of the cached exact IMU-error blocks
+  std::vector<MatrixXd> Phi, Qd;    // per process block
+  // covariance-only propagation along an unchanged nominal
+  bool nominal_valid = false;
+  ins::NavState nominal;
+  Vector3d w, f;
+  double nominal_dt = 0.0;
+  Transition T;
+  Transition tmp;                   // scratch
+};
+
+namespace {
+std::string tstr(double t) {
+  std::ostringstream s;
+  s.precision(9);
+  s << t;
+  return s.str();
+}
+bool sameState(const ins::NavState& a, const ins::NavState& b) {
+  return a.lat == b.lat && a.lon == b.lon && a.h == b.h && a.v_N == b.v_N &&
+         a.q_BtoN.coeffs() == b.q_BtoN.coeffs();
+}
+}  // namespace
+
+ErrorStateEkf::ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
+                             const stochastic::ImuModel& model, const EkfConfig& cfg)
+    : cfg_(cfg), mech_(x0, cfg.mechanization), cache_(std::make_shared<Cache>()) {
+  if (cfg.propagate_every < 1)
+    throw Error("propagate_every must be >= 1, got " + std::to_string(cfg.propagate_every));
+  if (!(cfg.gate_probability >= 0.0 && cfg.gate_probability < 1.0))
+    throw Error("gate_probability must be in [0, 1) (0 = gate off), got " +
+                tstr(cfg.gate_probability));
+  if (!P0_nav.allFinite() || (P0_nav - P0_nav.transpose()).cwiseAbs().maxCoeff() >
+                                 1e-12 * (1.0 + P0_nav.cwiseAbs().maxCoeff()) ||
+      (P0_nav.diagonal().array() < 0.0).any())
+    throw Error("initial navigation covariance must be finite, symmetric, with diagonal >= 0");
+  layout_ = StateLayout::build(model, cfg.imu);
+  const int N = layout_.size(), m = layout_.imuSize();
+  P_ = MatrixXd::Zero(N, N);
+  P_.topLeftCorner<9, 9>() = P0_nav;
+  P_.bottomRightCorner(m, m) = layout_.imuP0();
+  x_imu_ = VectorXd::Zero(m);
+  A_acc_.setIdentity();
+  B_acc_ = MatrixXd::Zero(9, m);
+  D_acc_ = MatrixXd::Identity(m, m);
+  Q_acc_ = MatrixXd::Zero(N, N);
+  last_.t = x0.t;
+}
+
+Eigen::Matrix<double, 6, 1> ErrorStateEkf::sensorErrors() const {
+  Eigen::Matrix<double, 6, 1> e;
+  for (int c = 0; c < 6; ++c) e(c) = layout_.sensorRow(c).dot(x_imu_);
+  return e;
+}
+
+MatrixXd ErrorStateEkf::F() const {
+  const int N = size();
+  MatrixXd F = MatrixXd::Zero(N, N);
+  F.topLeftCorner<9, 9>() = navErrorDynamics(state(), f_B_);
+  const Eigen::Matrix3d C = state().C_BtoN();
+  for (const ProcessBlock& b : layout_.blocks()) {
+    const int row = b.channel < 3 ? kAtt : kVel;
+    // d(psi)/dt += C dw_B, d(dv)/dt += C df_B, with dsensor = -H dx_imu (Groves 14.64-14.65)
+    F.block(row, b.offset, 3, b.ss.n) = -C.col(b.channel % 3) * b.ss.H;
+    F.block(b.offset, b.offset, b.ss.n, b.ss.n) = b.ss.F;
+  }
+  return F;
+}
+
+MatrixXd ErrorStateEkf::Qc() const {
+  const int N = size();
+  MatrixXd Q = MatrixXd::Zero(N, N);
+  const Eigen::Matrix3d C = state().C_BtoN();
+  const auto& psd = layout_.whitePsd();
+  const Vector3d pg(psd[0], psd[1], psd[2]), pa(psd[3], psd[4], psd[5]);
+  Q.block<3, 3>(kVel, kVel) = C * pa.asDiagonal() * C.transpose();
+  Q.block<3, 3>(kAtt, kAtt) = C * pg.asDiagonal() * C.transpose();
+  for (const ProcessBlock& b : layout_.blocks())
+    Q.block(b.offset, b.offset, b.ss.n, b.ss.n) = b.ss.Qc;
+  return Q;
+}
+
+void ErrorStateEkf::buildTransition(double dt, Transition& T) const {
+  const int m = layout_.imuSize();
+  const auto& blocks = layout_.blocks();
+  Cache& c = *cache_;
+  if (c.dt != dt) {  // exact discrete IMU-error blocks (from stochastic), cached per dt
+    c.Phi.clear();
+    c.Qd.clear();
+    for (const ProcessBlock& b : blocks) {
+      const bool constant = b.ss.F.cwiseAbs().maxCoeff() == 0.0 && b.ss.Qc.cwiseAbs().maxCoeff() == 0.0;
+      c.Phi.push_back(constant ? MatrixXd::Identity(b.ss.n, b.ss.n) : b.ss.Phi(dt));
+      c.Qd.push_back(constant ? MatrixXd::Zero(b.ss.n, b.ss.n) : b.ss.Qd(dt));
+    }
+    c.dt = dt;
+  }
+  T.D.setZero(m, m);
+  T.Q.setZero(9 + m, 9 + m);
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const int o = blocks[k].offset - kNav, n = blocks[k].ss.n;
+    T.D.block(o, o, n, n) = c.Phi[k];
+    T.Q.block(9 + o, 9 + o, n, n) = c.Qd[k];
+  }
+
+  if (cfg_.discretization == Discretization::VanLoan) {
+    // Van Loan (1978): expm([-F Qc; 0 F'] dt) = [.. Phi^-1 Qd; 0 Phi'] (Groves 3.? / 14.?)
+    const MatrixXd F = this->F(), Q = this->Qc();
+    const int N = size();
+    MatrixXd M = MatrixXd::Zero(2 * N, 2 * N);
+    M.topLeftCorner(N, N) = -F * dt;
+    M.topRightCorner(N, N) = Q * dt;
+    M.bottomRightCorner(N, N) = F.transpose() * dt;
+    const MatrixXd E = M.exp();
+    const MatrixXd Phi = E.bottomRightCorner(N, N).transpose();
+    MatrixXd Qd = Phi * E.topRightCorner(N, N);
+    Qd = 0.5 * (Qd + Qd.transpose());
+    T.A = Phi.topLeftCorner<9, 9>();
+    T.B = Phi.topRightCorner(9, m);
+    // IMU-error blocks keep their exact closed forms (identical up to rounding)
+    const MatrixXd Qii = T.Q.bottomRightCorner(m, m);
+    T.Q = Qd;
+    T.Q.bottomRightCorner(m, m) = Qii;
+    return;
+  }
+
+  // Series form (Groves 3.34, 3.46-3.47 truncated): Phi to second order in dt,
+  // Qd to third order, computed block by block.
+  const Matrix9d Fnn = navErrorDynamics(state(), f_B_);
+  const Eigen::Matrix3d C = state().C_BtoN();
+  MatrixXd Fni = MatrixXd::Zero(9, m), FniFii = MatrixXd::Zero(9, m), FniQii = MatrixXd::Zero(9, m),
+           FniQiiFii = MatrixXd::Zero(9, m), FniFiiQii = MatrixXd::Zero(9, m);
+  for (const ProcessBlock& b : blocks) {
+    const int o = b.offset - kNav, n = b.ss.n;
+    const int row = b.channel < 3 ? kAtt : kVel;
+    Fni.block(row, o, 3, n) = -C.col(b.channel % 3) * b.ss.H;
+    FniFii.block(row, o, 3, n) = Fni.block(row, o, 3, n) * b.ss.F;
+    FniQii.block(row, o, 3, n) = Fni.block(row, o, 3, n) * b.ss.Qc;
+    FniQiiFii.block(row, o, 3, n) = FniQii.block(row, o, 3, n) * b.ss.F.transpose();
+    FniFiiQii.block(row, o, 3, n) = FniFii.block(row, o, 3, n) * b.ss.Qc;
+  }
+  const double dt2 = dt * dt, dt3 = dt2 * dt;
+  const Matrix9d Fnn2 = Fnn * Fnn;
+  T.A = Matrix9d::Identity() + Fnn * dt + Fnn2 * (0.5 * dt2);
+  T.B = Fni * dt + (Fnn * Fni + FniFii) * (0.5 * dt2);
+  const auto& psd = layout_.whitePsd();
+  const Vector3d pg(psd[0], psd[1], psd[2]), pa(psd[3], psd[4], psd[5]);
+  Matrix9d Qnn = Matrix9d::Zero();
+  Qnn.block<3, 3>(kVel, kVel) = C * pa.asDiagonal() * C.transpose();
+  Qnn.block<3, 3>(kAtt, kAtt) = C * pg.asDiagonal() * C.transpose();
+  // Qd = Q dt + (FQ + QF') dt^2/2 + (F^2 Q + 2 F Q F' + Q F^2') dt^3/6 + O(dt^4),
+  // with Q = blockdiag(Qnn, Qii) and F = [Fnn Fni; 0 Fii]:
+  const Matrix9d FQ = Fnn * Qnn;
+  const Matrix9d F2Q = Fnn2 * Qnn;
+  const Matrix9d FQFt = FQ * Fnn.transpose() + FniQii * Fni.transpose();
+  T.Q.topLeftCorner<9, 9>() = Qnn * dt + (FQ + FQ.transpose()) * (0.5 * dt2) +
+                              (F2Q + F2Q.transpose() + 2.0 * FQFt) * (dt3 / 6.0);
+  const MatrixXd Qni = FniQii * (0.5 * dt2) +
+                       (Fnn * FniQii + FniFiiQii + 2.0 * FniQiiFii) * (dt3 / 6.0);
+  T.Q.topRightCorner(9, m) = Qni;
+  T.Q.bottomLeftCorner(m, 9) = Qni.transpose();
+}
+
+namespace {
+// X <- X * D' for block-diagonal D (blocks given by the layout), columns in place.
+void rightMulDt(MatrixXd& X, const MatrixXd& D, const std::vector<ProcessBlock>& blocks) {
+  for (const ProcessBlock& b : blocks) {
+    const int o = b.offset - kNav, n = b.ss.n;
+    if (n == 1) {
+      X.col(o) *= D(o, o);
+    } else {
+      X.middleCols(o, n) = (X.middleCols(o, n) * D.block(o, o, n, n).transpose()).eval();
+    }
+  }
+}
+// X <- D * X (rows in place).
+void leftMulD(MatrixXd& X, const MatrixXd& D, const std::vector<ProcessBlock>& blocks) {
+  for (const ProcessBlock& b : blocks) {
+    const int o = b.offset - kNav, n = b.ss.n;
+    if (n == 1) {
+      X.row(o) *= D(o, o);
+    } else {
+      X.middleRows(o, n) = (D.block(o, o, n, n) * X.middleRows(o, n)).eval();
+    }
+  }
+}
+}  // namespace
+
+void ErrorStateEkf::accumulate(const Transition& T) {
+  const auto& blocks = layout_.blocks();
+  if (pending_ == 0) {
+    A_acc_ = T.A;
+    B_acc_ = T.B;
+    D_acc_ = T.D;
+    Q_acc_ = T.Q;
+  } else {
+    // Phi_acc <- Phi_k Phi_acc (structure kept); Q_acc <- Q_acc + Q_k
+    MatrixXd BD = T.B;
+    rightMulDt(BD, D_acc_.transpose(), blocks);  // B_k D_acc
+    B_acc_ = T.A * B_acc_ + BD;
+    A_acc_ = T.A * A_acc_;
+    MatrixXd Dn = D_acc_;
+    leftMulD(Dn, T.D, blocks);
+    D_acc_ = Dn;
+    Q_acc_ += T.Q;
+  }
+  ++pending_;
+  if (pending_ >= cfg_.propagate_every) applyTransition();
+}
+
+void ErrorStateEkf::applyTransition() {
+  if (pending_ == 0) return;
+  const int m = layout_.imuSize();
+  const auto& blocks = layout_.blocks();
+  // P <- Phi P Phi' + Q with Phi = [A B; 0 D] (Groves 3.46), block by block:
+  //  P'nn = (A Pnn + B Pin) A' + (A Pni + B Pii) B'
+  //  P'ni = (A Pni + B Pii) D'
+  //  P'ii = D Pii D'
+  const Matrix9d Pnn = P_.topLeftCorner<9, 9>();
+  MatrixXd Pni = P_.topRightCorner(9, m);
+  MatrixXd Pii = P_.bottomRightCorner(m, m);
+  const Matrix9d Mnn = A_acc_ * Pnn + B_acc_ * Pni.transpose();
+  MatrixXd Mni = A_acc_ * Pni;
+  Mni.noalias() += B_acc_ * Pii;
+  Matrix9d Pnn1 = Mnn * A_acc_.transpose();
+  Pnn1.noalias() += Mni * B_acc_.transpose();
+  rightMulDt(Mni, D_acc_, blocks);
+  leftMulD(Pii, D_acc_, blocks);
+  rightMulDt(Pii, D_acc_, blocks);
+  P_.topLeftCorner<9, 9>() = Pnn1;
+  P_.topRightCorner(9, m) = Mni;
+  P_.bottomLeftCorner(m, 9) = Mni.transpose();
+  P_.bottomRightCorner(m, m) = Pii;
+  P_ += Q_acc_;
+  pending_ = 0;
+  checkP("propagation");
+}
+
+void ErrorStateEkf::flushPropagation() { applyTransition(); }
+
+void ErrorStateEkf::checkP(const char* where) const {
+  const VectorXd d = P_.diagonal();
+  const double scale = d.cwiseAbs().maxCoeff();
+  for (int i = 0; i < d.size(); ++i) {
+    if (!std::isfinite(d(i)) || d(i) < -1e-12 * (1.0 + scale))
+      throw Error("filter covariance is not positive definite at t = " + tstr(state().t) +
+                  " s after " + where + " (state " + layout_.names()[i] + " variance " +
+                  tstr(d(i)) + ")");
+  }
+}
+
+void ErrorStateEkf::predict(const ins::ImuSample& raw) {
+  if (!(raw.dt > 0.0) || !std::isfinite(raw.dt))
+    throw Error("IMU sample at t = " + tstr(raw.t) + " s has non-positive interval dt");
+  // Corrected output = raw - estimated error (closed loop, Groves 14.? feedback).
+  const Eigen::Matrix<double, 6, 1> e = sensorErrors();
+  ins::ImuSample s = raw;
+  s.dtheta_B -= e.head<3>() * raw.dt;
+  s.dv_B -= e.tail<3>() * raw.dt;
+  w_IB_B_ = s.w_IB_B();
+  f_B_ = s.f_B();
+  mech_.step(s);
+  cache_->nominal_valid = false;
+  Transition& T = cache_->tmp;
+  buildTransition(raw.dt, T);
+  // deterministic propagation of the IMU-error estimates with the exact blocks
+  if (x_imu_.size() > 0) {
+    MatrixXd xm = x_imu_;
+    leftMulD(xm, T.D, layout_.blocks());
+    x_imu_ = xm.col(0);
+  }
+  accumulate(T);
+}
+
+void ErrorStateEkf::predictCovariance(const ins::NavState& nominal, const Vector3d& w_IB_B,
+                                      const Vector3d& f_B, double dt) {
+  if (!(dt > 0.0) || !std::isfinite(dt))
+    throw Error("covariance propagation at t = " + tstr(nominal.t) + " s: dt must be > 0");
+  Cache& c = *cache_;
+  const bool same = c.nominal_valid && c.nominal_dt == dt && c.w == w_IB_B && c.f == f_B &&
+                    sameState(c.nominal, nominal);
+  mech_.setState(nominal);
+  w_IB_B_ = w_IB_B;
+  f_B_ = f_B;
+  if (!same) {
+    buildTransition(dt, c.T);
+    c.nominal = nominal;
+    c.w = w_IB_B;
+    c.f = f_B;
+    c.nominal_dt = dt;
+    c.nominal_valid = true;
+  }
+  accumulate(c.T);
+}
+
+MatrixXd ErrorStateEkf::H_gnssPosition(const Vector3d& lever_B) const {
+  MatrixXd H = MatrixXd::Zero(3, size());
+  H.block<3, 3>(0, kPos).setIdentity();
+  // p_ant = p + C l: d(C l) = psi x (C l) = -[(C l) x] psi (Groves 14.110 with our signs)
+  H.block<3, 3>(0, kAtt) = -skew(state().C_BtoN() * lever_B);
+  return H;
+}
+
+MatrixXd ErrorStateEkf::H_gnssVelocity(const Vector3d& lever_B) const {
+  MatrixXd H = MatrixXd::Zero(3, size());
+  const Eigen::Matrix3d C = state().C_BtoN();
+  const Vector3d w_ie = earth::w_IE_N(state().lat);
+  H.block<3, 3>(0, kVel).setIdentity();
+  // v_ant = v + C (w_IB_B x l) - w_IE_N x (C l)  (Groves 14.111)
+  H.block<3, 3>(0, kAtt) = -skew(C * w_IB_B_.cross(lever_B)) + skew(w_ie) * skew(C * lever_B);
+  // gyro error: d(w) = -h_c dx_imu -> C (dw x l) = C [l x] Hg dx
+  if (layout_.imuSize() > 0 && lever_B.squaredNorm() > 0.0) {
+    MatrixXd Hg(3, layout_.imuSize());
+    for (int c = 0; c < 3; ++c) Hg.row(c) = layout_.sensorRow(c);
+    H.rightCols(layout_.imuSize()) = C * skew(lever_B) * Hg;
+  }
+  return H;
+}
+
+MatrixXd ErrorStateEkf::H_baro() const {
+  MatrixXd H = MatrixXd::Zero(1, size());
+  H(0, kPos + 2) = -1.0;  // h_est - h = -dp_D
+  return H;
+}
+
+UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const MatrixXd& R,
+                                   bool feedback) {
+  flushPropagation();
+  const int mz = static_cast<int>(dz.size());
+  UpdateResult res;
+  res.t = state().t;
+  const MatrixXd PHt = P_ * H.transpose();
+  res.S = H * PHt + R;
+  res.innovation = dz;
+  Eigen::LLT<MatrixXd> llt(res.S);
+  if (llt.info() != Eigen::Success || !res.S.allFinite())
+    throw Error("innovation covariance not positive definite at t = " + tstr(res.t) + " s");
+  res.nis = dz.dot(llt.solve(dz));
+  if (cfg_.gate_probability > 0.0) {
+    const boost::math::chi_squared chi2(mz);
+    if (res.nis > boost::math::quantile(chi2, cfg_.gate_probability)) {
+      res.accepted = false;
+      ++rejections_;
+      last_ = res;
+      return res;
+    }
+  }
+  const MatrixXd K = llt.solve(PHt.transpose()).transpose();  // K = P H' S^-1 (Groves 3.21)
+  // Joseph form (I-KH) P (I-KH)' + K R K' (Groves 3.58), expanded:
+  // P - K (PH')' - (PH') K' + K S K'
+  const MatrixXd KS = K * res.S;
+  P_.noalias() -= K * PHt.transpose();
+  P_.noalias() -= PHt * K.transpose();
+  P_.noalias() += KS * K.transpose();
+  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  if (feedback) {
+    const VectorXd dx = K * dz;  // estimated error (estimate minus truth)
+    mech_.setState(correctNav(state(), dx.head<9>()));
+    x_imu_ -= dx.tail(layout_.imuSize());
+    cache_->nominal_valid = false;
+  }
+  checkP("update");
+  Eigen::LDLT<MatrixXd> ldlt(P_);
+  if (ldlt.info() != Eigen::Success ||
+      (ldlt.vectorD().array() < -1e-9 * (1.0 + P_.diagonal().cwiseAbs().maxCoeff())).any())
+    throw Error("filter covariance is not positive definite at t = " + tstr(res.t) +
+                " s after update");
+  last_ = res;
+  return res;
+}
+
+VectorXd ErrorStateEkf::residualGnssPosition(const earth::Geodetic& z,
+                                             const Vector3d& lever_B) const {
+  const ins::NavState& x = state();
+  const earth::Radii r = earth::radii(x.lat);
+  const Vector3d l_N = x.C_BtoN() * lever_B;
+  const earth::Geodetic ant{x.lat + l_N.x() / (r.R_N + x.h),
+                            x.lon + l_N.y() / ((r.R_E + x.h) * std::cos(x.lat)), x.h - l_N.z()};
+  return earth::curvilinearDiffNed(ant, z);
+}
+
+UpdateResult ErrorStateEkf::updateGnssPosition(const earth::Geodetic& z, const Vector3d& sigma,
+                                               const Vector3d& lever_B) {
+  if (!(sigma.array() > 0.0).all() || !sigma.allFinite())
+    throw Error("GNSS position sigma must be > 0 at t = " + tstr(state().t) + " s");
+  flushPropagation();
+  const VectorXd dz = residualGnssPosition(z, lever_B);
+  const MatrixXd R = sigma.cwiseAbs2().asDiagonal();
+  return update(dz, H_gnssPosition(lever_B), R);
+}
+
+VectorXd ErrorStateEkf::residualGnssVelocity(const Vector3d& z_N, const Vector3d& lever_B) const {
+  const ins::NavState& x = state();
+  const Eigen::Matrix3d C = x.C_BtoN();
+  const Vector3d v_ant =
+      x.v_N + C * w_IB_B_.cross(lever_B) - earth::w_IE_N(x.lat).cross(C * lever_B);
+  return v_ant - z_N;
+}
+
+UpdateResult ErrorStateEkf::updateGnssVelocity(const Vector3d& z_N, const Vector3d& sigma,
+                                               const Vector3d& lever_B) {
+  if (!(sigma.array() > 0.0).all() || !sigma.allFinite())
+    throw Error("GNSS velocity sigma must be > 0 at t = " + tstr(state().t) + " s");
+  flushPropagation();
+  const VectorXd dz = residualGnssVelocity(z_N, lever_B);
+  const MatrixXd R = sigma.cwiseAbs2().asDiagonal();
+  return update(dz, H_gnssVelocity(lever_B), R);
+}
+
+UpdateResult ErrorStateEkf::updateBaro(double h_meas, double sigma) {
+  if (!(sigma > 0.0) || !std::isfinite(sigma))
+    throw Error("barometer sigma must be > 0 at t = " + tstr(state().t) + " s");
+  VectorXd dz(1);
+  dz(0) = state().h - h_meas;
+  return update(dz, H_baro(), MatrixXd::Constant(1, 1, sigma * sigma));
+}
+
+void ErrorStateEkf::discretize(double dt, MatrixXd& Phi, MatrixXd& Qd) const {
+  Transition T;
+  buildTransition(dt, T);
+  const int m = layout_.imuSize(), N = size();
+  Phi = MatrixXd::Zero(N, N);
+  Phi.topLeftCorner<9, 9>() = T.A;
+  Phi.topRightCorner(9, m) = T.B;
+  Phi.bottomRightCorner(m, m) = T.D;
+  Qd = T.Q;
+}
+
+}  // namespace navimpact::filter

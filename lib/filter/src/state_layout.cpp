@@ -1,0 +1,104 @@
+#include "navimpact/filter/state_layout.hpp"
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/imu_series.hpp"
+
+namespace navimpact::filter {
+
+namespace {
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(4);
+  s << v;
+  return s.str();
+}
+}  // namespace
+
+StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuErrorOptions& opt) {
+  StateLayout L;
+  L.model_ = model;
+  L.names_ = {"pos_N", "pos_E", "pos_D", "vel_N", "vel_E", "vel_D", "att_N", "att_E", "att_D"};
+  for (int c = 0; c < 6; ++c) {
+    const std::string ch = kChannelNames[c];
+    if (opt.turn_on_bias) {
+      const double s = opt.turn_on_sigma[c];
+      if (!(std::isfinite(s) && s > 0.0))
+        throw Error("turn-on bias sigma of " + ch + " must be finite and > 0, got " + fmt(s));
+      ProcessBlock b;
+      b.channel = c;
+      b.offset = static_cast<int>(L.names_.size());
+      b.ss.n = 1;
+      b.ss.F = Eigen::MatrixXd::Zero(1, 1);
+      b.ss.Qc = Eigen::MatrixXd::Zero(1, 1);
+      b.ss.H = Eigen::RowVectorXd::Ones(1);
+      b.ss.P0 = Eigen::MatrixXd::Constant(1, 1, s * s);
+      b.ss.names = {"turn-on bias"};
+      L.names_.push_back(ch + ".TOB(sigma=" + fmt(s) + ")");
+      L.blocks_.push_back(b);
+    }
+    const stochastic::Model& m = model.axis[c];
+    if (m.empty()) continue;
+    stochastic::validate(m);
+    std::map<stochastic::ProcessKind, int> count;
+    for (const stochastic::Process& p : m.terms) {
+      const int k = ++count[p.kind];
+      stochastic::StateSpaceBlock ss = stochastic::stateSpace(p, m.rate_hz);
+      L.white_psd_[c] += ss.white_psd;
+      if (ss.n == 0) continue;
+      ProcessBlock b;
+      b.channel = c;
+      b.offset = static_cast<int>(L.names_.size());
+      b.ss = ss;
+      std::string base = ch + "." + stochastic::kindName(p.kind) + std::to_string(k);
+      switch (p.kind) {
+        case stochastic::ProcessKind::GM:
+          L.names_.push_back(base + "(T=" + fmt(p.T) + "s)");
+          break;
+        case stochastic::ProcessKind::RW:
+          L.names_.push_back(base);
+          break;
+        case stochastic::ProcessKind::DR:
+          L.names_.push_back(base + ".bias");
+          L.names_.push_back(base + ".rate");
+          break;
+        case stochastic::ProcessKind::SIN:
+          L.names_.push_back(base + "(f=" + fmt(p.freq_hz) + "Hz).a");
+          L.names_.push_back(base + "(f=" + fmt(p.freq_hz) + "Hz).b");
+          break;
+        default:
+          for (int i = 0; i < ss.n; ++i) L.names_.push_back(base + "." + std::to_string(i));
+      }
+      if (static_cast<int>(L.names_.size()) != b.offset + ss.n)
+        throw Error("internal: state-space block of " + base + " has " + std::to_string(ss.n) +
+                    " states, expected a different number");
+      L.blocks_.push_back(b);
+    }
+  }
+  const int m = L.imuSize();
+  for (int c = 0; c < 6; ++c) L.h_[c] = Eigen::RowVectorXd::Zero(m);
+  for (const ProcessBlock& b : L.blocks_)
+    L.h_[b.channel].segment(b.offset - kNav, b.ss.n) = b.ss.H;
+  return L;
+}
+
+Eigen::MatrixXd StateLayout::imuP0() const {
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(imuSize(), imuSize());
+  for (const ProcessBlock& b : blocks_)
+    P.block(b.offset - kNav, b.offset - kNav, b.ss.n, b.ss.n) = b.ss.P0;
+  return P;
+}
+
+std::string StateLayout::describe() const {
+  std::ostringstream s;
+  for (int i = 0; i < size(); ++i) s << i << " " << names_[i] << "\n";
+  for (int c = 0; c < 6; ++c)
+    if (white_psd_[c] > 0.0)
+      s << "noise " << kChannelNames[c] << " white PSD " << white_psd_[c] << " (SI unit^2 s)\n";
+  return s.str();
+}
+
+}  // namespace navimpact::filter
