@@ -890,11 +890,9 @@ class PanelPainter {
                kInk, HAlign::Center, VAlign::Top);
     }
     if (!ax_.ylabel.empty()) {
-      int yw = 0;
-      for (const auto& t : p_.yt)
-        if (t.labeled) yw = std::max(yw, tr_.labelWidth(t.label, sz_.tick));
-      const int labelH = TextRenderer::capHeight(sz_.label) + TextRenderer::descent(sz_.label);
-      const int x = std::max(c.x + sz_.pad / 2, a.x - 1 - sz_.tickLen - sz_.gap - yw - sz_.labelGap - labelH);
+      // At the left edge of the column's margin, so that the y labels of
+      // stacked panels line up whatever their tick-label widths.
+      const int x = c.x + sz_.pad;
       tr_.drawVertical(canvas_, ax_.ylabel, {x, a.y + a.height / 2},
                        fitPx(tr_, ax_.ylabel, sz_.label, a.height + a.height / 4), kInk);
     }
