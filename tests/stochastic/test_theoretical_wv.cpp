@@ -13,6 +13,7 @@
 #include "navimpact/stochastic/process.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 #include "test_support.hpp"
+#include "wv_helper.hpp"
 
 using namespace navimpact::stochastic;
 namespace test = navimpact::test;
@@ -277,22 +278,6 @@ TEST(RateConversion, RejectsBadRates) {
   EXPECT_THROW(convertRate(m, 100.0), navimpact::Error);
 }
 
-namespace {
-/// Empirical Haar MODWT WV from the definition: W_t = (mean of last n - mean
-/// of the n before)/2 over all full windows, nu^2 = mean of W_t^2.
-double empiricalWv(const std::vector<double>& x, std::size_t tau) {
-  const std::size_t n = tau / 2;
-  std::vector<double> c(x.size() + 1, 0.0);
-  for (std::size_t i = 0; i < x.size(); ++i) c[i + 1] = c[i] + x[i];
-  double s = 0.0;
-  std::size_t M = 0;
-  for (std::size_t t = tau; t <= x.size(); ++t, ++M) {
-    const double w = ((c[t] - c[t - n]) - (c[t - n] - c[t - tau])) / (2.0 * n);
-    s += w * w;
-  }
-  return s / M;
-}
-}  // namespace
 
 TEST(TheoreticalWv, SinusoidMatchesLongRecordAveragedOverPhase) {
   // The closed form is an average over a uniform phase; a long deterministic
@@ -304,7 +289,7 @@ TEST(TheoreticalWv, SinusoidMatchesLongRecordAveragedOverPhase) {
   for (std::size_t k = 0; k < x.size(); ++k) x[k] = A * std::sin(w * k + 0.4);
   for (std::size_t tau = 2; tau <= 4096; tau *= 2) {
     const double th = haarWv(Process::sin(A, f), rate, static_cast<double>(tau));
-    const double emp = empiricalWv(x, tau);
+    const double emp = test::empiricalHaarWv(x, tau);
     // residual non-averaged part is O(period / record length) of the power
     EXPECT_NEAR(emp, th, 2e-3 * A * A / 2) << "tau=" << tau;
   }

@@ -216,8 +216,16 @@ Process parseTerm(Parser& P, double rate_hz) {
   return Process::ar1(phi, s2, rate_hz);
 }
 
+/// %g with @p digits significant digits; digits >= 17 means "exact": the
+/// shortest of 15, 16, 17 digits that reads back as the same double.
 std::string fmt(double v, int digits) {
   char buf[64];
+  if (digits >= 17) {
+    for (int d = 15; d <= 17; ++d) {
+      std::snprintf(buf, sizeof buf, "%.*g", d, v);
+      if (std::strtod(buf, nullptr) == v) return buf;
+    }
+  }
   std::snprintf(buf, sizeof buf, "%.*g", digits, v);
   return buf;
 }

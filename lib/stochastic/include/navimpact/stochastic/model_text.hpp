@@ -25,7 +25,9 @@ namespace navimpact::stochastic {
  */
 std::vector<Process> parseTerms(const std::string& text, double rate_hz);
 
-/// Text form with 4 significant digits by default; round-trips exactly with digits=17.
+/// Text form with 4 significant digits by default; round-trips exactly with
+/// digits=17 (then each number is printed with the shortest of 15/16/17 digits
+/// that reads back as the same double, e.g. 4.811e-4 rather than 0.00048109999999999998).
 std::string formatTerms(const std::vector<Process>& terms, int digits = 4);
 
 /// Parse a structure like "WN+GM+GM+DR" (also accepts "AR1" for GM, "SIN", "QN", "RW").

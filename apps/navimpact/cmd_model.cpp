@@ -1,0 +1,126 @@
+// navimpact model {show,list,convert}: inspect IMU error model files.
+//   navimpact model show FILE[:NAME]
+//   navimpact model list FILE
+//   navimpact model convert FILE[:NAME] --rate HZ [--out FILE.yaml]
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "cli_common.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/imu_series.hpp"
+#include "navimpact/core/output.hpp"
+#include "navimpact/stochastic/datasheet.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+
+namespace {
+
+namespace st = navimpact::stochastic;
+
+struct Opts {
+  std::string spec;
+  std::string file;
+  double rate_hz = 0.0;
+  std::string out;
+};
+
+std::string fmtRate(double hz) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g Hz", hz);
+  return buf;
+}
+
+/// Print one group of axes sharing a model: its text and datasheet figures.
+void printGroup(std::ostream& os, const std::string& label, const st::Model& m,
+                navimpact::units::Quantity q) {
+  os << label << ": " << st::formatTerms(m.terms) << "   [" << navimpact::units::siUnit(q)
+     << ", per sample]\n";
+  if (m.empty()) return;
+  std::istringstream lines(st::formatDatasheet(st::datasheetFigures(m), q));
+  std::string l;
+  while (std::getline(lines, l)) os << "    " << l << "\n";
+}
+
+int runShow(const Opts& o) {
+  const st::ImuModel m = st::loadImuModel(o.spec);
+  std::cout << "model " << m.source << " (parameters per sample at " << fmtRate(m.rate_hz)
+            << ")\n";
+  for (int s = 0; s < 2; ++s) {  // gyroscope axes 0..2, accelerometer axes 3..5
+    const int a0 = 3 * s;
+    const auto q = s == 0 ? navimpact::units::Quantity::AngularRate
+                          : navimpact::units::Quantity::SpecificForce;
+    const bool same =
+        m.axis[a0].terms == m.axis[a0 + 1].terms && m.axis[a0].terms == m.axis[a0 + 2].terms;
+    if (same) {
+      const std::string label = std::string(navimpact::kChannelNames[a0]) + ", " +
+                                navimpact::kChannelNames[a0 + 1] + ", " +
+                                navimpact::kChannelNames[a0 + 2];
+      printGroup(std::cout, label, m.axis[a0], q);
+    } else {
+      for (int i = a0; i < a0 + 3; ++i) printGroup(std::cout, navimpact::kChannelNames[i], m.axis[i], q);
+    }
+  }
+  return 0;
+}
+
+int runList(const Opts& o) {
+  const auto names = st::listModels(o.file);
+  if (names.empty()) {
+    const st::ImuModel m = st::loadImuModel(o.file);
+    std::cout << o.file << ": single model (rate " << fmtRate(m.rate_hz) << ")\n";
+    return 0;
+  }
+  for (const auto& n : names) {
+    const st::ImuModel m = st::loadImuModel(o.file + ":" + n);
+    std::vector<st::ProcessKind> g, a;
+    for (const auto& p : m.axis[0].terms) g.push_back(p.kind);
+    for (const auto& p : m.axis[3].terms) a.push_back(p.kind);
+    std::printf("%-16s gyro: %-14s acc: %-14s (%g Hz)\n", n.c_str(), st::formatStructure(g).c_str(),
+                st::formatStructure(a).c_str(), m.rate_hz);
+  }
+  return 0;
+}
+
+int runConvert(const Opts& o) {
+  const st::ImuModel m = st::loadImuModel(o.spec);
+  const st::ImuModel c = st::convertRate(m, o.rate_hz);
+  const std::string note = "converted from " + fmtRate(m.rate_hz) + " to " + fmtRate(o.rate_hz);
+  const std::string yaml = st::toYaml(c, "navimpact model convert: " + m.source + ", " + note +
+                                             "\n(exact: same noise densities and continuous processes)");
+  if (o.out.empty()) {
+    std::cout << yaml;
+    return 0;
+  }
+  const std::filesystem::path out(o.out);
+  navimpact::OutputSet set(out.has_parent_path() ? out.parent_path() : std::filesystem::path("."));
+  set.writeText(out.filename().string(), yaml);
+  set.commit();
+  std::cout << m.source << ": " << note << ", wrote " << o.out << "\n";
+  return 0;
+}
+
+navimpact::cli::Registrar reg({"model", "Inspect IMU error model files (show, list, convert)",
+                               [](CLI::App& app) -> std::function<int()> {
+  auto o = std::make_shared<Opts>();
+  app.require_subcommand(1);
+  auto* show = app.add_subcommand("show", "Print each axis' model and its datasheet figures");
+  show->add_option("model", o->spec, "Model file, FILE or FILE:NAME")->required();
+  auto* list = app.add_subcommand("list", "List the named models of a model file");
+  list->add_option("file", o->file, "Model file (YAML)")->required();
+  auto* conv = app.add_subcommand("convert", "Convert a model exactly to another sampling rate");
+  conv->add_option("model", o->spec, "Model file, FILE or FILE:NAME")->required();
+  conv->add_option("--rate", o->rate_hz, "New sampling rate [Hz]")->required()->check(
+      CLI::PositiveNumber);
+  conv->add_option("--out", o->out, "Write the converted single-model YAML file here");
+  return [o, show, list, conv]() -> int {
+    if (show->parsed()) return runShow(*o);
+    if (list->parsed()) return runList(*o);
+    if (conv->parsed()) return runConvert(*o);
+    return 1;
+  };
+}});
+
+}  // namespace
