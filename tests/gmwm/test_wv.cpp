@@ -71,6 +71,29 @@ double naiveWv(const std::vector<double>& x, int j) {
   return static_cast<double>(acc / cnt);
 }
 
+// Straightforward pyramid on whole arrays (Percival & Walden 2000, eq. 177a),
+// boundary coefficients dropped: the blocked library code must agree.
+std::vector<double> simplePyramidWv(const std::vector<double>& x, int J) {
+  std::vector<double> v = x, out;
+  std::size_t first = 0;  // first index of v that is boundary-free
+  for (int j = 1; j <= J; ++j) {
+    const std::size_t s = std::size_t{1} << (j - 1);
+    std::vector<double> nv(x.size(), 0.0);
+    long double acc = 0;
+    std::size_t cnt = 0;
+    for (std::size_t t = first + s; t < x.size(); ++t) {
+      const double w = 0.5 * (v[t] - v[t - s]);
+      nv[t] = 0.5 * (v[t] + v[t - s]);
+      acc += static_cast<long double>(w) * w;
+      ++cnt;
+    }
+    first += s;
+    v.swap(nv);
+    out.push_back(static_cast<double>(acc / cnt));
+  }
+  return out;
+}
+
 }  // namespace
 
 class WvReference : public ::testing::TestWithParam<int> {};
@@ -129,6 +152,22 @@ TEST(Wv, MatchesNaiveDefinitionWithLargeMean) {
     EXPECT_GT(w.ci_high[j - 1], w.wv[j - 1]);
   }
   EXPECT_DOUBLE_EQ(w.tauSeconds()[0], 0.2);
+}
+
+TEST(Wv, BlockedPyramidMatchesWholeArrayPyramid) {
+  // 200003 samples: several cache blocks in every stage of the blocked code.
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  std::vector<double> x(200003);
+  double ar = 0;
+  for (auto& v : x) {
+    ar = 0.999 * ar + 0.1 * nd(rng);
+    v = -9.8 + 0.01 * nd(rng) + ar;
+  }
+  const auto w = gmwm::waveletVariance(x.data(), x.size(), 100.0);
+  const auto ref = simplePyramidWv(x, 17);
+  ASSERT_EQ(w.scales(), 17);
+  for (int j = 1; j <= 17; ++j) EXPECT_LT(rel(w.wv[j - 1], ref[j - 1]), 1e-12) << "j=" << j;
 }
 
 TEST(Wv, MaxLevelLimitsScales) {

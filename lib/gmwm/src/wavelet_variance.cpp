@@ -9,8 +9,10 @@
 #include <atomic>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <sstream>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "navimpact/core/error.hpp"
@@ -93,6 +95,108 @@ void haarModwtLevels(const double* x, std::size_t n, int J,
   }
 }
 
+namespace {
+
+/// Sum of squares of (0.5 (a[i] - b[i])) and v[i] = 0.5 (a[i] + b[i]), i < m.
+/// Eight independent partial sums per chunk keep it vectorised; chunk totals
+/// go to long double.
+inline long double levelStep(const double* __restrict a, const double* __restrict b,
+                             double* __restrict v, std::size_t m, std::size_t acc_from) {
+  for (std::size_t i = 0; i < std::min(acc_from, m); ++i) v[i] = 0.5 * (a[i] + b[i]);
+  long double total = 0.0L;
+  constexpr std::size_t kChunk = 4096;
+  for (std::size_t c = acc_from; c < m; c += kChunk) {
+    const std::size_t e = std::min(m, c + kChunk);
+    double acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    std::size_t i = c;
+    for (; i + 8 <= e; i += 8) {
+      for (int k = 0; k < 8; ++k) {
+        const double w = 0.5 * (a[i + k] - b[i + k]);
+        acc[k] += w * w;
+        v[i + k] = 0.5 * (a[i + k] + b[i + k]);
+      }
+    }
+    double sum = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+    for (; i < e; ++i) {
+      const double w = 0.5 * (a[i] - b[i]);
+      sum += w * w;
+      v[i] = 0.5 * (a[i] + b[i]);
+    }
+    total += sum;
+  }
+  return total;
+}
+
+/**
+ * Levels jfrom..jto of the Haar MODWT pyramid, cache-blocked over time.
+ * @param in   V_{jfrom-1,t} for t = 2^{jfrom-1} - 1 .. n-1.
+ * @param out  receives V_{jto,t} for t = 2^{jto} - 1 .. n-1.
+ * @param ss   ss[j-1] += sum over kept t of W_{j,t}^2.
+ * @param block output samples per block (the lookback 2^jto - 2^{jfrom-1} is recomputed per block).
+ */
+void pyramidStage(const double* in, double* out, std::size_t n, int jfrom, int jto,
+                  std::size_t block, std::vector<double>& buf1, std::vector<double>& buf2,
+                  std::vector<long double>& ss) {
+  const std::size_t t_in0 = (std::size_t{1} << (jfrom - 1)) - 1;
+  const std::size_t t_out0 = (std::size_t{1} << jto) - 1;
+  const std::size_t L = t_out0 - t_in0;
+  if (buf1.size() < block + L) buf1.resize(block + L);
+  if (buf2.size() < block + L) buf2.resize(block + L);
+  for (std::size_t t0 = t_out0; t0 < n; t0 += block) {
+    const std::size_t t1 = std::min(n, t0 + block);
+    std::size_t bs = t0 - L;  // time of element 0 of the current level's buffer
+    const double* src = in + (bs - t_in0);
+    std::size_t len = t1 - bs;
+    for (int j = jfrom; j <= jto; ++j) {
+      const std::size_t s = std::size_t{1} << (j - 1);
+      const std::size_t m = len - s;
+      bs += s;
+      double* dst = (j == jto) ? out + (t0 - t_out0) : ((j - jfrom) % 2 == 0 ? buf1.data() : buf2.data());
+      // W_{j,t} = (V_{j-1,t} - V_{j-1,t-s}) / 2 for t = bs + k. Each t is counted
+      // once: in its own block, except that the first block also counts the
+      // kept t < t_out0 of the lower levels (there bs = 2^j - 1, the first kept t).
+      ss[j - 1] += levelStep(src + s, src, dst, m, t0 == t_out0 ? 0 : t0 - bs);
+      src = dst;
+      len = m;
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<long double> haarModwtSumSquares(const double* x, std::size_t n, int J) {
+  // Same pyramid as haarModwtLevels, fused (no W array) and blocked so that the
+  // small levels run in cache: levels 1..10 in blocks of 16 Ki samples, 11..14
+  // in blocks of 64 Ki, the rest unblocked over the whole series.
+  std::vector<long double> ss(J, 0.0L);
+  std::vector<double> b1, b2;
+  std::unique_ptr<double[]> va(new double[n]), vb(new double[n]);  // no zero fill
+  const double* in = x;
+  int j = 1;
+  bool useA = true;
+  const std::pair<int, std::size_t> stages[] = {{10, 16384}, {14, 65536}};
+  for (const auto& st : stages) {
+    const int jto = std::min(st.first, J);
+    if (jto < j) continue;
+    double* out = useA ? va.get() : vb.get();
+    pyramidStage(in, out, n, j, jto, st.second, b1, b2, ss);
+    in = out;
+    useA = !useA;
+    j = jto + 1;
+  }
+  // Remaining large levels: one streaming pass each, ping-pong between va and vb;
+  // in[i] = V_{j-1, 2^{j-1} - 1 + i}.
+  for (; j <= J; ++j) {
+    const std::size_t s = std::size_t{1} << (j - 1);
+    const std::size_t m = n - 2 * s + 1;
+    double* out = useA ? va.get() : vb.get();
+    ss[j - 1] += levelStep(in + s, in, out, m, 0);
+    in = out;
+    useA = !useA;
+  }
+  return ss;
+}
+
 }  // namespace detail
 
 Eigen::VectorXd WaveletVariance::weights() const {
@@ -130,15 +234,16 @@ WaveletVariance waveletVariance(const double* x, std::size_t n, double rate_hz, 
   r.rate_hz = rate_hz;
   r.n = n;
   r.robust = false;
-  detail::haarModwtLevels(x, n, J, [&](int j, const double* w, std::size_t m) {
-    const double tau = std::ldexp(1.0, j);
-    const int i = j - 1;
+  const std::vector<long double> ss = detail::haarModwtSumSquares(x, n, J);
+  for (int i = 0; i < J; ++i) {
+    const double tau = std::ldexp(1.0, i + 1);
+    const double m = static_cast<double>(n) - tau + 1.0;  // M_j
     r.tau[i] = tau;
-    r.n_coef[i] = static_cast<double>(m);
-    r.wv[i] = detail::sumSquares(w, m) / static_cast<double>(m);
-    r.eta[i] = std::max(static_cast<double>(m) / tau, 1.0);  // eta3
+    r.n_coef[i] = m;
+    r.wv[i] = static_cast<double>(ss[i] / static_cast<long double>(m));
+    r.eta[i] = std::max(m / tau, 1.0);  // eta3
     wvConfidenceInterval(r.wv[i], r.eta[i], alpha, r.ci_low[i], r.ci_high[i]);
-  });
+  }
   return r;
 }
 

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <vector>
 
 namespace navimpact::gmwm::detail {
 
@@ -20,6 +21,12 @@ double sumSquares(const double* w, std::size_t m);
  * asymptotic Gaussian efficiency @p eff in (0, 1). Returns 0 when all values are equal.
  */
 double robustScale(const double* w, std::size_t m, double eff);
+
+/**
+ * Sums of squares of the kept Haar MODWT coefficients of levels 1..J
+ * (element j-1 for level j), computed cache-blocked without storing W.
+ */
+std::vector<long double> haarModwtSumSquares(const double* x, std::size_t n, int J);
 
 /**
  * Haar MODWT pyramid, levels 1..J; calls onLevel(j, W_j, M_j) with the M_j =
