@@ -226,7 +226,29 @@ void ErrorStateEkf::accumulate(const Transition& T) {
     D_acc_ = T.D;
     Q_acc_ = T.Q;
   } else {
-    // Phi_acc <- Phi_k Phi_acc (structure kept); Q_acc <- Q_acc + Q_k
+    // Q_acc <- Phi_k Q_acc Phi_k' + Q_k, exact and cheap because the IMU block
+    // of Q_acc stays block-diagonal (Groves 3.46 applied to the noise alone):
+    const int m = layout_.imuSize();
+    const Matrix9d Qnn = Q_acc_.topLeftCorner<9, 9>();
+    const MatrixXd Qni = Q_acc_.topRightCorner(9, m);
+    MatrixXd Qii = Q_acc_.bottomRightCorner(m, m);
+    MatrixXd BQ(9, m);  // B_k Qii, block by block
+    for (const ProcessBlock& b : blocks) {
+      const int o = b.offset - kNav, n = b.ss.n;
+      BQ.middleCols(o, n) = T.B.middleCols(o, n) * Qii.block(o, o, n, n);
+    }
+    MatrixXd M = T.A * Qni + BQ;
+    Matrix9d Qnn1 = (T.A * Qnn + T.B * Qni.transpose()) * T.A.transpose();
+    Qnn1.noalias() += M * T.B.transpose();
+    rightMulDt(M, T.D, blocks);
+    leftMulD(Qii, T.D, blocks);
+    rightMulDt(Qii, T.D, blocks);
+    Q_acc_.topLeftCorner<9, 9>() = Qnn1;
+    Q_acc_.topRightCorner(9, m) = M;
+    Q_acc_.bottomLeftCorner(m, 9) = M.transpose();
+    Q_acc_.bottomRightCorner(m, m) = Qii;
+    Q_acc_ += T.Q;
+    // Phi_acc <- Phi_k Phi_acc (structure kept)
     MatrixXd BD = T.B;
     rightMulDt(BD, D_acc_.transpose(), blocks);  // B_k D_acc
     B_acc_ = T.A * B_acc_ + BD;
@@ -234,7 +256,6 @@ void ErrorStateEkf::accumulate(const Transition& T) {
     MatrixXd Dn = D_acc_;
     leftMulD(Dn, T.D, blocks);
     D_acc_ = Dn;
-    Q_acc_ += T.Q;
   }
   ++pending_;
   if (pending_ >= cfg_.propagate_every) applyTransition();
@@ -392,9 +413,15 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
     cache_->nominal_valid = false;
   }
   checkP("update");
-  Eigen::LDLT<MatrixXd> ldlt(P_);
-  if (ldlt.info() != Eigen::Success ||
-      (ldlt.vectorD().array() < -1e-9 * (1.0 + P_.diagonal().cwiseAbs().maxCoeff())).any())
+  // Positive (semi-)definiteness on the correlation scale, so that states with
+  // tiny variances (1e-14) are judged as strictly as the metre-level ones.
+  const VectorXd d = P_.diagonal();
+  VectorXd inv = VectorXd::Ones(d.size());
+  for (int i = 0; i < d.size(); ++i)
+    if (d(i) > 0.0) inv(i) = 1.0 / std::sqrt(d(i));
+  const MatrixXd Pc = inv.asDiagonal() * P_ * inv.asDiagonal();
+  Eigen::LDLT<MatrixXd> ldlt(Pc);
+  if ((ldlt.vectorD().array() < -1e-9).any() || !ldlt.vectorD().allFinite())
     throw Error("filter covariance is not positive definite at t = " + tstr(res.t) +
                 " s after update");
   last_ = res;

@@ -51,7 +51,8 @@ Discretization parseDiscretization(const std::string& s);
 struct EkfConfig {
   Discretization discretization = Discretization::Series;
   /// Propagate the covariance every k IMU samples (k >= 1) with the product of
-  /// the k transitions and the summed process noise; pending propagation is
+  /// the k transitions and the accumulated process noise (Q_acc <- Phi Q_acc Phi' + Q,
+  /// cheap because its IMU block stays block-diagonal); pending propagation is
   /// always flushed before an update and on request.
   int propagate_every = 1;
   /// Chi-square innovation gate: reject when NIS > quantile(gate_probability, m).
