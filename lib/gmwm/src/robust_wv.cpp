@@ -81,11 +81,15 @@ double scaleEquation(const double* x, std::size_t m, double t, double c, double 
 namespace detail {
 
 double robustScale(const double* w, std::size_t m, double eff) {
-  if (m < 2) throw Error("robust scale: needs at least 2 values");
   if (!(eff > 0.0 && eff < 1.0))
     throw Error("robust wavelet variance: efficiency must be in (0, 1), got " + std::to_string(eff));
   const double c = biweightConstant(eff);
-  const double a = consistencyA(c);
+  return robustScale(w, m, c, consistencyA(c));
+}
+
+double robustScale(const double* w, std::size_t m, double c, double a) {
+  if (m == 0) throw Error("robust scale: no values");
+  if (m == 1) return w[0] * w[0];  // a single coefficient: nothing to down-weight
   // Classical variance (two-pass) to standardise.
   long double mean = 0;
   for (std::size_t i = 0; i < m; ++i) mean += w[i];
@@ -97,35 +101,42 @@ double robustScale(const double* w, std::size_t m, double eff) {
   const double sd = std::sqrt(var);
   std::vector<double> x(m);
   for (std::size_t i = 0; i < m; ++i) x[i] = w[i] / sd;
-  // In r = t x, f(t) = mean chi(t x) vanishes at t -> 0 and t -> inf and is
-  // unimodal for any reasonable sample; the M-scale is the root on the
-  // decreasing branch (largest t with f(t) = a, i.e. smallest sigma).
+  // In r = t x, f(t) = mean chi(t x) vanishes at t -> 0 and t -> inf and, for
+  // any reasonable sample, rises to one maximum and falls again; f = a has two
+  // roots. At the normal the consistent one is t = 1 on the rising branch
+  // (chi peaks at |r| = c / sqrt(5), beyond the bulk of the data for the usual
+  // c ~ 4), so the M-scale is the smallest root: the first crossing of a from
+  // below as t grows. Bracket it with g(lo) < 0 <= g(hi).
   auto g = [&](double t) { return scaleEquation(x.data(), m, t, c, a); };
   const auto noRoot = []() {
     return Error("robust wavelet variance: the biweight scale equation has no root (too many "
                  "identical wavelet coefficients?)");
   };
-  double lo = 1.0, hi = 1.0;  // bracket with g(lo) >= 0 > g(hi), lo < hi
+  double lo = 1.0, hi = 1.0;
   const double g1 = g(1.0);
-  if (g1 < 0.0 && g(1.01) <= g1) {
-    // Right of the maximum: the root lies at smaller t.
-    for (int k = 0; g(lo) < 0.0; ++k) {
-      hi = lo;
-      lo *= 0.5;
-      if (k > 100) throw noRoot();
-    }
-  } else {
-    // Left of the maximum (g rising) or between the roots: move to larger t
-    // until g >= 0, then on until it drops below 0 again.
-    for (int k = 0; g(lo) < 0.0; ++k) {
-      lo *= 2.0;
-      if (k > 100) throw noRoot();
-    }
-    hi = 2.0 * lo;
-    for (int k = 0; g(hi) >= 0.0; ++k) {
+  int k = 0;
+  if (g1 < 0.0 && g(1.01) > g1) {
+    // Rising branch, below the root: move right.
+    hi = 2.0;
+    while (g(hi) < 0.0) {
       lo = hi;
       hi *= 2.0;
-      if (k > 100) throw noRoot();
+      if (++k > 100) throw noRoot();
+    }
+  } else {
+    if (g1 < 0.0) {
+      // Falling branch beyond the maximum: move left into the bump first.
+      while (g(hi) < 0.0) {
+        hi *= 0.5;
+        if (++k > 100) throw noRoot();
+      }
+    }
+    // Now g(hi) >= 0: move left until below the first root.
+    lo = 0.5 * hi;
+    while (g(lo) >= 0.0) {
+      hi = lo;
+      lo *= 0.5;
+      if (++k > 200) throw noRoot();
     }
   }
   boost::uintmax_t it = 100;
@@ -154,6 +165,8 @@ WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rat
   r.n = n;
   r.robust = true;
   const double inflate = 1.0 / std::sqrt(eff);
+  const double c = biweightConstant(eff);
+  const double a = consistencyA(c);
   double min_low = std::numeric_limits<double>::infinity();
   detail::haarModwtLevels(x, n, J, [&](int j, const double* w, std::size_t m) {
     const int i = j - 1;
@@ -161,7 +174,7 @@ WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rat
     r.tau[i] = tau;
     r.n_coef[i] = static_cast<double>(m);
     r.eta[i] = std::max(static_cast<double>(m) / tau, 1.0);
-    const double nu = detail::robustScale(w, m, eff);
+    const double nu = detail::robustScale(w, m, c, a);
     r.wv[i] = nu;
     // gmwm_formulas.md §2 (ci_eta3_robust): the classical relative half-widths,
     // inflated by 1/sqrt(eff), around the robust estimate.

@@ -18,9 +18,13 @@ double sumSquares(const double* w, std::size_t m);
 
 /**
  * Tukey-biweight M-estimate of the variance of @p m values (not centred) at
- * asymptotic Gaussian efficiency @p eff in (0, 1). Returns 0 when all values are equal.
+ * asymptotic Gaussian efficiency @p eff in (0, 1). Returns 0 when all values are equal,
+ * w[0]^2 for a single value.
  */
 double robustScale(const double* w, std::size_t m, double eff);
+
+/// Same with the biweight constant @p c and its consistency constant @p a = E[chi(Z)].
+double robustScale(const double* w, std::size_t m, double c, double a);
 
 /**
  * Sums of squares of the kept Haar MODWT coefficients of levels 1..J
