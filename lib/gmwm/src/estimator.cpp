@@ -231,6 +231,9 @@ double solve(const Layout& L, Eigen::VectorXd& th, const Data& d, const Eigen::V
   so.gradient_tolerance = 1e-14;
   so.parameter_tolerance = 1e-12;
   so.logging_type = ceres::SILENT;
+  // Bound-constrained steps use a projected line search; bisection avoids
+  // polynomial interpolation (and its warnings) on flat directions.
+  so.line_search_interpolation_type = ceres::BISECTION;
   so.minimizer_progress_to_stdout = false;
   so.num_threads = 1;
   ceres::Solver::Summary sum;
@@ -250,8 +253,7 @@ Eigen::VectorXd unitProfile(const Layout& L, int i, const Eigen::VectorXd& th, c
 
 /**
  * Non-negative least squares for the amplitudes (variances) a >= 0 of the
- * columns of P: min || diag(w) (nu_hat - P a) ||^2. Exact by enumeration of
- * the active sets for up to 7 columns, greedy (drop the most negative) above.
+ * columns of P: min || diag(w) (nu_hat - P a) ||^2 (Lawson-Hanson active set).
  * Zero amplitudes become negligible ones (at most 1e-3 of nu_hat at any scale).
  * Writes log amplitudes (0.5 log a) into th; returns the criterion.
  */
@@ -269,10 +271,11 @@ double nnlsAmplitudes(const Layout& L, Eigen::VectorXd& th, const Data& d, const
   const Eigen::MatrixXd G = A.transpose() * A;
   const Eigen::VectorXd b = A.transpose() * y;
   const double yy = y.squaredNorm();
-  auto solveSubset = [&](unsigned mask, Eigen::VectorXd& a) -> bool {
+  // Lawson & Hanson (1974) active-set NNLS on the normal equations (m <= 10 columns).
+  auto solvePassive = [&](const std::vector<bool>& P, Eigen::VectorXd& z) {
     std::vector<int> idx;
     for (int i = 0; i < m; ++i)
-      if (mask & (1u << i)) idx.push_back(i);
+      if (P[i]) idx.push_back(i);
     const int s = static_cast<int>(idx.size());
     Eigen::MatrixXd Gs(s, s);
     Eigen::VectorXd bs(s);
@@ -281,45 +284,40 @@ double nnlsAmplitudes(const Layout& L, Eigen::VectorXd& th, const Data& d, const
       for (int c = 0; c < s; ++c) Gs(r, c) = G(idx[r], idx[c]);
     }
     Gs.diagonal().array() += 1e-12;
-    const Eigen::VectorXd as = Gs.ldlt().solve(bs);
-    a.setZero(m);
-    bool feasible = true;
-    for (int r = 0; r < s; ++r) {
-      a[idx[r]] = as[r];
-      if (!(as[r] >= 0.0)) feasible = false;
-    }
-    return feasible;
+    const Eigen::VectorXd zs = Gs.ldlt().solve(bs);
+    z.setZero(m);
+    for (int r = 0; r < s; ++r) z[idx[r]] = zs[r];
   };
-  auto value = [&](const Eigen::VectorXd& a) { return yy - 2.0 * a.dot(b) + a.dot(G * a); };
-  Eigen::VectorXd best = Eigen::VectorXd::Zero(m), a;
-  double best_v = yy;
-  const unsigned full = (1u << m) - 1u;
-  if (solveSubset(full, a)) {
-    best = a;
-    best_v = value(a);
-  } else if (m <= 7) {
-    for (unsigned mask = 1; mask < full; ++mask)
-      if (solveSubset(mask, a)) {
-        const double v = value(a);
-        if (v < best_v) {
-          best_v = v;
-          best = a;
-        }
-      }
-  } else {
-    unsigned mask = full;
-    while (mask) {
-      if (solveSubset(mask, a)) {
-        best = a;
-        best_v = value(a);
+  Eigen::VectorXd best = Eigen::VectorXd::Zero(m), z;
+  std::vector<bool> P(m, false);
+  for (int outer = 0; outer < 3 * m + 3; ++outer) {
+    const Eigen::VectorXd grad = b - G * best;
+    int jmax = -1;
+    for (int i = 0; i < m; ++i)
+      if (!P[i] && grad[i] > 1e-12 * std::sqrt(yy) && (jmax < 0 || grad[i] > grad[jmax])) jmax = i;
+    if (jmax < 0) break;
+    P[jmax] = true;
+    for (int inner = 0; inner < 3 * m + 3; ++inner) {
+      solvePassive(P, z);
+      bool ok = true;
+      for (int i = 0; i < m; ++i)
+        if (P[i] && !(z[i] > 0.0)) ok = false;
+      if (ok) {
+        best = z;
         break;
       }
-      int worst = -1;
+      double alpha = 1.0;
       for (int i = 0; i < m; ++i)
-        if ((mask & (1u << i)) && (worst < 0 || a[i] < a[worst])) worst = i;
-      mask &= ~(1u << worst);
+        if (P[i] && !(z[i] > 0.0)) alpha = std::min(alpha, best[i] / (best[i] - z[i]));
+      best += alpha * (z - best);
+      for (int i = 0; i < m; ++i)
+        if (P[i] && best[i] <= 1e-300) {
+          P[i] = false;
+          best[i] = 0.0;
+        }
     }
   }
+  const double best_v = yy - 2.0 * best.dot(b) + best.dot(G * best);
   for (int i = 0; i < m; ++i) {
     double amp = best[i] / scale[i];  // variance-like amplitude
     if (!(amp > 0.0)) {
@@ -635,7 +633,6 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
     // recompute the WV, refit from theta_hat; percentile interval.
     const std::size_t n = wv.n;
     if (n < 4) throw Error("GMWM bootstrap: the wavelet variance does not record its sample count");
-#ifdef NAVIMPACT_FIT_HAVE_SIMULATE
     std::vector<Eigen::VectorXd> reps;
     for (int b = 0; b < opt.bootstrap; ++b) {
       const std::vector<double> x =
@@ -647,10 +644,6 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
       sortTerms(L, t);
       reps.push_back(t);
     }
-#else
-    throw Error("GMWM bootstrap: stochastic::simulate is not built yet");
-    std::vector<Eigen::VectorXd> reps;
-#endif
     for (int k = 0; k < p; ++k) {
       std::vector<double> v;
       for (auto& t : reps) v.push_back(t[k]);

@@ -151,9 +151,17 @@ std::vector<RankedModel> selectModel(const std::vector<std::vector<ProcessKind>>
   if (out.empty())
     throw Error("model selection: every candidate has more parameters than the " +
                 std::to_string(wv.scales()) + " scales of the wavelet variance");
-  std::stable_sort(out.begin(), out.end(), [](const RankedModel& a, const RankedModel& b) {
-    if (a.criterion != b.criterion) return a.criterion < b.criterion;
-    return a.fit.model.terms.size() < b.fit.model.terms.size();
+  // Rank by criterion; criteria equal to 1e-9 (relative to the smallest) are
+  // ties, broken by fewer parameters: a negligible extra term (e.g. a DR that
+  // stayed at 1e-3 of the WV) adds neither objective nor optimism.
+  double cmin = out.front().criterion;
+  for (const auto& r : out) cmin = std::min(cmin, r.criterion);
+  const double tol = 1e-9 * std::max(std::fabs(cmin), 1e-300);
+  auto key = [&](const RankedModel& r) { return std::floor((r.criterion - cmin) / tol + 0.5); };
+  std::stable_sort(out.begin(), out.end(), [&](const RankedModel& a, const RankedModel& b) {
+    const double ka = key(a), kb = key(b);
+    if (ka != kb) return ka < kb;
+    return parameterCount(kindsOf(a.fit.model)) < parameterCount(kindsOf(b.fit.model));
   });
   if (opt.bootstrap > 0) {
     // Bootstrap intervals for the selected model only.
