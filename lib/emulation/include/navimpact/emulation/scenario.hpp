@@ -1,0 +1,79 @@
+/**
+ * @file scenario.hpp
+ * @brief An emulation scenario from a YAML configuration, and its run:
+ *        trajectory -> smooth truth -> perfect IMU -> IMU errors -> GNSS,
+ *        barometer and ground truth records.
+ *
+ * Configuration keys (units in the names or stated; relative paths are
+ * resolved against the configuration file's folder):
+ * @code
+ * trajectory:
+ *   file: ../../datasets/uav_flight_260s.csv.gz
+ *   system: geodetic            # geodetic (lat, lon, h) | ned (tangent-plane NED metres)
+ *   columns: {time: time_s, lat: lat_rad, lon: lon_rad, height: alt_m,
+ *             north: x_N_m, east: x_E_m, down: x_D_m,
+ *             roll: roll_rad, pitch: pitch_rad, yaw: yaw_rad}
+ *   latlon_unit: rad            # rad | deg
+ *   attitude_unit: rad          # rad | deg
+ *   time_unit: s                # s | ms
+ *   origin: {lat_deg: 46.5, lon_deg: 6.5, height_m: 400}   # required for ned
+ *   max_gap_s: 0.25             # largest time step bridged [s]
+ *   start_s: 0                  # optional window, file time [s]
+ *   end_s: 260
+ * smoothing: {position_cutoff_hz: 1.0, attitude_cutoff_hz: 1.0, knot_step_s: 0.05, penalty_order: 3}
+ * imu:
+ *   rate_hz: 200                # [Hz]
+ *   errors: model               # model | static | none
+ *   model: ../models/navchip_table1.yaml:ref
+ *   seed: 1
+ *   static: {file: ..., gyro_unit: deg/s, acc_unit: g, rate_hz: 100, axes: "x,y,z",
+ *            offset_s: 100, seed: 7}
+ * gnss: {rate_hz: 1, sigma_pos_h_m: 2, sigma_pos_v_m: 4, sigma_vel_h_mps: 0.05,
+ *        sigma_vel_v_mps: 0.10, lever_arm_B_m: [0, 0, 0], seed: 2}
+ * baro: {rate_hz: 10, sigma_m: 0.5, seed: 3}
+ * ground_truth: {rate_hz: 10}   # [Hz]
+ * output: {start_utc: "2026-01-01T00:00:00Z"}   # timestamp of the first trajectory time
+ * @endcode
+ */
+#pragma once
+
+#include <string>
+
+#include "navimpact/emulation/records.hpp"
+#include "navimpact/emulation/sensors.hpp"
+#include "navimpact/emulation/trajectory.hpp"
+
+namespace navimpact::emulation {
+
+/// A parsed emulation configuration (all paths absolute or relative to the CWD).
+struct EmulationConfig {
+  std::string config_file;          ///< where it came from ("" if built in code)
+  TrajectorySpec trajectory;
+  SmoothingOptions smoothing;
+  double imu_rate_hz = 200.0;       ///< [Hz]
+  std::string imu_errors = "model"; ///< "model", "static" or "none"
+  std::string model_spec;           ///< FILE[:NAME] for "model"
+  std::uint64_t imu_seed = 1;       ///< seed of the simulated IMU errors
+  StaticRecordingSpec static_rec;   ///< for "static"
+  GnssOptions gnss;
+  BaroOptions baro;
+  double truth_rate_hz = 10.0;      ///< ground-truth record rate [Hz]
+  std::string start_utc = "2026-01-01T00:00:00Z";  ///< UTC of the first trajectory time
+};
+
+/**
+ * Read a configuration file.
+ * @throws navimpact::Error naming the file and key for unknown keys, wrong
+ *         types, missing required keys, invalid values.
+ */
+EmulationConfig loadEmulationConfig(const std::string& path);
+
+/**
+ * Run a scenario.
+ * @param[in] cfg      configuration.
+ * @param[in] version  navimpact version string, recorded in the scenario text.
+ * @throws navimpact::Error for any bad input (trajectory, model, recording).
+ */
+EmulationData runEmulation(const EmulationConfig& cfg, const std::string& version);
+
+}  // namespace navimpact::emulation

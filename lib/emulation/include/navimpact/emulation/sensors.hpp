@@ -1,0 +1,116 @@
+/**
+ * @file sensors.hpp
+ * @brief Sensor outputs of an emulation: IMU errors (simulated from a model
+ *        or taken from a measured static recording), GNSS fixes and barometer.
+ *
+ * IMU errors are per-axis sequences in SI rate units (rad/s, m/s^2) at the
+ * IMU rate, added to the mean rates of each interval (increment / dt), i.e.
+ * what an integrating IMU outputs. Axes in kChannelNames order
+ * (gyro_x, gyro_y, gyro_z, acc_x, acc_y, acc_z), body FRD.
+ */
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "navimpact/core/csv_reader.hpp"
+#include "navimpact/emulation/trajectory.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+
+namespace navimpact::emulation {
+
+/// Six error sequences (kChannelNames order) and what was done to make them.
+struct ImuErrors {
+  std::array<std::vector<double>, 6> axis;  ///< SI rate units, one value per IMU sample
+  std::vector<std::string> notices;         ///< human-readable notes (rate conversions, windows)
+  std::string description;                  ///< one line: source and parameters
+};
+
+/**
+ * Simulate IMU errors from a model: axis i uses stochastic::simulate with
+ * stochastic::deriveSeed(seed, i). A model at another rate is converted
+ * exactly to the IMU rate first (stochastic::convertRate) with a notice.
+ * @param[in] model    per-axis composite models.
+ * @param[in] imu_rate_hz  IMU rate [Hz], > 0.
+ * @param[in] n        number of IMU samples.
+ * @param[in] seed     master seed.
+ */
+ImuErrors modelImuErrors(const stochastic::ImuModel& model, double imu_rate_hz, std::size_t n,
+                         std::uint64_t seed);
+
+/// Where to take measured IMU errors from.
+struct StaticRecordingSpec {
+  std::string file;                 ///< CSV of a static recording (navimpact::readImuCsv format)
+  CsvImuOptions csv;                ///< units, rate, axes of that file
+  std::optional<double> offset_s;   ///< start of the window in the recording [s]; unset: from the seed
+  std::uint64_t seed = 0;           ///< picks the window start uniformly when offset_s is unset
+};
+
+/**
+ * Measured IMU errors: a window of a static recording, mean of the window
+ * removed per axis (removes gravity, Earth rate and the turn-on bias of that
+ * window). The recording's rate must equal the IMU rate or be an exact
+ * integer multiple of it; then blocks of m samples are averaged (what an
+ * integrating IMU at the lower rate would output).
+ * @throws navimpact::Error "static recording is at 100 Hz, emulation at 200 Hz"
+ *         when the rates do not fit, or naming the needed and available
+ *         durations when the recording is too short, or when the offset
+ *         leaves too little.
+ */
+ImuErrors staticImuErrors(const StaticRecordingSpec& spec, double imu_rate_hz, std::size_t n);
+
+/// GNSS receiver options (defaults: Khaghani & Skaloud 2019 Table 2).
+struct GnssOptions {
+  double rate_hz = 1.0;             ///< fix rate [Hz]
+  double sigma_pos_h_m = 2.0;       ///< horizontal position noise, each of N and E [m]
+  double sigma_pos_v_m = 4.0;       ///< vertical position noise [m]
+  double sigma_vel_h_mps = 0.05;    ///< horizontal velocity noise, each axis [m/s]
+  double sigma_vel_v_mps = 0.10;    ///< vertical velocity noise [m/s]
+  Eigen::Vector3d lever_arm_B = Eigen::Vector3d::Zero();  ///< antenna in body FRD from the IMU [m]
+  std::uint64_t seed = 2;           ///< noise seed
+};
+
+/// Barometer options (defaults: Table 2).
+struct BaroOptions {
+  double rate_hz = 10.0;   ///< [Hz]
+  double sigma_m = 0.5;    ///< height noise [m]
+  std::uint64_t seed = 3;  ///< noise seed
+};
+
+/// One GNSS fix: antenna position and velocity with white noise, and its covariance.
+struct GnssFix {
+  double t = 0.0;                 ///< [s]
+  earth::Geodetic pos;            ///< antenna position (noisy)
+  Eigen::Vector3d v_N;            ///< antenna velocity w.r.t. Earth in N (noisy) [m/s]
+  Eigen::Matrix3d cov_pos_N;      ///< position covariance in N [m^2]
+  Eigen::Matrix3d cov_vel_N;      ///< velocity covariance in N [m^2/s^2]
+};
+
+/// One barometer sample: ellipsoidal height with white noise.
+struct BaroSample {
+  double t = 0.0;      ///< [s]
+  double h = 0.0;      ///< height above the ellipsoid [m]
+  double sigma = 0.0;  ///< its standard deviation [m]
+};
+
+/**
+ * GNSS fixes at t_start + k / rate_hz (k = 0, 1, ...) up to t_end. The antenna
+ * is at r_IMU + C_BtoN l_B, moving at v_N + C_BtoN (w_NB_B x l_B) (Groves 2013
+ * eq. 14.121 without the small Earth-rate term of the lever arm).
+ */
+std::vector<GnssFix> simulateGnss(const SmoothTrajectory& tr, const GnssOptions& opt, double t_start,
+                                  double t_end);
+
+/// Barometer samples at t_start + k / rate_hz up to t_end.
+std::vector<BaroSample> simulateBaro(const SmoothTrajectory& tr, const BaroOptions& opt, double t_start,
+                                     double t_end);
+
+/// n independent N(0,1) draws from a seed (stochastic white noise, reproducible).
+std::vector<double> standardNormal(std::size_t n, std::uint64_t seed);
+
+}  // namespace navimpact::emulation

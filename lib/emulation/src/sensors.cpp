@@ -1,0 +1,136 @@
+#include "navimpact/emulation/sensors.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/imu_series.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/simulate.hpp"
+
+namespace navimpact::emulation {
+
+namespace {
+std::string num(double x) {
+  std::ostringstream o;
+  o << x;
+  return o.str();
+}
+}  // namespace
+
+std::vector<double> standardNormal(std::size_t n, std::uint64_t seed) {
+  stochastic::Model wn;
+  wn.rate_hz = 1.0;
+  wn.terms.push_back(stochastic::Process::wn(1.0));
+  return stochastic::simulate(wn, n, seed);
+}
+
+ImuErrors modelImuErrors(const stochastic::ImuModel& model, double imu_rate_hz, std::size_t n,
+                         std::uint64_t seed) {
+  ImuErrors e;
+  stochastic::ImuModel m = model;
+  if (std::abs(m.rate_hz - imu_rate_hz) > 1e-9 * imu_rate_hz) {
+    e.notices.push_back("IMU error model '" + model.source + "' is given at " + num(model.rate_hz) +
+                        " Hz; converted exactly to the IMU rate " + num(imu_rate_hz) + " Hz");
+    m = stochastic::convertRate(model, imu_rate_hz);
+  }
+  for (std::size_t i = 0; i < 6; ++i) {
+    e.axis[i].assign(n, 0.0);
+    if (!m.axis[i].empty()) stochastic::simulateAdd(m.axis[i], stochastic::deriveSeed(seed, i), e.axis[i].data(), n);
+  }
+  e.description = "simulated from model " + model.source + " at " + num(imu_rate_hz) + " Hz, seed " +
+                  std::to_string(seed) + " (axis i: deriveSeed(seed, i))";
+  return e;
+}
+
+ImuErrors staticImuErrors(const StaticRecordingSpec& spec, double imu_rate_hz, std::size_t n) {
+  const ImuSeries rec = readImuCsv(spec.file, spec.csv);
+  const double ratio = rec.rate_hz / imu_rate_hz;
+  const double m_real = std::round(ratio);
+  if (m_real < 1.0 || std::abs(ratio - m_real) > 1e-6 * ratio)
+    throw Error(spec.file + ": static recording is at " + num(rec.rate_hz) + " Hz, emulation at " +
+                num(imu_rate_hz) + " Hz (the recording's rate must equal the IMU rate or be an exact integer multiple of it)");
+  const std::size_t m = static_cast<std::size_t>(m_real);
+  const std::size_t need = n * m, have = rec.size();
+  if (need > have)
+    throw Error(spec.file + ": static recording too short: " + num(have / rec.rate_hz) + " s available, " +
+                num(need / rec.rate_hz) + " s needed for " + std::to_string(n) + " IMU samples");
+  std::size_t start = 0;
+  ImuErrors e;
+  if (spec.offset_s) {
+    if (*spec.offset_s < 0.0) throw Error(spec.file + ": static recording offset must be >= 0 s");
+    start = static_cast<std::size_t>(std::llround(*spec.offset_s * rec.rate_hz));
+    if (start + need > have)
+      throw Error(spec.file + ": offset " + num(*spec.offset_s) + " s leaves " +
+                  num((have > start ? have - start : 0) / rec.rate_hz) + " s of the recording, " +
+                  num(need / rec.rate_hz) + " s needed");
+  } else {
+    const std::uint64_t r = stochastic::deriveSeed(spec.seed, 0);
+    start = static_cast<std::size_t>(r % (have - need + 1));
+    e.notices.push_back("static recording window chosen by seed " + std::to_string(spec.seed) + ": offset " +
+                        num(start / rec.rate_hz) + " s");
+  }
+  if (m > 1)
+    e.notices.push_back("static recording at " + num(rec.rate_hz) + " Hz decimated by " + std::to_string(m) +
+                        " (block means) to the IMU rate " + num(imu_rate_hz) + " Hz");
+  for (std::size_t i = 0; i < 6; ++i) {
+    auto& out = e.axis[i];
+    out.assign(n, 0.0);
+    if (!rec.has(kChannelNames[i])) {
+      e.notices.push_back(std::string("static recording has no ") + kChannelNames[i] + ": no error on that axis");
+      continue;
+    }
+    const auto& x = rec.channel(kChannelNames[i]).x;
+    double mean = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      double s = 0.0;
+      for (std::size_t j = 0; j < m; ++j) s += x[start + k * m + j];
+      out[k] = s / double(m);
+      mean += out[k];
+    }
+    mean /= double(n);
+    for (auto& v : out) v -= mean;
+  }
+  e.description = "measured static recording " + spec.file + ", window from " + num(start / rec.rate_hz) +
+                  " s, mean removed per axis";
+  return e;
+}
+
+std::vector<GnssFix> simulateGnss(const SmoothTrajectory& tr, const GnssOptions& opt, double t_start,
+                                  double t_end) {
+  if (!(opt.rate_hz > 0.0)) throw Error("gnss.rate_hz must be > 0");
+  const auto n = static_cast<std::size_t>(std::floor((t_end - t_start) * opt.rate_hz + 1e-9)) + 1;
+  const auto z = standardNormal(6 * n, opt.seed);
+  std::vector<GnssFix> out(n);
+  const Eigen::Vector3d sp(opt.sigma_pos_h_m, opt.sigma_pos_h_m, opt.sigma_pos_v_m);
+  const Eigen::Vector3d sv(opt.sigma_vel_h_mps, opt.sigma_vel_h_mps, opt.sigma_vel_v_mps);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = t_start + double(k) / opt.rate_hz;
+    const TruthState s = tr.at(t);
+    GnssFix& f = out[k];
+    f.t = t;
+    const Eigen::Vector3d lever_N = s.C_BtoN * opt.lever_arm_B;
+    const Eigen::Vector3d dpos_N = lever_N + sp.cwiseProduct(Eigen::Vector3d(z[6 * k], z[6 * k + 1], z[6 * k + 2]));
+    f.pos = earth::nedToGeodetic(s.pos, dpos_N);
+    f.v_N = s.v_N + s.C_BtoN * s.w_NB_B.cross(opt.lever_arm_B) +
+            sv.cwiseProduct(Eigen::Vector3d(z[6 * k + 3], z[6 * k + 4], z[6 * k + 5]));
+    f.cov_pos_N = sp.cwiseAbs2().asDiagonal();
+    f.cov_vel_N = sv.cwiseAbs2().asDiagonal();
+  }
+  return out;
+}
+
+std::vector<BaroSample> simulateBaro(const SmoothTrajectory& tr, const BaroOptions& opt, double t_start,
+                                     double t_end) {
+  if (!(opt.rate_hz > 0.0)) throw Error("baro.rate_hz must be > 0");
+  const auto n = static_cast<std::size_t>(std::floor((t_end - t_start) * opt.rate_hz + 1e-9)) + 1;
+  const auto z = standardNormal(n, opt.seed);
+  std::vector<BaroSample> out(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = t_start + double(k) / opt.rate_hz;
+    out[k] = {t, tr.at(t).pos.h + opt.sigma_m * z[k], opt.sigma_m};
+  }
+  return out;
+}
+
+}  // namespace navimpact::emulation

@@ -1,0 +1,317 @@
+// Rawlog writer and event reader for emulations (see writer.hpp).
+#include "navimpact/rawlog/writer.hpp"
+
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CObservationComment.h>
+#include <mrpt/obs/CObservationGPS.h>
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/serialization/CArchive.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "navimpact/core/error.hpp"
+
+namespace navimpact::rawlog {
+
+using mrpt::obs::CObservationIMU;
+namespace gnss = mrpt::obs::gnss;
+
+namespace {
+
+constexpr double kTick = 1e-7;  // MRPT Clock resolution [s]
+
+mrpt::Clock::time_point stamp(long long startUnix, double tRel) {
+  const auto base = mrpt::Clock::fromDouble(static_cast<double>(startUnix));
+  return base + mrpt::Clock::duration(std::llround(tRel / kTick));
+}
+
+double seconds(const mrpt::Clock::time_point& ts, long long startUnix) {
+  const auto base = mrpt::Clock::fromDouble(static_cast<double>(startUnix));
+  return static_cast<double>((ts - base).count()) * kTick;
+}
+
+struct Entry {
+  double t;
+  int order;  // tie-break: GT 0, IMU 1, BARO 2, GNSS 3
+  std::size_t index;
+};
+
+Eigen::Matrix4f cov4(const Eigen::Matrix3d& c) {
+  Eigen::Matrix4f m = Eigen::Matrix4f::Zero();
+  m.topLeftCorner<3, 3>() = c.cast<float>();
+  return m;
+}
+
+}  // namespace
+
+void writeRawlog(const std::string& path, const emulation::EmulationData& d, const RawlogWriteOptions& opt) {
+  mrpt::io::CFileGZOutputStream out;
+  if (!out.open(path, opt.gzip ? std::clamp(opt.gzip_level, 1, 9) : 0))
+    throw Error(path + ": cannot open the rawlog for writing");
+  auto arch = mrpt::serialization::archiveFrom(out);
+  const long long su = d.start_unix_s;
+  auto rel = [&](double t) { return t - d.t_start_s; };
+
+  {
+    mrpt::obs::CObservationComment c;
+    c.sensorLabel = "SCENARIO";
+    c.timestamp = stamp(su, 0.0);
+    c.text = d.scenario_yaml;
+    arch << c;
+  }
+  std::vector<Entry> order;
+  order.reserve(d.imu.size() + d.gnss.size() + d.baro.size() + d.truth.size());
+  for (std::size_t i = 0; i < d.truth.size(); ++i) order.push_back({d.truth[i].t, 0, i});
+  for (std::size_t i = 0; i < d.imu.size(); ++i) order.push_back({d.imu[i].t, 1, i});
+  for (std::size_t i = 0; i < d.baro.size(); ++i) order.push_back({d.baro[i].t, 2, i});
+  for (std::size_t i = 0; i < d.gnss.size(); ++i) order.push_back({d.gnss[i].t, 3, i});
+  std::stable_sort(order.begin(), order.end(), [](const Entry& a, const Entry& b) {
+    const auto ta = std::llround(a.t / kTick), tb = std::llround(b.t / kTick);
+    return ta != tb ? ta < tb : a.order < b.order;
+  });
+
+  CObservationIMU imu, baro, gt;
+  imu.sensorLabel = "IMU";
+  baro.sensorLabel = "BARO";
+  gt.sensorLabel = "GT";
+  mrpt::obs::CObservationGPS gps;
+  gps.sensorLabel = "GNSS";
+  gps.has_satellite_timestamp = false;
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  (void)zero;
+  for (const Entry& e : order) {
+    const auto ts = stamp(su, rel(e.t));
+    if (e.order == 1) {
+      const auto& r = d.imu[e.index];
+      imu.timestamp = ts;
+      imu.set(mrpt::obs::IMU_WX, r.w_IB_B[0]);
+      imu.set(mrpt::obs::IMU_WY, r.w_IB_B[1]);
+      imu.set(mrpt::obs::IMU_WZ, r.w_IB_B[2]);
+      imu.set(mrpt::obs::IMU_X_ACC, r.f_B[0]);
+      imu.set(mrpt::obs::IMU_Y_ACC, r.f_B[1]);
+      imu.set(mrpt::obs::IMU_Z_ACC, r.f_B[2]);
+      arch << imu;
+    } else if (e.order == 2) {
+      baro.timestamp = ts;
+      baro.set(mrpt::obs::IMU_ALTITUDE, d.baro[e.index].h);
+      arch << baro;
+    } else if (e.order == 0) {
+      const auto& r = d.truth[e.index];
+      gt.timestamp = ts;
+      gt.set(mrpt::obs::IMU_X, r.p_L[0]);
+      gt.set(mrpt::obs::IMU_Y, r.p_L[1]);
+      gt.set(mrpt::obs::IMU_Z, r.p_L[2]);
+      gt.set(mrpt::obs::IMU_X_VEL, r.v_N[0]);
+      gt.set(mrpt::obs::IMU_Y_VEL, r.v_N[1]);
+      gt.set(mrpt::obs::IMU_Z_VEL, r.v_N[2]);
+      gt.set(mrpt::obs::IMU_ORI_QUAT_X, r.q_BtoN.x());
+      gt.set(mrpt::obs::IMU_ORI_QUAT_Y, r.q_BtoN.y());
+      gt.set(mrpt::obs::IMU_ORI_QUAT_Z, r.q_BtoN.z());
+      gt.set(mrpt::obs::IMU_ORI_QUAT_W, r.q_BtoN.w());
+      arch << gt;
+    } else {
+      const auto& f = d.gnss[e.index];
+      gps.timestamp = ts;
+      gps.originalReceivedTimestamp = ts;
+      gps.messages.clear();
+      const double tu = static_cast<double>(su) + rel(e.t);
+      const double daySec = std::fmod(tu, 86400.0);
+      gnss::Message_NMEA_GGA gga;
+      gga.fields.UTCTime.hour = static_cast<uint8_t>(daySec / 3600.0);
+      gga.fields.UTCTime.minute = static_cast<uint8_t>(std::fmod(daySec, 3600.0) / 60.0);
+      gga.fields.UTCTime.sec = std::fmod(daySec, 60.0);
+      gga.fields.latitude_degrees = f.pos.lat * 180.0 / M_PI;
+      gga.fields.longitude_degrees = f.pos.lon * 180.0 / M_PI;
+      gga.fields.fix_quality = 1;
+      gga.fields.altitude_meters = f.pos.h;
+      gga.fields.geoidal_distance = 0.0;
+      gga.fields.orthometric_altitude = f.pos.h;
+      gga.fields.corrected_orthometric_altitude = f.pos.h;
+      gga.fields.satellitesUsed = 10;
+      gga.fields.thereis_HDOP = true;
+      gga.fields.HDOP = 1.0f;
+      gps.setMsg(gga);
+      gnss::Message_TOPCON_PZS pzs;
+      pzs.latitude_degrees = gga.fields.latitude_degrees;
+      pzs.longitude_degrees = gga.fields.longitude_degrees;
+      pzs.height_meters = f.pos.h;
+      pzs.RTK_height_meters = f.pos.h;
+      pzs.PSigma = static_cast<float>(std::sqrt(f.cov_pos_N.trace()));
+      pzs.Fix = 1;
+      const Eigen::Matrix3d C_NtoE = earth::C_EtoN(f.pos.lat, f.pos.lon).transpose();
+      const Eigen::Vector3d r_E = earth::geodeticToEcef(f.pos);
+      const Eigen::Vector3d v_E = C_NtoE * f.v_N;
+      pzs.hasCartesianPosVel = true;
+      pzs.cartesian_x = r_E[0];
+      pzs.cartesian_y = r_E[1];
+      pzs.cartesian_z = r_E[2];
+      pzs.cartesian_vx = v_E[0];
+      pzs.cartesian_vy = v_E[1];
+      pzs.cartesian_vz = v_E[2];
+      pzs.hasPosCov = true;
+      pzs.pos_covariance = mrpt::math::CMatrixFloat44(cov4(C_NtoE * f.cov_pos_N * C_NtoE.transpose()));
+      pzs.hasVelCov = true;
+      pzs.vel_covariance = mrpt::math::CMatrixFloat44(cov4(C_NtoE * f.cov_vel_N * C_NtoE.transpose()));
+      gps.setMsg(pzs);
+      arch << gps;
+    }
+  }
+  out.close();
+  if (!std::filesystem::exists(path)) throw Error(path + ": rawlog was not written");
+}
+
+emulation::EmulationData readRawlog(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw Error(path + ": rawlog not found");
+  mrpt::io::CFileGZInputStream in;
+  if (!in.open(path)) throw Error(path + ": cannot open the rawlog");
+  auto arch = mrpt::serialization::archiveFrom(in);
+  emulation::EmulationData d;
+  bool haveComment = false, haveOrigin = false, haveBase = false;
+  mrpt::Clock::time_point base{};
+  std::size_t entry = 0, skipped = 0;
+  double lastT = -1e300;
+  std::string lastLabel;
+  std::vector<mrpt::Clock::time_point> pendingGt;  // unused: GT requires the comment first
+  earth::Geodetic origin;
+  Eigen::Vector3d r0_E = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d C_LtoE = Eigen::Matrix3d::Identity();
+  auto where = [&](const std::string& label, double t) {
+    std::string s = path + ": entry " + std::to_string(entry);
+    if (!label.empty()) s += " (label " + label + (std::isfinite(t) ? ", t = " + std::to_string(t) + " s" : "") + ")";
+    return s;
+  };
+  for (;; ++entry) {
+    mrpt::serialization::CSerializable::Ptr obj;
+    if (in.checkEOF()) break;  // clean end between entries (plain files)
+    const auto pos0 = in.getPosition();
+    try {
+      obj = arch.ReadObject();
+    } catch (const mrpt::serialization::CExceptionEOF&) {
+      if (in.getPosition() == pos0) break;  // clean end (gzip streams see EOF only on reading)
+      throw Error(where("", NAN) + ": truncated entry (the file ends inside it)");
+    } catch (const std::exception& e) {
+      std::string msg = e.what();
+      const auto nl = msg.find('\n');
+      if (nl != std::string::npos) msg = msg.substr(0, nl);
+      throw Error(where("", NAN) + ": malformed or truncated entry (" + msg + ")");
+    }
+    if (!obj) break;
+    if (auto c = std::dynamic_pointer_cast<mrpt::obs::CObservationComment>(obj)) {
+      if (!haveComment) {
+        haveComment = true;
+        d.scenario_yaml = c->text;
+        try {
+          const YAML::Node y = YAML::Load(c->text)["navimpact_scenario"];
+          if (y && y["origin"]) {
+            origin = {y["origin"]["lat_deg"].as<double>() * M_PI / 180, y["origin"]["lon_deg"].as<double>() * M_PI / 180,
+                      y["origin"]["height_m"].as<double>()};
+            haveOrigin = true;
+            r0_E = earth::geodeticToEcef(origin);
+            C_LtoE = earth::C_EtoN(origin.lat, origin.lon).transpose();
+          }
+          if (y && y["time"] && y["time"]["start_unix_s"]) {
+            d.start_unix_s = y["time"]["start_unix_s"].as<long long>();
+            base = mrpt::Clock::fromDouble(static_cast<double>(d.start_unix_s));
+            haveBase = true;
+          }
+          if (y && y["imu"] && y["imu"]["rate_hz"]) d.imu_rate_hz = y["imu"]["rate_hz"].as<double>();
+        } catch (const YAML::Exception& e) {
+          throw Error(where("SCENARIO", NAN) + ": scenario comment is not valid YAML (" + e.msg + ")");
+        }
+      }
+      continue;
+    }
+    auto o = std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj);
+    if (!o) { ++skipped; continue; }
+    const std::string& label = o->sensorLabel;
+    if (!haveBase) {
+      if (label != "IMU") {  // no time base yet: the first IMU sample defines it
+        if (label == "GT" || label == "GNSS" || label == "BARO") {
+          base = o->timestamp;
+          haveBase = true;
+        }
+      } else {
+        base = o->timestamp;
+        haveBase = true;
+      }
+    }
+    const double t = haveBase ? static_cast<double>((o->timestamp - base).count()) * kTick : 0.0;
+    if (t < lastT)
+      throw Error(where(label, t) + ": timestamp goes backwards (previous entry, label " + lastLabel + ", at t = " +
+                  std::to_string(lastT) + " s)");
+    lastT = t;
+    lastLabel = label;
+    if (label == "IMU" || label == "BARO" || label == "GT") {
+      auto m = std::dynamic_pointer_cast<CObservationIMU>(o);
+      if (!m) throw Error(where(label, t) + ": expected a CObservationIMU, found " + o->GetRuntimeClass()->className);
+      auto need = [&](mrpt::obs::TIMUDataIndex i, const char* name) {
+        if (!m->has(i)) throw Error(where(label, t) + ": field " + name + " is not set");
+        return m->get(i);
+      };
+      if (label == "IMU") {
+        emulation::ImuRecord r;
+        r.t = t;
+        r.w_IB_B = {need(mrpt::obs::IMU_WX, "IMU_WX"), need(mrpt::obs::IMU_WY, "IMU_WY"), need(mrpt::obs::IMU_WZ, "IMU_WZ")};
+        r.f_B = {need(mrpt::obs::IMU_X_ACC, "IMU_X_ACC"), need(mrpt::obs::IMU_Y_ACC, "IMU_Y_ACC"),
+                 need(mrpt::obs::IMU_Z_ACC, "IMU_Z_ACC")};
+        d.imu.push_back(r);
+      } else if (label == "BARO") {
+        d.baro.push_back({t, need(mrpt::obs::IMU_ALTITUDE, "IMU_ALTITUDE"), NAN});
+      } else {
+        if (!haveOrigin) throw Error(where(label, t) + ": ground truth needs the scenario comment's origin, none found before it");
+        emulation::TruthRecord r;
+        r.t = t;
+        r.p_L = {need(mrpt::obs::IMU_X, "IMU_X"), need(mrpt::obs::IMU_Y, "IMU_Y"), need(mrpt::obs::IMU_Z, "IMU_Z")};
+        r.v_N = {need(mrpt::obs::IMU_X_VEL, "IMU_X_VEL"), need(mrpt::obs::IMU_Y_VEL, "IMU_Y_VEL"),
+                 need(mrpt::obs::IMU_Z_VEL, "IMU_Z_VEL")};
+        r.q_BtoN = Eigen::Quaterniond(need(mrpt::obs::IMU_ORI_QUAT_W, "IMU_ORI_QUAT_W"),
+                                      need(mrpt::obs::IMU_ORI_QUAT_X, "IMU_ORI_QUAT_X"),
+                                      need(mrpt::obs::IMU_ORI_QUAT_Y, "IMU_ORI_QUAT_Y"),
+                                      need(mrpt::obs::IMU_ORI_QUAT_Z, "IMU_ORI_QUAT_Z"));
+        d.truth.push_back(r);
+      }
+    } else if (label == "GNSS") {
+      auto g = std::dynamic_pointer_cast<mrpt::obs::CObservationGPS>(o);
+      if (!g) throw Error(where(label, t) + ": expected a CObservationGPS, found " + o->GetRuntimeClass()->className);
+      emulation::GnssFix f;
+      f.t = t;
+      if (const auto* p = g->getMsgByClassPtr<gnss::Message_TOPCON_PZS>(); p && p->hasCartesianPosVel) {
+        const Eigen::Vector3d r_E(p->cartesian_x, p->cartesian_y, p->cartesian_z);
+        f.pos = earth::ecefToGeodetic(r_E);
+        const Eigen::Matrix3d C_EtoN = earth::C_EtoN(f.pos.lat, f.pos.lon);
+        f.v_N = C_EtoN * Eigen::Vector3d(p->cartesian_vx, p->cartesian_vy, p->cartesian_vz);
+        f.cov_pos_N = f.cov_vel_N = Eigen::Matrix3d::Constant(NAN);
+        if (p->hasPosCov) {
+          const Eigen::Matrix3d c = p->pos_covariance.asEigen().topLeftCorner<3, 3>().cast<double>();
+          f.cov_pos_N = C_EtoN * c * C_EtoN.transpose();
+        }
+        if (p->hasVelCov) {
+          const Eigen::Matrix3d c = p->vel_covariance.asEigen().topLeftCorner<3, 3>().cast<double>();
+          f.cov_vel_N = C_EtoN * c * C_EtoN.transpose();
+        }
+      } else if (const auto* gga = g->getMsgByClassPtr<gnss::Message_NMEA_GGA>()) {
+        f.pos = {gga->fields.latitude_degrees * M_PI / 180, gga->fields.longitude_degrees * M_PI / 180,
+                 gga->fields.altitude_meters + gga->fields.geoidal_distance * 0.0};
+        f.v_N = Eigen::Vector3d::Constant(NAN);
+        f.cov_pos_N = f.cov_vel_N = Eigen::Matrix3d::Constant(NAN);
+      } else {
+        throw Error(where(label, t) + ": GNSS entry has neither a TOPCON_PZS nor an NMEA GGA message");
+      }
+      d.gnss.push_back(f);
+    } else {
+      ++skipped;
+    }
+  }
+  if (skipped) d.notices.push_back(std::to_string(skipped) + " entries with other labels or types skipped");
+  d.origin = origin;
+  d.t_start_s = 0.0;
+  if (!haveOrigin && !d.gnss.empty()) d.origin = d.gnss.front().pos;
+  (void)r0_E;
+  (void)C_LtoE;
+  return d;
+}
+
+}  // namespace navimpact::rawlog
