@@ -613,13 +613,13 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
   if (structure.empty()) throw Error("GMWM fit: the structure is empty (expected e.g. WN+GM)");
   const int p = parameterCount(structure);
   const std::string sname = stochastic::formatStructure(structure);
-  if (p > kMaxParams)
-    throw Error("GMWM fit of " + sname + ": " + std::to_string(p) + " parameters, at most " +
-                std::to_string(kMaxParams) + " supported");
   if (p > wv.scales())
     throw Error("GMWM fit of " + sname + ": " + std::to_string(p) +
                 " parameters but the wavelet variance has only " + std::to_string(wv.scales()) +
                 " scales (use a longer record or a smaller structure)");
+  if (p > kMaxParams)
+    throw Error("GMWM fit of " + sname + ": " + std::to_string(p) + " parameters, at most " +
+                std::to_string(kMaxParams) + " supported");
   const Data d = makeData(wv);
   const Layout L(structure);
   FitResult r;

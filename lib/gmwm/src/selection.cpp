@@ -190,19 +190,31 @@ std::vector<RankedModel> selectModel(const std::vector<std::vector<ProcessKind>>
         break;
       }
     }
+    // Richer neighbour: the one-term-larger structure that lowers the objective most.
+    const RankedModel* rich = nullptr;
+    ProcessKind rich_extra{};
     for (const auto& r : out) {
       ProcessKind extra{};
-      const auto rk = kindsOf(r.fit.model);
-      if (oneLess(bk, rk, &extra)) {
-        os << "; adding " << stochastic::kindName(extra) << " (" << stochastic::formatStructure(rk)
-           << ") lowers the objective by " << fmt(b.fit.objective - r.fit.objective) << " but costs "
-           << fmt(r.optimism - b.optimism) << " in optimism (criterion " << fmt(r.criterion) << ")";
-        break;
+      if (oneLess(bk, kindsOf(r.fit.model), &extra) &&
+          (!rich || r.fit.objective < rich->fit.objective)) {
+        rich = &r;
+        rich_extra = extra;
       }
     }
-    if (out.size() > 1)
-      os << "; runner-up " << stochastic::formatStructure(kindsOf(out[1].fit.model)) << " at "
-         << fmt(out[1].criterion);
+    if (rich && b.fit.objective - rich->fit.objective > 1e-9 * b.fit.objective)
+      os << "; adding " << stochastic::kindName(rich_extra) << " ("
+         << stochastic::formatStructure(kindsOf(rich->fit.model)) << ") lowers the objective by "
+         << fmt(b.fit.objective - rich->fit.objective) << " but costs " << fmt(rich->optimism - b.optimism)
+         << " in optimism (criterion " << fmt(rich->criterion) << ")";
+    else if (rich)
+      os << "; no added term lowers the objective";
+    // Runner-up: the best candidate with a different criterion value.
+    for (std::size_t q = 1; q < out.size(); ++q)
+      if (key(out[q]) != key(b)) {
+        os << "; runner-up " << stochastic::formatStructure(kindsOf(out[q].fit.model)) << " at "
+           << fmt(out[q].criterion);
+        break;
+      }
     *why = os.str();
   }
   return out;

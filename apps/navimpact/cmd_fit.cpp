@@ -1,0 +1,311 @@
+// navimpact fit: GMWM fit of an IMU error model to a static recording.
+//   navimpact fit --input FILE [--rate HZ] [--gyro-unit U] [--acc-unit U] [--axes SPEC]
+//                 [--label L] [--channels gyro_x,...] --structure SPEC|auto
+//                 [--max-gm N] [--bootstrap N] [--seed S] --out DIR
+// Writes DIR/model.yaml (stochastic::loadImuModel reads it back), DIR/fit.json
+// (estimates, intervals, WV and model WV per channel) and one WV figure per
+// sensor (fit_gyroscope.png, fit_accelerometer.png), all or nothing.
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "cli_common.hpp"
+#include "navimpact/core/csv_reader.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/imu_series.hpp"
+#include "navimpact/core/output.hpp"
+#include "navimpact/core/units.hpp"
+#include "navimpact/gmwm/estimator.hpp"
+#include "navimpact/gmwm/wavelet_variance.hpp"
+#include "navimpact/plot/figure.hpp"
+#include "navimpact/stochastic/datasheet.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/simulate.hpp"
+#include "navimpact/stochastic/theoretical_wv.hpp"
+
+namespace {
+
+namespace st = navimpact::stochastic;
+namespace gm = navimpact::gmwm;
+using json = nlohmann::json;
+
+struct Opts {
+  std::string input;
+  double rate_hz = 0.0;
+  std::string gyro_unit, acc_unit, axes, label, channels;
+  std::string structure;
+  int max_gm = 3;
+  int bootstrap = 0;
+  std::uint64_t seed = 20190101;
+  std::string out;
+};
+
+struct ChannelFit {
+  const navimpact::ImuChannel* ch = nullptr;
+  gm::WaveletVariance wv;
+  gm::FitResult fit;
+  std::vector<gm::RankedModel> ranking;  // auto only
+  std::string why;
+};
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string t;
+  while (std::getline(ss, t, ','))
+    if (!t.empty()) out.push_back(t);
+  return out;
+}
+
+std::vector<double> vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+json termJson(const st::Process& p, const std::vector<gm::ParamInterval>& ci) {
+  json t;
+  t["process"] = st::kindName(p.kind);
+  json c = json::object();
+  for (const auto& pi : ci) {
+    t[pi.name] = pi.value;
+    c[pi.name] = {{"low", pi.low}, {"high", pi.high}};
+  }
+  t["ci"] = c;
+  return t;
+}
+
+json datasheetJson(const st::DatasheetFigures& f) {
+  json d = json::object();
+  auto put = [&](const char* k, const std::optional<double>& v) {
+    if (v) d[k] = *v;
+  };
+  put("noise_density", f.noise_density);
+  put("bias_instability", f.bias_instability);
+  put("bias_instability_tau_s", f.bias_instability_tau_s);
+  put("random_walk", f.random_walk);
+  put("quantization", f.quantization);
+  put("drift_rate", f.drift_rate);
+  return d;
+}
+
+/// One WV panel in the style of the paper's Figures 1-4.
+navimpact::plot::Axes wvAxes(const ChannelFit& c) {
+  namespace pl = navimpact::plot;
+  pl::Axes ax;
+  ax.logx = ax.logy = true;
+  ax.title = c.ch->name + ": " + st::formatStructure([&] {
+    std::vector<st::ProcessKind> k;
+    for (const auto& t : c.fit.model.terms) k.push_back(t.kind);
+    return k;
+  }());
+  const std::string u = navimpact::units::siUnit(c.ch->quantity);
+  ax.xlabel = "scale τ [s]";
+  ax.ylabel = "wavelet variance [(" + u + ")²]";
+  const auto tau_s = vec(c.wv.tauSeconds());
+  ax.bands.push_back({"95% CI", tau_s, vec(c.wv.ci_low), vec(c.wv.ci_high), pl::palette(0), 0.2});
+  ax.series.push_back({"empirical WV", tau_s, vec(c.wv.wv), pl::palette(0), pl::LineStyle::Solid,
+                       pl::Marker::FilledCircle, 2.0});
+  const Eigen::MatrixXd terms = st::haarWvTerms(c.fit.model, c.wv.tau);
+  for (Eigen::Index i = 0; i < terms.cols(); ++i) {
+    const auto& p = c.fit.model.terms[static_cast<std::size_t>(i)];
+    std::string lab = st::kindName(p.kind);
+    if (p.kind == st::ProcessKind::GM) {
+      char b[48];
+      std::snprintf(b, sizeof b, "GM (T = %.3g s)", p.T);
+      lab = b;
+    }
+    ax.series.push_back({lab, tau_s, vec(terms.col(i)), pl::palette(static_cast<int>(i) + 2),
+                         pl::LineStyle::Dashed, pl::Marker::None, 1.5});
+  }
+  ax.series.push_back({"model WV", tau_s, vec(st::haarWv(c.fit.model, c.wv.tau)), pl::palette(1),
+                       pl::LineStyle::Solid, pl::Marker::Circle, 2.0});
+  // Components far below the data would stretch the log axis: limit y to the data range.
+  const double lo = c.wv.ci_low.minCoeff() > 0 ? c.wv.ci_low.minCoeff() : c.wv.wv.minCoeff();
+  ax.ylim = std::make_pair(lo / 10.0, c.wv.ci_high.maxCoeff() * 3.0);
+  return ax;
+}
+
+int run(const Opts& o) {
+  // Structure (parsed first: a bad spec fails before reading a large file).
+  const bool autoSel = o.structure == "auto";
+  std::vector<st::ProcessKind> structure;
+  if (!autoSel) structure = st::parseStructure(o.structure);
+  if (o.bootstrap < 0) throw navimpact::Error("--bootstrap must be >= 0, got " + std::to_string(o.bootstrap));
+  if (o.max_gm < 0 || o.max_gm > 3) throw navimpact::Error("--max-gm must be in 0..3");
+
+  navimpact::CsvImuOptions ro;
+  if (o.rate_hz > 0) ro.rate_hz = o.rate_hz;
+  ro.gyro_unit = o.gyro_unit;
+  ro.acc_unit = o.acc_unit;
+  ro.axes = o.axes;
+  const navimpact::ImuSeries s = navimpact::readImuCsv(o.input, ro);
+
+  std::vector<const navimpact::ImuChannel*> chans;
+  if (o.channels.empty()) {
+    for (const auto& c : s.channels) chans.push_back(&c);
+  } else {
+    for (const auto& n : splitList(o.channels)) {
+      if (navimpact::channelIndex(n) < 0)
+        throw navimpact::Error("--channels: unknown channel '" + n +
+                               "' (expected gyro_x, gyro_y, gyro_z, acc_x, acc_y, acc_z)");
+      chans.push_back(&s.channel(n));
+    }
+  }
+  if (chans.empty()) throw navimpact::Error(o.input + ": no IMU channel to fit");
+
+  gm::FitOptions fo;
+  fo.bootstrap = o.bootstrap;
+  fo.seed = o.seed;
+  const auto cands = gm::defaultCandidates(o.max_gm);
+
+  std::vector<ChannelFit> fits(chans.size());
+  navimpact::cli::Progress prog("fit", chans.size());
+  for (std::size_t i = 0; i < chans.size(); ++i) {
+    ChannelFit& c = fits[i];
+    c.ch = chans[i];
+    c.wv = gm::waveletVariance(c.ch->x.data(), c.ch->x.size(), s.rate_hz);
+    gm::FitOptions fi = fo;
+    fi.seed = st::deriveSeed(o.seed, static_cast<std::uint64_t>(navimpact::channelIndex(c.ch->name)));
+    try {
+      if (autoSel) {
+        c.ranking = gm::selectModel(cands, c.wv, fi, &c.why);
+        c.fit = c.ranking.front().fit;
+      } else {
+        c.fit = gm::fit(structure, c.wv, fi);
+      }
+    } catch (const navimpact::Error& e) {
+      throw navimpact::Error(o.input + ": channel " + c.ch->name + ": " + e.what());
+    }
+    prog.update(i + 1);
+  }
+  prog.finish();
+
+  // model.yaml: per-axis keys at the data rate; channels not fitted stay "none".
+  st::ImuModel im;
+  im.rate_hz = s.rate_hz;
+  for (auto& m : im.axis) m.rate_hz = s.rate_hz;
+  for (const auto& c : fits) im.forChannel(c.ch->name) = c.fit.model;
+
+  json j;
+  j["input"] = {{"file", o.input},      {"rate_hz", s.rate_hz},     {"samples", s.size()},
+                {"gyro_unit", o.gyro_unit}, {"acc_unit", o.acc_unit}, {"axes", o.axes},
+                {"label", o.label}};
+  j["seed"] = o.seed;
+  j["structure"] = autoSel ? std::string("auto") : st::formatStructure(structure);
+  j["conventions"] =
+      "SI units; WN sigma, QN Q, RW gamma, DR omega per sample at input.rate_hz; GM sigma stationary, "
+      "T in s; DR sign not identified by the WV (|omega|)";
+  j["channels"] = json::array();
+  for (const auto& c : fits) {
+    json cj;
+    cj["name"] = c.ch->name;
+    cj["unit"] = navimpact::units::siUnit(c.ch->quantity);
+    cj["model"] = st::formatTerms(c.fit.model.terms, 17);
+    cj["objective"] = c.fit.objective;
+    std::vector<st::ProcessKind> k;
+    for (const auto& t : c.fit.model.terms) k.push_back(t.kind);
+    cj["structure"] = st::formatStructure(k);
+    cj["ci_method"] = c.fit.ci_method;
+    cj["converged"] = c.fit.converged;
+    cj["starts"] = c.fit.starts;
+    json terms = json::array();
+    for (std::size_t i = 0; i < c.fit.model.terms.size(); ++i) {
+      json t = termJson(c.fit.model.terms[i], c.fit.ci[i]);
+      if (c.fit.model.terms[i].kind == st::ProcessKind::GM)  // AR1 form: phi = exp(-dt/T)
+        t["phi"] = std::exp(-1.0 / (s.rate_hz * c.fit.model.terms[i].T));
+      terms.push_back(t);
+    }
+    cj["terms"] = terms;
+    cj["datasheet"] = datasheetJson(st::datasheetFigures(c.fit.model));
+    if (autoSel) {
+      json sel = json::array();
+      for (const auto& r : c.ranking) {
+        std::vector<st::ProcessKind> rk;
+        for (const auto& t : r.fit.model.terms) rk.push_back(t.kind);
+        sel.push_back({{"structure", st::formatStructure(rk)},
+                       {"objective", r.fit.objective},
+                       {"optimism", r.optimism},
+                       {"criterion", r.criterion},
+                       {"model", st::formatTerms(r.fit.model.terms)}});
+      }
+      cj["selection"] = sel;
+      cj["selection_reason"] = c.why;
+    }
+    const Eigen::MatrixXd tw = st::haarWvTerms(c.fit.model, c.wv.tau);
+    json terms_wv = json::array();
+    for (Eigen::Index i = 0; i < tw.cols(); ++i) terms_wv.push_back(vec(tw.col(i)));
+    cj["wv"] = {{"tau_s", vec(c.wv.tauSeconds())},
+                {"wv", vec(c.wv.wv)},
+                {"ci_low", vec(c.wv.ci_low)},
+                {"ci_high", vec(c.wv.ci_high)},
+                {"model_wv", vec(st::haarWv(c.fit.model, c.wv.tau))},
+                {"terms_wv", terms_wv}};
+    j["channels"].push_back(cj);
+  }
+
+  navimpact::OutputSet outs(o.out);
+  std::ostringstream comment;
+  comment << "GMWM fit by navimpact " << NAVIMPACT_VERSION << " of " << o.input
+          << (o.label.empty() ? "" : " (" + o.label + ")") << ", structure " << j["structure"].get<std::string>()
+          << ", seed " << o.seed;
+  outs.writeText("model.yaml", st::toYaml(im, comment.str()));
+  outs.writeText("fit.json", j.dump(2) + "\n");
+  for (int sensor = 0; sensor < 2; ++sensor) {
+    navimpact::plot::Figure fig;
+    for (const auto& c : fits) {
+      const bool gyro = c.ch->quantity == navimpact::units::Quantity::AngularRate;
+      if (gyro == (sensor == 0)) fig.axes.push_back(wvAxes(c));
+    }
+    if (fig.axes.empty()) continue;
+    const std::string sname = sensor == 0 ? "gyroscope" : "accelerometer";
+    fig.rows = 1;
+    fig.cols = static_cast<int>(fig.axes.size());
+    fig.width = 650 * fig.cols;
+    fig.height = 620;
+    fig.title = "GMWM fit, " + sname + (o.label.empty() ? "" : " — " + o.label);
+    navimpact::plot::savePng(fig, outs.stage("fit_" + sname + ".png").string());
+  }
+  outs.commit();
+
+  for (const auto& c : fits) {
+    std::cout << c.ch->name << ": " << st::formatTerms(c.fit.model.terms) << "   ["
+              << navimpact::units::siUnit(c.ch->quantity) << ", per sample at " << s.rate_hz << " Hz]\n";
+    std::cout << "    objective " << c.fit.objective << "  (" << c.fit.ci_method << " 95 % intervals in fit.json)\n";
+    if (autoSel) std::cout << "    " << c.why << "\n";
+    std::istringstream lines(st::formatDatasheet(st::datasheetFigures(c.fit.model), c.ch->quantity));
+    std::string l;
+    while (std::getline(lines, l)) std::cout << "    " << l << "\n";
+  }
+  std::cout << "wrote";
+  for (const auto& p : outs.finalPaths()) std::cout << " " << p.string();
+  std::cout << "\n";
+  return 0;
+}
+
+navimpact::cli::Registrar reg({
+    "fit",
+    "GMWM fit of IMU error models (WN, QN, RW, DR, GM, SIN) to a static recording",
+    [](CLI::App& app) {
+      auto o = std::make_shared<Opts>();
+      app.add_option("--input", o->input, "static IMU recording (CSV or CSV.gz, columns gyro_x..acc_z)")
+          ->required();
+      app.add_option("--rate", o->rate_hz, "sampling rate [Hz] (needed without a time column)");
+      app.add_option("--gyro-unit", o->gyro_unit, "unit of the gyro columns (rad/s, deg/s, deg/h, ...)");
+      app.add_option("--acc-unit", o->acc_unit, "unit of the accelerometer columns (m/s2, g, mg, ...)");
+      app.add_option("--axes", o->axes, "axis remapping file -> body FRD, e.g. x,-y,-z");
+      app.add_option("--label", o->label, "label for reports and figures");
+      app.add_option("--channels", o->channels, "comma-separated channels to fit (default: all in the file)");
+      app.add_option("--structure", o->structure,
+                     "model structure for every channel, e.g. WN+GM+GM+DR, or 'auto' (WIC selection)")
+          ->required();
+      app.add_option("--max-gm", o->max_gm, "auto: largest number of GM terms among the candidates (0..3)");
+      app.add_option("--bootstrap", o->bootstrap, "parametric bootstrap replicates for the intervals (0: asymptotic)");
+      app.add_option("--seed", o->seed, "seed of the bootstrap");
+      app.add_option("--out", o->out, "output directory (model.yaml, fit.json, fit_*.png)")->required();
+      return [o]() -> int { return run(*o); };
+    }});
+
+}  // namespace

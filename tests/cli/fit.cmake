@@ -1,0 +1,101 @@
+# navimpact fit on the committed ADIS16405 excerpt (100 Hz, deg/s and g).
+set(_fdata ${CMAKE_SOURCE_DIR}/datasets/adis16405_static_excerpt.csv.gz)
+set(_fdir ${CMAKE_CURRENT_BINARY_DIR}/fit_cli)
+file(MAKE_DIRECTORY ${_fdir})
+
+# Runs NI with ARGS ('|'-separated), requires a non-zero exit and output matching REGEX.
+file(WRITE ${_fdir}/expect_fail.cmake [=[
+string(REPLACE "|" ";" _args "${ARGS}")
+execute_process(COMMAND ${NI} ${_args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(rc EQUAL 0)
+  message(FATAL_ERROR "expected a non-zero exit, got 0; output: ${out}${err}")
+endif()
+if(NOT "${out}${err}" MATCHES "${REGEX}")
+  message(FATAL_ERROR "output does not match '${REGEX}': ${out}${err}")
+endif()
+if(DEFINED NOFILE AND EXISTS "${NOFILE}")
+  message(FATAL_ERROR "a failing fit left ${NOFILE} behind")
+endif()
+]=])
+
+# fit.json has the six channels, each with terms, intervals and the WV; both figures exist.
+file(WRITE ${_fdir}/check_fit_json.cmake [=[
+file(READ ${DIR}/fit.json j)
+string(JSON n LENGTH "${j}" channels)
+if(NOT n EQUAL 6)
+  message(FATAL_ERROR "fit.json has ${n} channels, expected 6")
+endif()
+math(EXPR last "${n} - 1")
+foreach(i RANGE ${last})
+  string(JSON name GET "${j}" channels ${i} name)
+  string(JSON s GET "${j}" channels ${i} structure)
+  if(NOT s STREQUAL "WN+GM")
+    message(FATAL_ERROR "channel ${name}: structure ${s}, expected WN+GM")
+  endif()
+  string(JSON T GET "${j}" channels ${i} terms 1 T)
+  string(JSON lo GET "${j}" channels ${i} terms 1 ci T low)
+  string(JSON hi GET "${j}" channels ${i} terms 1 ci T high)
+  if(NOT (lo LESS_EQUAL T AND T LESS_EQUAL hi))
+    message(FATAL_ERROR "channel ${name}: GM T ${T} outside its interval [${lo}, ${hi}]")
+  endif()
+  string(JSON nt LENGTH "${j}" channels ${i} wv tau_s)
+  string(JSON nm LENGTH "${j}" channels ${i} wv model_wv)
+  string(JSON nc LENGTH "${j}" channels ${i} wv terms_wv)
+  if(NOT nt EQUAL 18 OR NOT nm EQUAL 18 OR NOT nc EQUAL 2)
+    message(FATAL_ERROR "channel ${name}: WV arrays of ${nt}/${nm} scales and ${nc} components (expected 18/18/2)")
+  endif()
+endforeach()
+string(JSON seed GET "${j}" seed)
+if(NOT seed EQUAL 7)
+  message(FATAL_ERROR "seed ${seed} not recorded")
+endif()
+foreach(f fit_gyroscope.png fit_accelerometer.png model.yaml)
+  if(NOT EXISTS ${DIR}/${f})
+    message(FATAL_ERROR "missing ${DIR}/${f}")
+  endif()
+endforeach()
+]=])
+
+add_test(NAME cli_fit_wn_gm
+  COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GM
+          --seed 7 --label "ADIS16405 excerpt" --out ${_fdir}/wn_gm)
+set_tests_properties(cli_fit_wn_gm PROPERTIES
+  PASS_REGULAR_EXPRESSION "gyro_x: WN\\(sigma=[0-9.e-]+\\) \\+ GM\\(sigma=[0-9.e-]+, T=[0-9.e+-]+\\).*objective.*ARW.*acc_z: WN"
+  FIXTURES_SETUP fit_wn_gm)
+
+# the written model file loads back through the model file reader
+add_test(NAME cli_fit_model_loads COMMAND ${NI} model show ${_fdir}/wn_gm/model.yaml)
+set_tests_properties(cli_fit_model_loads PROPERTIES
+  PASS_REGULAR_EXPRESSION "per sample at 100 Hz.*gyro_x[^\n]*WN\\(sigma=.*GM\\(sigma=.*acc_z[^\n]*WN\\(sigma=.*GM\\("
+  FIXTURES_REQUIRED fit_wn_gm)
+
+add_test(NAME cli_fit_json
+  COMMAND ${CMAKE_COMMAND} -DDIR=${_fdir}/wn_gm -P ${_fdir}/check_fit_json.cmake)
+set_tests_properties(cli_fit_json PROPERTIES FIXTURES_REQUIRED fit_wn_gm)
+
+# automatic selection on two channels prints the reason and ranks the candidates
+add_test(NAME cli_fit_auto
+  COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure auto
+          --max-gm 2 --channels gyro_x,acc_z --out ${_fdir}/auto)
+set_tests_properties(cli_fit_auto PROPERTIES
+  PASS_REGULAR_EXPRESSION "gyro_x: .*picked [A-Z+]+: criterion .*acc_z: .*picked [A-Z+]+: criterion")
+
+# a bad structure string: error naming the position, no output left behind
+add_test(NAME cli_fit_bad_structure
+  COMMAND ${CMAKE_COMMAND} -DNI=${NI}
+          "-DARGS=fit|--input|${_fdata}|--rate|100|--gyro-unit|deg/s|--acc-unit|g|--structure|WN+GX+DR|--out|${_fdir}/bad"
+          "-DREGEX=navimpact: error: .*structure.*position 4.*'GX'" -DNOFILE=${_fdir}/bad/fit.json
+          -P ${_fdir}/expect_fail.cmake)
+
+# more parameters (WN + 9 GM = 19) than the 18 scales of 2^18 samples: clear error
+add_test(NAME cli_fit_too_many_parameters
+  COMMAND ${CMAKE_COMMAND} -DNI=${NI}
+          "-DARGS=fit|--input|${_fdata}|--rate|100|--gyro-unit|deg/s|--acc-unit|g|--structure|WN+9GM|--out|${_fdir}/big"
+          "-DREGEX=navimpact: error: .*channel gyro_x: .*19 parameters but the wavelet variance has only 18 scales"
+          -DNOFILE=${_fdir}/big/fit.json -P ${_fdir}/expect_fail.cmake)
+
+# an unknown channel name is rejected
+add_test(NAME cli_fit_bad_channel
+  COMMAND ${CMAKE_COMMAND} -DNI=${NI}
+          "-DARGS=fit|--input|${_fdata}|--rate|100|--gyro-unit|deg/s|--acc-unit|g|--structure|WN|--channels|gyro_q|--out|${_fdir}/badch"
+          "-DREGEX=navimpact: error: --channels: unknown channel 'gyro_q'" -P ${_fdir}/expect_fail.cmake)
