@@ -18,6 +18,9 @@ struct DatasheetFigures {
   std::optional<double> noise_density;
   /// Bias instability, IEEE 952 flicker-floor reading from the model's Allan
   /// deviation minimum divided by 0.664 [unit]. Empty if no minimum in range.
+  /// The ADEV is the model's, AVAR(m) = 2 nu^2(tau = 2m), on a log grid of 50
+  /// points per decade from 1 sample to 1e6 s; the FIRST interior local minimum
+  /// is reported (the floor after the white-noise slope).
   std::optional<double> bias_instability;
   std::optional<double> bias_instability_tau_s;  ///< tau where the minimum occurs [s]
   /// Rate random walk K = gamma / sqrt(dt) [unit/sqrt(s)].

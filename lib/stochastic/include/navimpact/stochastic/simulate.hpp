@@ -3,7 +3,12 @@
  * @brief Seeded simulation of processes and composite models.
  *
  * Every stream is created from an explicit 64-bit seed; the same seed gives
- * the same samples on every run and thread count.
+ * the same samples on every run and thread count. Term i of a model uses its
+ * own stream std::mt19937_64(deriveSeed(seed, i)), so adding a term leaves the
+ * others unchanged. Gaussian draws use a ziggurat (Marsaglia & Tsang 2000)
+ * implemented in simulate.cpp rather than std::normal_distribution, whose
+ * algorithm is implementation-defined: the samples of a seed are therefore the
+ * same with every standard library. No MRPT dependency.
  */
 #pragma once
 
