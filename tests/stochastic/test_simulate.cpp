@@ -109,6 +109,11 @@ TEST(Simulate, ProcessMomentsAndDeterministicParts) {
   EXPECT_LE(mx, A * (1 + 1e-12));
   EXPECT_NEAR(ms / s.size(), A * A / 2, 1e-6);
   for (std::size_t k = 0; k + 50 < s.size(); k += 997) EXPECT_NEAR(s[k + 50], s[k], 1e-9);
+  // and its empirical Haar WV follows the closed form at every scale
+  for (std::size_t tau = 2; tau <= 1024; tau *= 2) {
+    const double th = haarWv(Process::sin(A, f), rate, static_cast<double>(tau));
+    EXPECT_NEAR(test::empiricalHaarWv(s, tau), th, 2e-3 * A * A / 2) << "tau=" << tau;
+  }
   // QN: variance 2 Q^2 (difference of two independent U(0,1) scaled by sqrt(12) Q)
   const double Q = 0.02;
   const auto q = simulate(model(100, {Process::qn(Q)}), 1 << 20, 6);
