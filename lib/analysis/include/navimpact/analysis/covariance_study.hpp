@@ -1,0 +1,104 @@
+/**
+ * @file covariance_study.hpp
+ * @brief Covariance analysis of navigation uncertainty for a set of IMU error
+ *        models (the paper's Figures 5 and 6): static vehicle, no GNSS,
+ *        near-perfect altitude, covariance-only propagation of the error-state
+ *        EKF (lib/filter), one run per model.
+ *
+ * Configuration (YAML, every key with its unit in the name), e.g.
+ * config/paper/covariance_static.yaml:
+ * @code
+ *   model_file: ../models/navchip_table1.yaml   # relative to this file
+ *   duration_s: 60
+ *   imu_rate_hz: 200
+ *   output_rate_hz: 10
+ *   summary_times_s: [1, 10, 30, 60]
+ *   static_state: {lat_deg: 46.52, lon_deg: 6.57, h_m: 400, roll_deg: 0, pitch_deg: 0, yaw_deg: 0}
+ *   initial_sigma: {position_m: 0, velocity_mps: 0, attitude_deg: 0}
+ *   baro: {rate_hz: 10, sigma_m: 0.001}
+ *   filter: {discretization: series, propagate_every: 1}
+ *   model_sets:
+ *     - {name: accelerometer, title: "...", models: [acc_model1, acc_model2, acc_model3, acc_ref]}
+ *     - {name: gyroscope, title: "...", models: [gyro_model1, gyro_model2, gyro_model3, gyro_ref]}
+ * @endcode
+ */
+#pragma once
+
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "navimpact/core/output.hpp"
+#include "navimpact/filter/ekf.hpp"
+
+namespace navimpact::analysis {
+
+struct ModelSet {
+  std::string name;                  ///< e.g. "accelerometer" (file names, CSV column)
+  std::string title;                 ///< figure title
+  std::vector<std::string> models;   ///< model names inside model_file
+};
+
+struct CovarianceStudyConfig {
+  std::string source;                ///< configuration file path (for messages)
+  std::string model_file;            ///< resolved path of the model file
+  double duration_s = 60.0;          ///< horizon [s], > 0
+  double imu_rate_hz = 200.0;        ///< propagation rate [Hz], > 0
+  double output_rate_hz = 10.0;      ///< rate of the rows written [Hz], > 0, <= imu_rate_hz
+  std::vector<double> summary_times_s = {1, 10, 30, 60};  ///< times reported in summary.json [s]
+  ins::NavState nominal;             ///< static state (t = 0)
+  double sigma0_position_m = 0.0;    ///< initial sigma of each position axis [m], >= 0
+  double sigma0_velocity_mps = 0.0;  ///< initial sigma of each velocity axis [m/s], >= 0
+  double sigma0_attitude_rad = 0.0;  ///< initial sigma of each attitude axis [rad], >= 0
+  double baro_rate_hz = 10.0;        ///< altitude observation rate [Hz], >= 0 (0 = none)
+  double baro_sigma_m = 1e-3;        ///< altitude observation sigma [m], > 0
+  filter::EkfConfig filter;          ///< discretization, propagate_every
+  std::vector<ModelSet> model_sets;
+  std::string echo;                  ///< the configuration as JSON text (for summary.json)
+};
+
+/**
+ * Read and validate a study configuration.
+ * @throws navimpact::Error naming the file and key: unknown keys (with the
+ *         accepted ones, so a wrong unit suffix is caught), wrong types,
+ *         non-positive durations/rates/sigmas, unknown models in the model file.
+ */
+CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path);
+
+/// Sigma history of one model: columns pos N, E, D [m], vel N, E, D [m/s], roll, pitch, yaw [rad].
+struct CovarianceRun {
+  std::string model_set, model;
+  std::string model_text;            ///< the models of the six axes, for the record
+  int states = 0;                    ///< filter state dimension
+  std::vector<double> t;             ///< [s]
+  std::vector<std::array<double, 9>> sigma;
+};
+
+struct CovarianceStudyResult {
+  std::vector<CovarianceRun> runs;
+};
+
+/**
+ * Roll, pitch, yaw sigmas from the covariance of psi (N, E, D small angles):
+ * d(euler) = M^-1 psi with psi = M d(euler), M = [Rz Ry e_x, Rz e_y, e_z].
+ * @param[in] P_psi  3x3 covariance of psi [rad^2].
+ * @param[in] x      state (its attitude fixes M); |pitch| < 90 deg.
+ */
+Eigen::Vector3d eulerSigmas(const Eigen::Matrix3d& P_psi, const ins::NavState& x);
+
+/**
+ * Run the study: one covariance-only propagation per model (perfect other sensor).
+ * @param[in] progress  optional callback(done, total) after each model.
+ */
+CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,
+                                         const std::function<void(int, int)>& progress = {});
+
+/**
+ * Write covariance.csv, summary.json and one PNG per model set
+ * (covariance_<set>.png) into @p out (staged; the caller commits).
+ */
+void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStudyResult& res,
+                          OutputSet& out);
+
+}  // namespace navimpact::analysis

@@ -1,0 +1,263 @@
+/**
+ * @file diagnosis.hpp
+ * @brief `navimpact diagnose`: what a simulation with the user's IMU error
+ *        model gets wrong on a measured static recording, why, and how much an
+ *        extended model gains.
+ *
+ * Pipeline per channel (all channels in parallel, see diagnose()):
+ *  1. time domain, where the wavelet variance (WV) is blind or distorted:
+ *     isolated spikes (robust z-score of the second difference, Bonferroni
+ *     over samples) and level shifts (multi-scale maximum of the Haar
+ *     coefficients against their robust scale, Bonferroni over positions and
+ *     scales); both are removed before the next steps;
+ *  2. spectrum: Welch periodogram against a running-median background;
+ *     narrow-band lines beyond a chi-square threshold (Bonferroni over bins)
+ *     are sinusoids; their frequency is refined on the whole record and they
+ *     are subtracted;
+ *  3. WV: measured Haar WV of the cleaned record against the model's
+ *     theoretical WV with its chi-square CI (eta_j = max(M_j / 2^j, 1),
+ *     Percival & Walden 2000 §8.4; lowered to the dof seen in the model's own
+ *     simulations where those are fewer), family-wise level by Bonferroni over
+ *     scales and channels; a Monte-Carlo envelope from seeded simulations;
+ *  4. cause: the excess is matched against each process family (add WN, QN,
+ *     RW, DR, GM, or retune one term of the model, the other terms kept) by
+ *     minimising the chi-square (gamma) deviance of the WV on the FIRST half of
+ *     the record, choosing by AIC = deviance + 2 p (a penalised criterion in
+ *     the spirit of the WIC, Guerrier et al. 2013); the chosen extension is
+ *     refitted on the whole record for the reported parameters and the model
+ *     file, repeated while scales remain outside the family-wise CI;
+ *  5. gain: the first-half extension and the user's model are both judged on
+ *     the SECOND half (held out): GMWM objective, deviance, scales outside the
+ *     95 % CI; significance by a chi-square test on the held-out deviance drop.
+ *
+ * The family-wise level alpha (default 1 % for the whole record) is split over
+ * the four test families (WV 40 %, spectrum 20 %, level shifts 20 %, spikes
+ * 20 %), each Bonferroni-corrected over its channels and elements, so that data
+ * drawn from the model itself are called adequate with probability >= 1 - alpha
+ * (up to the normal/chi-square approximations stated above).
+ */
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "navimpact/core/imu_series.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+#include "navimpact/stochastic/process.hpp"
+
+namespace navimpact::analysis {
+
+/// Vocabulary of causes, in the order they are listed in reports.
+enum class Cause {
+  WhiteNoise,         ///< "white_noise", params sigma [unit, per sample]
+  QuantizationNoise,  ///< "quantization_noise", params Q [unit]
+  RandomWalk,         ///< "random_walk", params gamma [unit, per sample]
+  Drift,              ///< "drift", params omega [unit/sample]
+  GaussMarkov,        ///< "gauss_markov", params sigma [unit], T [s]
+  Sinusoid,           ///< "sinusoid", params amplitude [unit], freq_hz [Hz]
+  LevelShift,         ///< "level_shift", params size [unit], t_s [s]
+  Outliers,           ///< "outliers", params count, times_s [s]
+};
+
+/// Snake-case name of a cause as written in diagnosis.json ("gauss_markov", ...).
+const char* causeName(Cause c);
+
+/// One named cause of misfit on one channel.
+struct Finding {
+  std::string channel;                                  ///< e.g. "gyro_z"
+  Cause cause = Cause::WhiteNoise;
+  std::vector<std::pair<std::string, double>> params;   ///< fixed keys (see Cause), SI
+  std::vector<double> times_s;                          ///< outliers: times [s]
+  /// Where it shows: "scales_s" (WV scales [s]), "freq_hz" (spectrum) or "t_s" (time).
+  std::string range_key = "scales_s";
+  double range_lo = 0.0, range_hi = 0.0;
+  /// 95 % profile interval of T (gauss_markov) [s]; empty otherwise.
+  std::optional<std::pair<double, double>> T_interval_s;
+  /// "missing" (the model lacks it / understates it) or "overstated".
+  std::string direction = "missing";
+  std::string explanation;                              ///< one sentence
+  std::string action;                                   ///< what to do about it
+  double statistic = 0.0;   ///< test statistic that triggered it (z or ratio)
+  double threshold = 0.0;   ///< its family-wise threshold
+  double get(const std::string& key) const;             ///< params lookup (NaN if absent)
+};
+
+/// Measured vs model WV at one scale.
+struct ScaleCheck {
+  double tau_s = 0;          ///< scale [s]
+  double measured = 0;       ///< empirical WV [unit^2]
+  double model = 0;          ///< model's theoretical WV [unit^2]
+  double ci_low = 0;         ///< 95 % CI of the measured WV under the model [unit^2]
+  double ci_high = 0;
+  double env_low = 0;        ///< simulation envelope (min over simulations) [unit^2]
+  double env_high = 0;       ///< (max over simulations)
+  double dof = 0;            ///< chi-square degrees of freedom used
+  double ratio = 0;          ///< measured / model
+  double ci_widths = 0;      ///< distance outside the CI in CI widths (signed, 0 inside)
+  double p_value = 1;        ///< two-sided per-scale p-value
+  bool outside95 = false;    ///< outside the per-scale 95 % CI
+  bool significant = false;  ///< outside at the family-wise level
+};
+
+/// Welch spectrum of a channel and its line test.
+struct SpectrumCheck {
+  std::vector<double> freq_hz;     ///< bin frequencies [Hz]
+  std::vector<double> psd;         ///< one-sided PSD [unit^2/Hz]
+  std::vector<double> background;  ///< running-median background [unit^2/Hz]
+  double threshold_ratio = 0;      ///< family-wise line threshold on psd/background
+  double dof = 0;                  ///< equivalent dof of the Welch estimate
+  int segments = 0, segment_length = 0;
+  int first_tested_bin = 0, last_tested_bin = 0;
+};
+
+/// Held-out comparison of the model before and after extension.
+struct GainCheck {
+  std::string basis;                 ///< "second_half" or "full_record" (cleaning only)
+  double objective_before = 0, objective_after = 0;   ///< GMWM objective (fast weights)
+  double deviance_before = 0, deviance_after = 0;     ///< chi-square (gamma) deviance
+  int outside_before = 0, outside_after = 0;          ///< scales outside the 95 % CI
+  int scales = 0;
+  int added_params = 0;
+  double p_value = 1;                ///< chi-square test of the deviance drop
+  bool significant = false;          ///< p_value < 0.05 and the deviance dropped
+};
+
+/// Diagnosis of one channel.
+struct ChannelDiagnosis {
+  std::string name;
+  bool adequate = true;
+  std::vector<Finding> findings;
+  stochastic::Model model_before;       ///< the user's model (at the data rate)
+  stochastic::Model model_after;        ///< extended model (whole-record fit)
+  stochastic::Model model_after_half;   ///< extension fitted on the first half
+  std::vector<ScaleCheck> scales;       ///< raw record vs model_before
+  std::vector<ScaleCheck> scales_after; ///< cleaned record vs model_after
+  std::vector<double> wv_cleaned;       ///< WV of the cleaned record [unit^2]
+  SpectrumCheck spectrum;
+  std::vector<double> line_freqs_hz;    ///< lines found (for plots)
+  GainCheck gain;
+  double wv_threshold_p = 0;            ///< per-scale p-value threshold used
+};
+
+/// Options of diagnose().
+struct DiagnoseOptions {
+  int simulations = 16;          ///< Monte-Carlo simulations of the model per channel (>= 2)
+  std::uint64_t seed = 20261121; ///< root seed (simulations: deriveSeed(seed, 1000 c + s))
+  double alpha = 0.01;           ///< family-wise level for the whole record, in (0, 0.5)
+  int max_terms = 3;             ///< most processes added per channel
+  int threads = 0;               ///< worker threads over channels (0 = hardware)
+  /// Called from worker threads with (fraction done 0..1, stage); may be empty.
+  std::function<void(double, const std::string&)> progress;
+};
+
+/// Whole diagnosis.
+struct Diagnosis {
+  std::string source;                 ///< input file
+  double rate_hz = 0;
+  std::size_t samples = 0;
+  bool adequate = true;
+  std::vector<ChannelDiagnosis> channels;
+  stochastic::ImuModel model_before;  ///< at the data rate
+  stochastic::ImuModel model_after;
+  std::vector<std::string> notices;   ///< e.g. rate conversion
+  DiagnoseOptions options;
+};
+
+/**
+ * Diagnose @p data against @p model (converted to the data rate, with a notice,
+ * when its rate differs).
+ * @param[in] data   static recording, SI, >= 2^12 samples per channel.
+ * @param[in] model  the user's model.
+ * @param[in] opt    see DiagnoseOptions.
+ * @throws navimpact::Error for too short records, non-finite samples, a
+ *         constant channel or invalid options.
+ */
+Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
+                   const DiagnoseOptions& opt = {});
+
+/// diagnosis.json text (see README "diagnose"); @p input_json is copied under "input".
+std::string diagnosisJson(const Diagnosis& d, const std::string& input_json);
+
+/// report.md text; @p figures are the PNG names to link.
+std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& figures);
+
+/**
+ * Render the figures (PNG): an overview of the measured WV vs the simulated
+ * envelope of every channel with the misfit scales marked; per channel with
+ * findings the extended model's fit and, where a line was found, the spectrum.
+ * @param[in] path_for  maps a file name ("wv_envelope.png") to the path to write
+ *                      (e.g. OutputSet::stage).
+ * @return the file names written.
+ */
+std::vector<std::string> diagnosisFigures(
+    const Diagnosis& d, const std::function<std::string(const std::string&)>& path_for);
+
+// ---------------------------------------------------------------------------
+// Building blocks (exposed for tests)
+
+/// Isolated spikes found by detectSpikes().
+struct SpikeResult {
+  std::vector<std::size_t> index;   ///< sample indices
+  std::vector<double> size;         ///< spike heights [unit]
+  double scale = 0;                 ///< robust std of the second difference [unit]
+  double threshold = 0;             ///< z threshold used
+};
+
+/**
+ * Spikes: r_k = x_k - (x_{k-1} + x_{k+1}) / 2 beyond @p z_threshold robust
+ * standard deviations (1.4826 MAD), with both neighbours of opposite sign and
+ * about half the size (what a single-sample spike does, unlike a step).
+ */
+SpikeResult detectSpikes(const std::vector<double>& x, double z_threshold);
+
+/// One level shift.
+struct StepResult {
+  std::size_t index = 0;   ///< first sample after the step
+  double size = 0;         ///< [unit]
+  double z = 0;            ///< Haar coefficient / robust scale at the detecting scale
+  double threshold = 0;
+  int level = 0;           ///< detecting Haar level j (scale 2^j samples)
+};
+
+/**
+ * Level shifts by the multi-scale Haar maximum test, at most @p max_steps,
+ * each removed from @p x (x[k >= index] -= size) before the next search.
+ * @param[in] alpha  family-wise level of one search, split (Bonferroni) over
+ *                   the levels tested and the positions of each level.
+ * @param[out] levels_tested  number of Haar levels tested (optional).
+ */
+std::vector<StepResult> detectSteps(std::vector<double>& x, double alpha,
+                                    int max_steps = 5, int* levels_tested = nullptr);
+
+/// Welch PSD (Hann window, 50 % overlap, per-segment linear detrend).
+SpectrumCheck welch(const std::vector<double>& x, double rate_hz, int segment_length);
+
+/// A spectral line.
+struct LineResult {
+  double freq_hz = 0;
+  double amplitude = 0;
+  double ratio = 0;   ///< peak psd / background
+};
+
+/**
+ * Lines beyond the Bonferroni threshold for @p alpha over the tested bins;
+ * fills spec.background and spec.threshold_ratio. Frequencies are Gaussian-
+ * interpolated Welch peaks (diagnose() refines them on the whole record of
+ * @p x and fits the amplitudes by least squares).
+ */
+std::vector<LineResult> detectLines(const std::vector<double>& x, double rate_hz,
+                                    SpectrumCheck& spec, double alpha);
+
+/**
+ * Chi-square (gamma) deviance of measured WV @p nu_hat against model WV @p nu
+ * with dof @p eta: sum eta_j (nu_hat/nu - log(nu_hat/nu) - 1).
+ */
+double wvDeviance(const std::vector<double>& nu_hat, const std::vector<double>& nu,
+                  const std::vector<double>& eta);
+
+}  // namespace navimpact::analysis

@@ -1,0 +1,126 @@
+/**
+ * @file nav_run.hpp
+ * @brief One GNSS/baro-aided INS run in memory: feed IMU samples, GNSS fixes
+ *        (outside the outage windows) and barometer samples into the
+ *        error-state EKF and record, at the truth epochs, the actual errors
+ *        (estimate minus truth), the predicted sigmas and the NEES.
+ *
+ * This is THE navigation loop of navimpact. Both the Monte Carlo emulation
+ * study (analysis/study.hpp, `navimpact study`) and the rawlog replay
+ * (`navimpact replay`) must run their filters through runNav(): the replay
+ * converts its rawlog records to the inputs below (emulation::ImuRecord ->
+ * ins::ImuSample::fromRates, GNSS/BARO records as they are, GT records to a
+ * TruthSeries) and calls runNav() once.
+ *
+ * Conventions (see filter/error_model.hpp): errors are estimate minus truth,
+ * position in metres along local N, E, D, velocity in NED [m/s], attitude as
+ * the small-angle vector psi with C_est = (I + [psi x]) C_true [rad].
+ *
+ * Timing: measurements apply when the filter time reaches them (to within
+ * half an IMU interval), after the prediction to that sample; at one epoch
+ * GNSS position, then GNSS velocity, then baro are applied, then the epoch
+ * is recorded. GNSS outage windows are half-open on the left: a fix at time
+ * t is dropped when start < t <= end, so with fixes at whole seconds and an
+ * integer start the last fix used is the one AT start and the error recorded
+ * at `end` is after exactly end - start seconds of coasting. The barometer
+ * keeps working during outages unless told otherwise (the paper's setting).
+ *
+ * NEES (normalised estimation error squared, Bar-Shalom et al. 2001 §5.4):
+ * e' P^-1 e with e the actual error block and P the filter's marginal
+ * covariance of that block, for position (3 dof), velocity (3), attitude (3)
+ * and all nine navigation errors (9).
+ */
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "navimpact/emulation/sensors.hpp"
+#include "navimpact/filter/ekf.hpp"
+#include "navimpact/ins/nav_state.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+
+namespace navimpact::analysis {
+
+/// A GNSS outage: fixes with start < t <= end are not used [s, filter time].
+struct OutageWindow {
+  double start = 0.0;  ///< last instant with GNSS [s]
+  double end = 0.0;    ///< end of the outage [s], > start
+};
+
+/// True states at the epochs where errors are recorded (time-ordered).
+struct TruthSeries {
+  std::vector<double> t;            ///< epochs [s], strictly increasing
+  std::vector<ins::NavState> x;     ///< true navigation state at each epoch
+};
+
+/// Inputs of one run. Pointers are non-owning and must outlive the call.
+struct NavRunInput {
+  ins::NavState x0;                                        ///< initial estimate at x0.t
+  const std::vector<ins::ImuSample>* imu = nullptr;        ///< raw samples (with errors), first covers (x0.t, x0.t + dt]
+  const std::vector<emulation::GnssFix>* gnss = nullptr;   ///< may be null (no GNSS)
+  const std::vector<emulation::BaroSample>* baro = nullptr;///< may be null (no baro)
+  const TruthSeries* truth = nullptr;                      ///< record epochs and truth; required
+};
+
+/// Options of one run.
+struct NavRunOptions {
+  filter::EkfConfig ekf;                        ///< filter options (propagate_every, ...)
+  filter::Matrix9d P0_nav = filter::Matrix9d::Identity();  ///< initial nav covariance [m, m/s, rad]^2
+  std::vector<OutageWindow> outages;            ///< GNSS outage windows
+  Eigen::Vector3d lever_arm_B = Eigen::Vector3d::Zero();   ///< GNSS antenna in body FRD [m]
+  bool baro_in_outage = true;                   ///< keep baro updates during GNSS outages
+  bool use_gnss_velocity = true;                ///< apply GNSS velocity besides position
+};
+
+/// Errors, sigmas and NEES at one record epoch.
+struct NavEpoch {
+  double t = 0.0;                   ///< [s]
+  filter::Vector9d err;             ///< estimate minus truth: dp NED [m], dv NED [m/s], psi [rad]
+  filter::Vector9d sigma;           ///< predicted 1-sigma of the same nine errors
+  std::array<double, 4> nees{};     ///< position (3 dof), velocity (3), attitude (3), all (9); NaN if P singular
+};
+
+/// What one outage did to this run.
+struct OutageSummary {
+  OutageWindow window;
+  int end_epoch = -1;               ///< index into NavRunResult::epochs of the last epoch <= end (-1: none)
+  double max_drift_h = 0.0;         ///< max horizontal position error over the epochs in (start, end] [m]
+  double max_drift_3d = 0.0;        ///< max 3-D position error over the same epochs [m]
+};
+
+/// Result of one run.
+struct NavRunResult {
+  std::vector<NavEpoch> epochs;     ///< one per truth epoch inside the IMU span
+  std::vector<OutageSummary> outages;  ///< one per NavRunOptions::outages
+  int states = 0;                   ///< EKF state count
+  std::size_t steps = 0;            ///< IMU samples processed
+  std::size_t gnss_updates = 0;     ///< GNSS fixes applied
+  std::size_t baro_updates = 0;     ///< baro samples applied
+  int rejections = 0;               ///< updates rejected by the chi-square gate
+  double wall_s = 0.0;              ///< wall-clock time of the run [s]
+};
+
+/**
+ * Run the filter over the inputs.
+ * @param[in] in     data (see NavRunInput); the IMU samples must be contiguous.
+ * @param[in] model  the IMU error model the FILTER uses (need not be the truth's).
+ * @param[in] opt    options.
+ * @throws navimpact::Error when inputs are missing, times are not increasing,
+ *         or a truth epoch does not fall on an IMU sample (to half an interval).
+ */
+NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
+                    const NavRunOptions& opt);
+
+/**
+ * NEES of the four blocks for an error @p err and covariance @p P9 (the 9x9
+ * navigation block): e' P^-1 e by Cholesky; NaN when a block is not positive
+ * definite.
+ */
+std::array<double, 4> navNees(const filter::Vector9d& err, const filter::Matrix9d& P9);
+
+}  // namespace navimpact::analysis

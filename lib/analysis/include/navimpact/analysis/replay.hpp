@@ -1,0 +1,92 @@
+/**
+ * @file replay.hpp
+ * @brief Replay of a rawlog (labels IMU, GNSS, BARO, GT; see rawlog/writer.hpp)
+ *        through the error-state EKF with GNSS outages injected, and its report:
+ *        solution.csv, summary.json and figures in the style of Khaghani et al.
+ *        (2019) Figures 8 and 9 (error and +-1 sigma envelope, outage shaded).
+ *
+ * The navigation loop is analysis::runNav() (shared with the emulation study).
+ * Time zero of a replay (for outages and outputs) is the start of the IMU data:
+ * the beginning of the first IMU interval, i.e. the first IMU timestamp minus
+ * one IMU period. An outage START:DURATION drops the GNSS fixes with
+ * START < t <= START + DURATION; the barometer keeps working.
+ *
+ * Configuration (YAML, every key optional; relative paths against its folder):
+ * @code
+ * rawlog: ../../datasets/uav_flight_260s_ref.rawlog
+ * model: ../models/navchip_table1.yaml:ref   # filter's IMU model; default: the rawlog's scenario model
+ * outages: [{start_s: 200, duration_s: 60}]  # [s] from time zero
+ * filter: {propagate_every: 10, use_gnss_velocity: true, gate_probability: 0}
+ * initial_sigma: {pos_h_m: 1, pos_v_m: 1, vel_mps: 0.1, roll_pitch_deg: 0.1, yaw_deg: 0.5}
+ * noise: {sigma_pos_h_m: 2, sigma_pos_v_m: 4, sigma_vel_h_mps: 0.05, sigma_vel_v_mps: 0.1, sigma_baro_m: 0.5}
+ * gnss_lever_arm_B_m: [0, 0, 0]              # default: the scenario's
+ * @endcode
+ * Without `noise`, the covariances recorded with each GNSS fix and the
+ * scenario's barometer sigma are used.
+ */
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "navimpact/analysis/nav_run.hpp"
+#include "navimpact/emulation/records.hpp"
+
+namespace navimpact::analysis {
+
+/// An outage in replay time [s].
+struct ReplayOutage {
+  double start_s = 0.0;     ///< last instant with GNSS, from time zero [s], >= 0
+  double duration_s = 0.0;  ///< [s], > 0
+};
+
+/// Parse "START:DURATION" (seconds). @throws navimpact::Error naming the text.
+ReplayOutage parseOutage(const std::string& text);
+
+/// Replay options (see the file comment for the YAML form).
+struct ReplayConfig {
+  std::string config_file;
+  std::string rawlog;
+  std::string model_spec;                       ///< "" = the rawlog scenario's model
+  std::vector<ReplayOutage> outages;
+  int propagate_every = 10;                     ///< covariance propagation every k IMU samples
+  bool use_gnss_velocity = true;
+  double gate_probability = 0.0;
+  double p0_pos_h_m = 1.0, p0_pos_v_m = 1.0, p0_vel_mps = 0.1;
+  double p0_roll_pitch_deg = 0.1, p0_yaw_deg = 0.5;
+  std::optional<double> sigma_pos_h_m, sigma_pos_v_m, sigma_vel_h_mps, sigma_vel_v_mps, sigma_baro_m;
+  std::optional<Eigen::Vector3d> lever_arm_B;
+};
+
+/// Read a replay configuration. @throws navimpact::Error naming file and key.
+ReplayConfig loadReplayConfig(const std::string& path);
+
+/// Everything a replay computed.
+struct ReplayResult {
+  ReplayConfig cfg;
+  std::string model_source;                 ///< the filter's IMU model
+  std::string scenario_yaml;                ///< the rawlog's comment
+  double t_zero = 0.0;                      ///< rawlog time of replay time zero [s]
+  double imu_rate_hz = 0.0;
+  NavRunResult run;                         ///< errors, sigmas, NEES at the GT epochs
+  std::vector<ins::NavState> truth;         ///< truth at the epochs
+  std::vector<ins::NavState> estimate;      ///< estimate at the epochs (truth (+) error)
+  std::vector<std::string> notices;
+};
+
+/**
+ * Run a replay: read the rawlog, check outages against the data, run the EKF.
+ * @throws navimpact::Error for a rawlog without IMU or GT, an outage outside
+ *         the data, a missing model.
+ */
+ReplayResult runReplay(const ReplayConfig& cfg);
+
+/// solution.csv text (one row per GT epoch; units in the header).
+std::string solutionCsv(const ReplayResult& r);
+/// summary.json text.
+std::string summaryJson(const ReplayResult& r);
+/// Write the figures (errors_full.png, errors_outage_K.png) into @p dir (existing).
+std::vector<std::string> writeReplayFigures(const ReplayResult& r, const std::string& dir);
+
+}  // namespace navimpact::analysis

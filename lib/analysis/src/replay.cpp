@@ -1,0 +1,491 @@
+// Rawlog replay through the shared navigation loop (runNav), and its report.
+#include "navimpact/analysis/replay.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <set>
+#include <sstream>
+#include <unistd.h>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/text_io.hpp"
+#include "navimpact/filter/error_model.hpp"
+#include "navimpact/plot/figure.hpp"
+#include "navimpact/rawlog/writer.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+
+namespace navimpact::analysis {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+std::string num(double x) {
+  std::ostringstream o;
+  o << std::setprecision(10) << x;
+  return o.str();
+}
+
+std::string resolve(const fs::path& dir, const std::string& p) {
+  if (p.empty() || fs::path(p).is_absolute() || dir.empty()) return p;
+  return (dir / p).lexically_normal().string();
+}
+
+std::string resolveModel(const fs::path& dir, const std::string& spec) {
+  const auto colon = spec.rfind(':');
+  if (colon != std::string::npos && colon > 1) return resolve(dir, spec.substr(0, colon)) + spec.substr(colon);
+  return resolve(dir, spec);
+}
+
+/// Roll, pitch, yaw [rad] errors of est w.r.t. truth (yaw wrapped).
+Eigen::Vector3d eulerError(const ins::NavState& est, const ins::NavState& truth) {
+  Eigen::Vector3d d = est.rollPitchYaw() - truth.rollPitchYaw();
+  for (int k = 0; k < 3; ++k) d[k] = ins::wrapAngle(d[k]);
+  return d;
+}
+
+/// 1-sigma of roll, pitch, yaw from the psi sigmas (J diag(s^2) J', cross-covariances ignored).
+Eigen::Vector3d eulerSigma(const ins::NavState& truth, const Eigen::Vector3d& sigPsi) {
+  const Eigen::Matrix3d C = truth.C_BtoN();
+  const Eigen::Vector3d e0 = ins::rollPitchYaw(C);
+  const double eps = 1e-6;
+  Eigen::Matrix3d J;
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    p[i] = eps;
+    Eigen::Vector3d d = ins::rollPitchYaw((Eigen::Matrix3d::Identity() + ins::skew(p)) * C) - e0;
+    for (int k = 0; k < 3; ++k) d[k] = ins::wrapAngle(d[k]);
+    J.col(i) = d / eps;
+  }
+  const Eigen::Matrix3d S = J * sigPsi.cwiseAbs2().asDiagonal() * J.transpose();
+  return S.diagonal().cwiseMax(0.0).cwiseSqrt();
+}
+
+}  // namespace
+
+ReplayOutage parseOutage(const std::string& text) {
+  const auto c = text.find(':');
+  ReplayOutage o;
+  if (c == std::string::npos || !parseDouble(trim(std::string_view(text).substr(0, c)), o.start_s) ||
+      !parseDouble(trim(std::string_view(text).substr(c + 1)), o.duration_s))
+    throw Error("outage '" + text + "': expected START:DURATION in seconds, e.g. 200:60");
+  if (!(o.start_s >= 0.0) || !(o.duration_s > 0.0))
+    throw Error("outage '" + text + "': START must be >= 0 s and DURATION > 0 s");
+  return o;
+}
+
+ReplayConfig loadReplayConfig(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw Error(path + ": cannot open the replay configuration");
+  } catch (const YAML::Exception& e) {
+    throw fileError(path, e.mark.line + 1, std::string("YAML syntax: ") + e.msg);
+  }
+  ReplayConfig c;
+  c.config_file = path;
+  const fs::path dir = fs::path(path).parent_path();
+  if (!root.IsMap()) throw keyError(path, "(root)", "expected a map");
+  const std::set<std::string> allowed = {"rawlog", "model", "outages", "filter", "initial_sigma", "noise",
+                                         "gnss_lever_arm_B_m"};
+  for (const auto& kv : root)
+    if (!allowed.count(kv.first.as<std::string>()))
+      throw keyError(path, kv.first.as<std::string>(),
+                     "unknown key (expected rawlog, model, outages, filter, initial_sigma, noise, gnss_lever_arm_B_m)");
+  auto num = [&](const YAML::Node& n, const std::string& key) {
+    try {
+      return n.as<double>();
+    } catch (const YAML::Exception&) {
+      throw keyError(path, key, "expected a number");
+    }
+  };
+  auto pos = [&](const YAML::Node& n, const std::string& key) {
+    const double v = num(n, key);
+    if (!(v > 0.0)) throw keyError(path, key, "must be > 0");
+    return v;
+  };
+  auto subKeys = [&](const YAML::Node& n, const std::string& name, const std::set<std::string>& ok) {
+    if (!n.IsMap()) throw keyError(path, name, "expected a map");
+    for (const auto& kv : n)
+      if (!ok.count(kv.first.as<std::string>()))
+        throw keyError(path, name + "." + kv.first.as<std::string>(), "unknown key");
+  };
+  if (root["rawlog"]) c.rawlog = resolve(dir, root["rawlog"].as<std::string>());
+  if (root["model"]) c.model_spec = resolveModel(dir, root["model"].as<std::string>());
+  if (const auto o = root["outages"]) {
+    if (!o.IsSequence()) throw keyError(path, "outages", "expected a list of {start_s, duration_s}");
+    for (std::size_t i = 0; i < o.size(); ++i) {
+      const std::string k = "outages[" + std::to_string(i) + "]";
+      subKeys(o[i], k, {"start_s", "duration_s"});
+      if (!o[i]["start_s"] || !o[i]["duration_s"]) throw keyError(path, k, "needs start_s and duration_s [s]");
+      ReplayOutage w{num(o[i]["start_s"], k + ".start_s"), pos(o[i]["duration_s"], k + ".duration_s")};
+      if (!(w.start_s >= 0.0)) throw keyError(path, k + ".start_s", "must be >= 0");
+      c.outages.push_back(w);
+    }
+  }
+  if (const auto f = root["filter"]) {
+    subKeys(f, "filter", {"propagate_every", "use_gnss_velocity", "gate_probability"});
+    if (f["propagate_every"]) {
+      c.propagate_every = f["propagate_every"].as<int>();
+      if (c.propagate_every < 1) throw keyError(path, "filter.propagate_every", "must be >= 1");
+    }
+    if (f["use_gnss_velocity"]) c.use_gnss_velocity = f["use_gnss_velocity"].as<bool>();
+    if (f["gate_probability"]) c.gate_probability = num(f["gate_probability"], "filter.gate_probability");
+  }
+  if (const auto p = root["initial_sigma"]) {
+    subKeys(p, "initial_sigma", {"pos_h_m", "pos_v_m", "vel_mps", "roll_pitch_deg", "yaw_deg"});
+    if (p["pos_h_m"]) c.p0_pos_h_m = pos(p["pos_h_m"], "initial_sigma.pos_h_m");
+    if (p["pos_v_m"]) c.p0_pos_v_m = pos(p["pos_v_m"], "initial_sigma.pos_v_m");
+    if (p["vel_mps"]) c.p0_vel_mps = pos(p["vel_mps"], "initial_sigma.vel_mps");
+    if (p["roll_pitch_deg"]) c.p0_roll_pitch_deg = pos(p["roll_pitch_deg"], "initial_sigma.roll_pitch_deg");
+    if (p["yaw_deg"]) c.p0_yaw_deg = pos(p["yaw_deg"], "initial_sigma.yaw_deg");
+  }
+  if (const auto n = root["noise"]) {
+    subKeys(n, "noise", {"sigma_pos_h_m", "sigma_pos_v_m", "sigma_vel_h_mps", "sigma_vel_v_mps", "sigma_baro_m"});
+    if (n["sigma_pos_h_m"]) c.sigma_pos_h_m = pos(n["sigma_pos_h_m"], "noise.sigma_pos_h_m");
+    if (n["sigma_pos_v_m"]) c.sigma_pos_v_m = pos(n["sigma_pos_v_m"], "noise.sigma_pos_v_m");
+    if (n["sigma_vel_h_mps"]) c.sigma_vel_h_mps = pos(n["sigma_vel_h_mps"], "noise.sigma_vel_h_mps");
+    if (n["sigma_vel_v_mps"]) c.sigma_vel_v_mps = pos(n["sigma_vel_v_mps"], "noise.sigma_vel_v_mps");
+    if (n["sigma_baro_m"]) c.sigma_baro_m = pos(n["sigma_baro_m"], "noise.sigma_baro_m");
+  }
+  if (const auto l = root["gnss_lever_arm_B_m"]) {
+    if (!l.IsSequence() || l.size() != 3) throw keyError(path, "gnss_lever_arm_B_m", "expected [x, y, z] in metres");
+    c.lever_arm_B = Eigen::Vector3d(num(l[0], "gnss_lever_arm_B_m"), num(l[1], "gnss_lever_arm_B_m"),
+                                    num(l[2], "gnss_lever_arm_B_m"));
+  }
+  return c;
+}
+
+ReplayResult runReplay(const ReplayConfig& cfg) {
+  if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
+  emulation::EmulationData d = rawlog::readRawlog(cfg.rawlog);
+  ReplayResult r;
+  r.cfg = cfg;
+  r.scenario_yaml = d.scenario_yaml;
+  r.notices = d.notices;
+  if (d.imu.size() < 2) throw Error(cfg.rawlog + ": no IMU data (label IMU) to replay");
+  if (d.truth.empty())
+    throw Error(cfg.rawlog + ": no ground truth (label GT): the replay reports errors against GT and needs it");
+
+  YAML::Node scen;
+  try {
+    if (!d.scenario_yaml.empty()) scen = YAML::Load(d.scenario_yaml)["navimpact_scenario"];
+  } catch (const YAML::Exception&) {
+  }
+  // IMU model of the filter.
+  stochastic::ImuModel model;
+  if (!cfg.model_spec.empty()) {
+    model = stochastic::loadImuModel(cfg.model_spec);
+    r.model_source = model.source;
+  } else if (scen && scen["imu_model_yaml"]) {
+    const fs::path tmp = fs::temp_directory_path() / ("navimpact_replay_model_" + std::to_string(::getpid()) + ".yaml");
+    std::ofstream(tmp) << scen["imu_model_yaml"].as<std::string>();
+    try {
+      model = stochastic::loadImuModel(tmp.string());
+    } catch (...) {
+      fs::remove(tmp);
+      throw;
+    }
+    fs::remove(tmp);
+    const std::string src = scen["imu"] && scen["imu"]["model"] ? scen["imu"]["model"].as<std::string>() : "";
+    model.source = "rawlog scenario model (" + src + ")";
+    r.model_source = model.source;
+  } else {
+    throw Error(cfg.rawlog + ": the scenario records no IMU error model: give one with --model FILE[:NAME]");
+  }
+
+  // IMU samples and time zero.
+  const double dt = d.imu[1].t - d.imu[0].t;
+  r.imu_rate_hz = 1.0 / dt;
+  r.t_zero = d.imu.front().t - dt;
+  std::vector<ins::ImuSample> imu(d.imu.size());
+  double prev = r.t_zero;
+  for (std::size_t k = 0; k < d.imu.size(); ++k) {
+    imu[k] = ins::ImuSample::fromRates(d.imu[k].t, d.imu[k].t - prev, d.imu[k].w_IB_B, d.imu[k].f_B);
+    prev = d.imu[k].t;
+  }
+  const double t_last = d.imu.back().t;
+
+  // Outages in rawlog time.
+  NavRunOptions opt;
+  for (const auto& o : cfg.outages) {
+    const double a = r.t_zero + o.start_s, b = a + o.duration_s;
+    if (b > t_last + 1e-6)
+      throw Error("outage " + num(o.start_s) + ":" + num(o.duration_s) + " ends at " + num(o.start_s + o.duration_s) +
+                  " s, after the data (IMU data span 0.." + num(t_last - r.t_zero) + " s)");
+    opt.outages.push_back({a, b});
+  }
+
+  // Measurement noise: recorded, or overridden.
+  double sBaro = NAN;
+  if (scen && scen["baro"] && scen["baro"]["sigma_m"]) sBaro = scen["baro"]["sigma_m"].as<double>();
+  if (cfg.sigma_baro_m) sBaro = *cfg.sigma_baro_m;
+  if (!d.baro.empty() && !std::isfinite(sBaro))
+    throw Error(cfg.rawlog + ": barometer sigma not recorded in the scenario: set noise.sigma_baro_m");
+  for (auto& b : d.baro) b.sigma = sBaro;
+  for (auto& f : d.gnss) {
+    Eigen::Vector3d sp = f.cov_pos_N.diagonal().cwiseSqrt(), sv = f.cov_vel_N.diagonal().cwiseSqrt();
+    if (cfg.sigma_pos_h_m) sp.head<2>().setConstant(*cfg.sigma_pos_h_m);
+    if (cfg.sigma_pos_v_m) sp[2] = *cfg.sigma_pos_v_m;
+    if (cfg.sigma_vel_h_mps) sv.head<2>().setConstant(*cfg.sigma_vel_h_mps);
+    if (cfg.sigma_vel_v_mps) sv[2] = *cfg.sigma_vel_v_mps;
+    if (!sp.allFinite() || !sv.allFinite())
+      throw Error(cfg.rawlog + ": GNSS fix at t = " + num(f.t) + " s has no covariance: set the noise.* sigmas");
+    f.cov_pos_N = sp.cwiseAbs2().asDiagonal();
+    f.cov_vel_N = sv.cwiseAbs2().asDiagonal();
+  }
+  Eigen::Vector3d lever = Eigen::Vector3d::Zero();
+  if (scen && scen["gnss"] && scen["gnss"]["lever_arm_B_m"]) {
+    const auto l = scen["gnss"]["lever_arm_B_m"].as<std::vector<double>>();
+    if (l.size() == 3) lever = Eigen::Vector3d(l[0], l[1], l[2]);
+  }
+  if (cfg.lever_arm_B) lever = *cfg.lever_arm_B;
+  opt.lever_arm_B = lever;
+
+  // Truth series from GT (tangent-plane NED at the origin -> geodetic).
+  TruthSeries truth;
+  for (const auto& g : d.truth) {
+    if (g.t < r.t_zero - 0.5 * dt || g.t > t_last + 0.5 * dt) continue;
+    ins::NavState x;
+    x.t = g.t;
+    const earth::Geodetic p = earth::nedToGeodetic(d.origin, g.p_L);
+    x.lat = p.lat;
+    x.lon = p.lon;
+    x.h = p.h;
+    x.v_N = g.v_N;
+    x.q_BtoN = g.q_BtoN.normalized();
+    truth.t.push_back(g.t);
+    truth.x.push_back(x);
+  }
+  if (truth.t.empty() || std::abs(truth.t.front() - r.t_zero) > 0.5 * dt)
+    throw Error(cfg.rawlog + ": no GT entry at the start of the IMU data (t = " + num(r.t_zero) +
+                " s) to initialise the filter from");
+
+  NavRunInput in;
+  in.x0 = truth.x.front();
+  in.x0.t = r.t_zero;
+  in.imu = &imu;
+  in.gnss = &d.gnss;
+  in.baro = &d.baro;
+  in.truth = &truth;
+  opt.ekf.propagate_every = cfg.propagate_every;
+  opt.ekf.gate_probability = cfg.gate_probability;
+  opt.use_gnss_velocity = cfg.use_gnss_velocity;
+  opt.P0_nav.setZero();
+  const double ph = cfg.p0_pos_h_m, pv = cfg.p0_pos_v_m, vv = cfg.p0_vel_mps;
+  const double rp = cfg.p0_roll_pitch_deg * kDeg, yw = cfg.p0_yaw_deg * kDeg;
+  opt.P0_nav.diagonal() << ph * ph, ph * ph, pv * pv, vv * vv, vv * vv, vv * vv, rp * rp, rp * rp, yw * yw;
+  r.run = runNav(in, model, opt);
+  for (const auto& e : r.run.epochs) {
+    std::size_t i = 0;
+    while (i < truth.t.size() && truth.t[i] < e.t - 1e-9) ++i;
+    const ins::NavState& x = truth.x[std::min(i, truth.t.size() - 1)];
+    r.truth.push_back(x);
+    r.estimate.push_back(filter::applyNavError(x, e.err));
+  }
+  return r;
+}
+
+std::string solutionCsv(const ReplayResult& r) {
+  std::ostringstream o;
+  o << "time_s,lat_deg,lon_deg,h_m,vN_mps,vE_mps,vD_mps,roll_deg,pitch_deg,yaw_deg,"
+       "sig_pN_m,sig_pE_m,sig_pD_m,sig_vN_mps,sig_vE_mps,sig_vD_mps,sig_roll_deg,sig_pitch_deg,sig_yaw_deg,"
+       "err_pN_m,err_pE_m,err_pD_m,err_vN_mps,err_vE_mps,err_vD_mps,err_roll_deg,err_pitch_deg,err_yaw_deg,"
+       "nees_pos,nees_vel,nees_att,nees_all,gnss\n";
+  o << std::setprecision(10);
+  for (std::size_t k = 0; k < r.run.epochs.size(); ++k) {
+    const auto& e = r.run.epochs[k];
+    const auto& x = r.estimate[k];
+    const Eigen::Vector3d rpy = x.rollPitchYaw() / kDeg;
+    const Eigen::Vector3d se = eulerSigma(r.truth[k], e.sigma.segment<3>(6)) / kDeg;
+    const Eigen::Vector3d ee = eulerError(x, r.truth[k]) / kDeg;
+    bool gnss = true;
+    for (const auto& w : r.cfg.outages)
+      if (e.t - r.t_zero > w.start_s + 1e-9 && e.t - r.t_zero <= w.start_s + w.duration_s + 1e-9) gnss = false;
+    o << e.t - r.t_zero << ',' << std::setprecision(12) << x.lat / kDeg << ',' << x.lon / kDeg << ','
+      << std::setprecision(10) << x.h << ',' << x.v_N[0] << ',' << x.v_N[1] << ',' << x.v_N[2] << ',' << rpy[0]
+      << ',' << rpy[1] << ',' << rpy[2];
+    for (int i = 0; i < 6; ++i) o << ',' << e.sigma[i];
+    for (int i = 0; i < 3; ++i) o << ',' << se[i];
+    for (int i = 0; i < 6; ++i) o << ',' << e.err[i];
+    for (int i = 0; i < 3; ++i) o << ',' << ee[i];
+    for (int i = 0; i < 4; ++i) o << ',' << e.nees[i];
+    o << ',' << (gnss ? 1 : 0) << '\n';
+  }
+  return o.str();
+}
+
+std::string summaryJson(const ReplayResult& r) {
+  using nlohmann::json;
+  json j;
+  j["rawlog"] = r.cfg.rawlog;
+  j["filter_model"] = r.model_source;
+  j["imu_rate_hz"] = r.imu_rate_hz;
+  j["time_zero_note"] = "times are seconds from the start of the IMU data (first IMU timestamp minus one period)";
+  j["propagate_every"] = r.cfg.propagate_every;
+  j["gnss_updates"] = r.run.gnss_updates;
+  j["baro_updates"] = r.run.baro_updates;
+  j["imu_steps"] = r.run.steps;
+  j["ekf_states"] = r.run.states;
+  j["filter_wall_s"] = r.run.wall_s;
+  try {
+    const YAML::Node s = YAML::Load(r.scenario_yaml)["navimpact_scenario"];
+    if (s) {
+      json seeds;
+      for (const char* k : {"imu", "gnss", "baro"})
+        if (s[k] && s[k]["seed"]) seeds[k] = s[k]["seed"].as<std::uint64_t>();
+      j["scenario_seeds"] = seeds;
+      if (s["imu"] && s["imu"]["model"]) j["scenario_imu_model"] = s["imu"]["model"].as<std::string>();
+      if (s["imu"] && s["imu"]["errors"]) j["scenario_imu_errors"] = s["imu"]["errors"].as<std::string>();
+    }
+  } catch (const YAML::Exception&) {
+  }
+  const auto& ep = r.run.epochs;
+  auto block = [&](std::size_t k, int b) { return ep[k].err.segment<3>(3 * b); };
+  json outs = json::array();
+  for (std::size_t i = 0; i < r.run.outages.size(); ++i) {
+    const auto& o = r.run.outages[i];
+    json jo;
+    jo["start_s"] = r.cfg.outages[i].start_s;
+    jo["duration_s"] = r.cfg.outages[i].duration_s;
+    if (o.end_epoch < 0) {
+      jo["note"] = "no GT epoch inside the outage";
+      outs.push_back(jo);
+      continue;
+    }
+    const std::size_t ke = static_cast<std::size_t>(o.end_epoch);
+    double maxPh = 0, maxPv = 0, maxVh = 0, maxVv = 0, neesSum = 0;
+    Eigen::Vector3d maxAtt = Eigen::Vector3d::Zero();
+    std::array<double, 4> neesB{};
+    int n = 0;
+    for (std::size_t k = 0; k <= ke; ++k) {
+      if (ep[k].t <= o.window.start) continue;
+      maxPh = std::max(maxPh, block(k, 0).head<2>().norm());
+      maxPv = std::max(maxPv, std::abs(block(k, 0)[2]));
+      maxVh = std::max(maxVh, block(k, 1).head<2>().norm());
+      maxVv = std::max(maxVv, std::abs(block(k, 1)[2]));
+      maxAtt = maxAtt.cwiseMax(eulerError(r.estimate[k], r.truth[k]).cwiseAbs() / kDeg);
+      for (int b = 0; b < 4; ++b) neesB[b] += ep[k].nees[b];
+      neesSum += ep[k].nees[3];
+      ++n;
+    }
+    const auto& e = ep[ke];
+    const Eigen::Vector3d attEnd = eulerError(r.estimate[ke], r.truth[ke]) / kDeg;
+    const Eigen::Vector3d attSig = eulerSigma(r.truth[ke], e.sigma.segment<3>(6)) / kDeg;
+    jo["end_epoch_s"] = e.t - r.t_zero;
+    jo["position"] = {{"horizontal_error_end_m", e.err.head<2>().norm()},
+                      {"vertical_error_end_m", std::abs(e.err[2])},
+                      {"horizontal_error_max_m", maxPh},
+                      {"vertical_error_max_m", maxPv},
+                      {"horizontal_sigma_end_m", e.sigma.head<2>().norm()},
+                      {"vertical_sigma_end_m", e.sigma[2]}};
+    jo["velocity"] = {{"horizontal_error_end_mps", e.err.segment<2>(3).norm()},
+                      {"vertical_error_end_mps", std::abs(e.err[5])},
+                      {"horizontal_error_max_mps", maxVh},
+                      {"vertical_error_max_mps", maxVv},
+                      {"horizontal_sigma_end_mps", e.sigma.segment<2>(3).norm()},
+                      {"vertical_sigma_end_mps", e.sigma[5]}};
+    jo["attitude_deg"] = {{"roll_pitch_yaw_error_end", {attEnd[0], attEnd[1], attEnd[2]}},
+                          {"roll_pitch_yaw_abs_error_max", {maxAtt[0], maxAtt[1], maxAtt[2]}},
+                          {"roll_pitch_yaw_sigma_end", {attSig[0], attSig[1], attSig[2]}}};
+    jo["mean_nees"] = {{"position_3dof", neesB[0] / n}, {"velocity_3dof", neesB[1] / n},
+                       {"attitude_3dof", neesB[2] / n}, {"all_9dof", neesSum / n}, {"epochs", n}};
+    outs.push_back(jo);
+  }
+  j["outages"] = outs;
+  // Overall RMS over all epochs.
+  double sPh = 0, sPv = 0, sV = 0;
+  Eigen::Vector3d sA = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < ep.size(); ++k) {
+    sPh += block(k, 0).head<2>().squaredNorm();
+    sPv += block(k, 0)[2] * block(k, 0)[2];
+    sV += block(k, 1).squaredNorm();
+    sA += (eulerError(r.estimate[k], r.truth[k]) / kDeg).cwiseAbs2();
+  }
+  const double n = std::max<std::size_t>(1, ep.size());
+  j["overall_rms"] = {{"horizontal_position_m", std::sqrt(sPh / n)},
+                      {"vertical_position_m", std::sqrt(sPv / n)},
+                      {"velocity_3d_mps", std::sqrt(sV / n)},
+                      {"roll_pitch_yaw_deg", {std::sqrt(sA[0] / n), std::sqrt(sA[1] / n), std::sqrt(sA[2] / n)}},
+                      {"epochs", ep.size()}};
+  j["notices"] = r.notices;
+  return j.dump(2) + "\n";
+}
+
+std::vector<std::string> writeReplayFigures(const ReplayResult& r, const std::string& dir) {
+  const auto& ep = r.run.epochs;
+  const std::size_t n = ep.size();
+  std::vector<double> t(n);
+  std::array<std::vector<double>, 9> err, sig;
+  for (auto& v : err) v.resize(n);
+  for (auto& v : sig) v.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    t[k] = ep[k].t - r.t_zero;
+    for (int i = 0; i < 6; ++i) {
+      err[i][k] = ep[k].err[i];
+      sig[i][k] = ep[k].sigma[i];
+    }
+    const Eigen::Vector3d ee = eulerError(r.estimate[k], r.truth[k]) / kDeg;
+    const Eigen::Vector3d se = eulerSigma(r.truth[k], ep[k].sigma.segment<3>(6)) / kDeg;
+    for (int i = 0; i < 3; ++i) {
+      err[6 + i][k] = ee[i];
+      sig[6 + i][k] = se[i];
+    }
+  }
+  const char* names[9] = {"north", "east", "down", "north", "east", "down", "roll", "pitch", "yaw"};
+  const char* units[3] = {"position error [m]", "velocity error [m/s]", "attitude error [deg]"};
+  auto figure = [&](double x0, double x1, const std::string& title) {
+    plot::Figure fig;
+    fig.width = 1800;
+    fig.height = 1200;
+    fig.rows = 3;
+    fig.cols = 3;
+    fig.title = title;
+    for (int i = 0; i < 9; ++i) {
+      plot::Axes ax;
+      ax.title = names[i];
+      if (i % 3 == 0) ax.ylabel = units[i / 3];
+      if (i >= 6) ax.xlabel = "time [s]";
+      ax.xlim = std::make_pair(x0, x1);
+      for (const auto& o : r.cfg.outages)
+        ax.spans.push_back({"GNSS outage", o.start_s, o.start_s + o.duration_s, {128, 128, 128}, 0.18});
+      std::vector<double> lo(n), hi(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        lo[k] = -sig[i][k];
+        hi[k] = sig[i][k];
+      }
+      ax.bands.push_back({"±1σ predicted", t, lo, hi, plot::palette(0), 0.22});
+      ax.series.push_back({"error", t, err[i], plot::palette(1), plot::LineStyle::Solid, plot::Marker::None, 1.6});
+      ax.legend = i == 0 ? plot::LegendPos::Best : plot::LegendPos::None;
+      fig.axes.push_back(ax);
+    }
+    return fig;
+  };
+  std::vector<std::string> files;
+  const double tEnd = n ? t.back() : 1.0;
+  plot::savePng(figure(0.0, tEnd, "Navigation errors (estimate − truth), filter model: " + r.model_source),
+                (fs::path(dir) / "errors_full.png").string());
+  files.push_back("errors_full.png");
+  for (std::size_t i = 0; i < r.cfg.outages.size(); ++i) {
+    const auto& o = r.cfg.outages[i];
+    const double a = std::max(0.0, o.start_s - 0.1 * o.duration_s);
+    const double b = std::min(tEnd, o.start_s + 1.1 * o.duration_s);
+    const std::string name = "errors_outage_" + std::to_string(i + 1) + ".png";
+    plot::savePng(figure(a, b, "GNSS outage " + std::to_string(i + 1) + ": " + num(o.duration_s) + " s from " +
+                                   num(o.start_s) + " s — errors and ±1σ"),
+                  (fs::path(dir) / name).string());
+    files.push_back(name);
+  }
+  return files;
+}
+
+}  // namespace navimpact::analysis

@@ -1,0 +1,649 @@
+// Monte Carlo emulation study: preparation, parallel runs, exact accumulation,
+// shards and their merge.
+#include "navimpact/analysis/study.hpp"
+
+#include <boost/math/distributions/chi_squared.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "navimpact/core/csv_reader.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/imu_series.hpp"
+#include "navimpact/core/units.hpp"
+#include "navimpact/emulation/perfect_imu.hpp"
+#include "navimpact/filter/error_model.hpp"
+#include "navimpact/filter/state_layout.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/simulate.hpp"
+#include "study_internal.hpp"
+
+namespace navimpact::analysis {
+
+using nlohmann::json;
+
+namespace {
+
+std::string num(double x, int prec = 6) {
+  std::ostringstream s;
+  s.precision(prec);
+  s << x;
+  return s.str();
+}
+
+/// Text of the six axis models, compact when the axes of a sensor agree.
+std::string describeModel(const stochastic::ImuModel& m) {
+  auto sensor = [&](int a0, const char* name) {
+    const auto& x = m.axis[a0];
+    const bool same = x.terms == m.axis[a0 + 1].terms && x.terms == m.axis[a0 + 2].terms;
+    std::string s = std::string(name) + ": ";
+    if (same) return s + stochastic::formatTerms(x.terms);
+    for (int i = a0; i < a0 + 3; ++i)
+      s += std::string(i > a0 ? "; " : "") + kChannelNames[i] + " " + stochastic::formatTerms(m.axis[i].terms);
+    return s;
+  };
+  return sensor(3, "acc") + " | " + sensor(0, "gyro");
+}
+
+}  // namespace
+
+namespace detail {
+
+double chi2Quantile(double p, double dof) {
+  boost::math::chi_squared d(dof);
+  return boost::math::quantile(d, p);
+}
+
+json metaToJson(const StudyMeta& m) {
+  json j;
+  j["version"] = m.version;
+  j["config_file"] = m.config_file;
+  j["config_text"] = m.config_text;
+  j["seed"] = m.seed;
+  j["runs_total"] = m.runs_total;
+  j["t0"] = m.t0;
+  j["duration_s"] = m.duration_s;
+  j["imu_rate_hz"] = m.imu_rate_hz;
+  j["trajectory"] = m.trajectory;
+  j["truth_description"] = m.truth_description;
+  j["notices"] = m.notices;
+  j["labels"] = m.labels;
+  j["sources"] = m.sources;
+  j["states"] = m.states;
+  json sets = json::array();
+  for (const auto& s : m.sets)
+    sets.push_back({{"name", s.name}, {"title", s.title}, {"models", s.models}, {"reference", s.reference},
+                    {"white_noise", s.white_noise}});
+  j["sets"] = sets;
+  json o = json::array();
+  for (const auto& w : m.outages) o.push_back({w.start, w.end});
+  j["outages"] = o;
+  j["epochs"] = m.epochs;
+  j["margin"] = m.margin;
+  j["plot_before_s"] = m.plot_before_s;
+  j["plot_after_s"] = m.plot_after_s;
+  j["settings"] = m.settings;
+  return j;
+}
+
+StudyMeta metaFromJson(const json& j, const std::string& where) {
+  try {
+    StudyMeta m;
+    m.version = j.at("version");
+    m.config_file = j.at("config_file");
+    m.config_text = j.at("config_text");
+    m.seed = j.at("seed");
+    m.runs_total = j.at("runs_total");
+    m.t0 = j.at("t0");
+    m.duration_s = j.at("duration_s");
+    m.imu_rate_hz = j.at("imu_rate_hz");
+    m.trajectory = j.at("trajectory");
+    m.truth_description = j.at("truth_description");
+    m.notices = j.at("notices").get<std::vector<std::string>>();
+    m.labels = j.at("labels").get<std::vector<std::string>>();
+    m.sources = j.at("sources").get<std::vector<std::string>>();
+    m.states = j.at("states").get<std::vector<int>>();
+    for (const auto& s : j.at("sets"))
+      m.sets.push_back({s.at("name"), s.at("title"), s.at("models").get<std::vector<std::string>>(),
+                        s.at("reference"), s.at("white_noise")});
+    for (const auto& o : j.at("outages")) m.outages.push_back({o.at(0), o.at(1)});
+    m.epochs = j.at("epochs").get<std::vector<double>>();
+    m.margin = j.at("margin");
+    m.plot_before_s = j.at("plot_before_s");
+    m.plot_after_s = j.at("plot_after_s");
+    m.settings = j.at("settings");
+    return m;
+  } catch (const json::exception& e) {
+    throw Error(where + ": not a navimpact study shard (" + e.what() + ")");
+  }
+}
+
+}  // namespace detail
+
+std::pair<double, double> aneesBand(std::size_t runs, int dof, double confidence) {
+  const double a = 0.5 * (1.0 - confidence), R = static_cast<double>(runs);
+  return {detail::chi2Quantile(a, R * dof) / R, detail::chi2Quantile(1.0 - a, R * dof) / R};
+}
+
+// ---------------------------------------------------------------------------
+// Plan
+
+class StudyPlan {
+ public:
+  StudyConfig cfg;
+  StudyMeta meta;
+  std::optional<emulation::SmoothTrajectory> traj;
+  std::vector<ins::ImuSample> perfect;
+  TruthSeries truth;
+  ins::NavState truth0;
+  double t0 = 0.0, t1 = 0.0;
+  stochastic::ImuModel truth_model;
+  std::optional<ImuSeries> recording;
+  std::size_t rec_block = 1;  // recording samples per IMU sample
+  std::vector<stochastic::ImuModel> filter_models;
+  NavRunOptions nav;
+};
+
+namespace {
+
+stochastic::ImuModel atRate(const stochastic::ImuModel& m, double rate, std::vector<std::string>& notices) {
+  if (std::abs(m.rate_hz - rate) <= 1e-9 * rate) return m;
+  notices.push_back("model " + m.source + " given at " + num(m.rate_hz) + " Hz, converted exactly to " +
+                    num(rate) + " Hz");
+  return stochastic::convertRate(m, rate);
+}
+
+stochastic::ImuModel buildCandidate(const CandidateSpec& c, double rate, std::vector<std::string>& notices) {
+  if (!c.model.empty()) {
+    stochastic::ImuModel m = atRate(stochastic::loadImuModel(c.model), rate, notices);
+    m.name = c.label;
+    return m;
+  }
+  stochastic::ImuModel m;
+  m.rate_hz = rate;
+  m.name = c.label;
+  m.source = "acc " + (c.accelerometer.empty() ? std::string("none") : c.accelerometer) + ", gyro " +
+             (c.gyroscope.empty() ? std::string("none") : c.gyroscope);
+  for (auto& a : m.axis) a.rate_hz = rate;
+  if (!c.accelerometer.empty()) {
+    const auto a = atRate(stochastic::loadImuModel(c.accelerometer), rate, notices);
+    for (int i = 3; i < 6; ++i) m.axis[i] = a.axis[i];
+  }
+  if (!c.gyroscope.empty()) {
+    const auto g = atRate(stochastic::loadImuModel(c.gyroscope), rate, notices);
+    for (int i = 0; i < 3; ++i) m.axis[i] = g.axis[i];
+  }
+  return m;
+}
+
+/// Measured errors of one run: a window of the recording (start from the
+/// seed as in emulation::staticImuErrors), block means to the IMU rate, the
+/// window mean removed per axis.
+std::array<std::vector<double>, 6> measuredWindow(const ImuSeries& rec, std::size_t m, std::size_t n,
+                                                  std::uint64_t seed) {
+  const std::size_t need = n * m, have = rec.size();
+  const std::size_t start = static_cast<std::size_t>(stochastic::deriveSeed(seed, 0) % (have - need + 1));
+  std::array<std::vector<double>, 6> out;
+  for (std::size_t i = 0; i < 6; ++i) {
+    out[i].assign(n, 0.0);
+    if (!rec.has(kChannelNames[i])) continue;
+    const auto& x = rec.channel(kChannelNames[i]).x;
+    double mean = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      double s = 0.0;
+      for (std::size_t j = 0; j < m; ++j) s += x[start + k * m + j];
+      out[i][k] = s / double(m);
+      mean += out[i][k];
+    }
+    mean /= double(n);
+    for (auto& v : out[i]) v -= mean;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std::string& version) {
+  if (cfg.runs < 1) throw Error("study: the number of runs must be >= 1");
+  if (cfg.candidates.empty()) throw Error("study: no candidate models");
+  auto plan = std::make_shared<StudyPlan>();
+  plan->cfg = cfg;
+  StudyMeta& meta = plan->meta;
+  const double rate = cfg.imu_rate_hz;
+
+  // Models first (cheap, most likely to be mistyped).
+  for (const auto& c : cfg.candidates) {
+    try {
+      plan->filter_models.push_back(buildCandidate(c, rate, meta.notices));
+      const auto layout = filter::StateLayout::build(plan->filter_models.back(), cfg.ekf.imu);
+      meta.states.push_back(layout.size());
+    } catch (const Error& e) {
+      throw Error("candidate '" + c.label + "': " + e.what());
+    }
+    meta.labels.push_back(c.label);
+    meta.sources.push_back(describeModel(plan->filter_models.back()));
+  }
+
+  // Trajectory and its smooth truth.
+  const emulation::SampledTrajectory samples = emulation::readTrajectoryCsv(cfg.trajectory);
+  plan->traj.emplace(samples, cfg.smoothing);
+  const auto& tr = *plan->traj;
+  plan->t0 = tr.tBegin();
+  const std::size_t n = static_cast<std::size_t>(std::floor((tr.tEnd() - tr.tBegin()) * rate + 1e-9));
+  plan->t1 = plan->t0 + double(n) / rate;
+  const double duration = plan->t1 - plan->t0;
+  meta.t0 = plan->t0;
+  meta.duration_s = duration;
+  meta.imu_rate_hz = rate;
+  meta.trajectory = cfg.trajectory.file + " (" + num(duration) + " s used)";
+
+  // Outages inside the trajectory.
+  for (const auto& o : cfg.outages) {
+    if (!(o.start >= 0.0 && o.end > o.start))
+      throw Error("outage (" + num(o.start) + ", " + num(o.end) + "] s is invalid");
+    if (o.end > duration + 1e-9)
+      throw Error("outage (" + num(o.start) + ", " + num(o.end) + "] s ends after the trajectory (" +
+                  num(duration) + " s of " + cfg.trajectory.file + ")");
+    meta.outages.push_back({plan->t0 + o.start, plan->t0 + o.end});
+  }
+
+  // True errors.
+  if (cfg.truth.kind == "model") {
+    plan->truth_model = atRate(stochastic::loadImuModel(cfg.truth.model), rate, meta.notices);
+    meta.truth_description = "simulated from model " + cfg.truth.model + " (" + describeModel(plan->truth_model) +
+                             ")";
+  } else {
+    plan->recording = readImuCsv(cfg.truth.recording.file, cfg.truth.recording.csv);
+    const ImuSeries& rec = *plan->recording;
+    const double ratio = rec.rate_hz / rate, m_real = std::round(ratio);
+    if (m_real < 1.0 || std::abs(ratio - m_real) > 1e-6 * ratio)
+      throw Error(cfg.truth.recording.file + ": static recording is at " + num(rec.rate_hz) + " Hz, emulation at " +
+                  num(rate) + " Hz (set imu.rate_hz to the recording's rate or an integer divisor of it)");
+    plan->rec_block = static_cast<std::size_t>(m_real);
+    if (n * plan->rec_block > rec.size())
+      throw Error(cfg.truth.recording.file + ": static recording too short: " + num(rec.size() / rec.rate_hz) +
+                  " s available, " + num(duration) + " s needed");
+    meta.truth_description = "measured static recording " + cfg.truth.recording.file + " (" +
+                             num(rec.size() / rec.rate_hz) + " s at " + num(rec.rate_hz) +
+                             " Hz): each run takes a " + num(duration) +
+                             " s window chosen by its seed, mean removed per axis" +
+                             (plan->rec_block > 1 ? ", block means of " + std::to_string(plan->rec_block) : "");
+  }
+
+  // Perfect IMU and record epochs (as IMU sample indices, t = t0 + k / rate).
+  plan->perfect = emulation::perfectImu(tr, rate, plan->t0, plan->t1);
+  if (plan->perfect.size() != n)
+    throw Error("study: perfect IMU has " + std::to_string(plan->perfect.size()) + " samples, expected " +
+                std::to_string(n));
+  std::vector<std::size_t> ks;
+  const auto step_out = std::max<std::size_t>(1, std::size_t(std::llround(rate / cfg.record_rate_hz)));
+  const auto step_in = std::max<std::size_t>(1, std::size_t(std::llround(rate / cfg.outage_record_rate_hz)));
+  for (std::size_t k = 0; k <= n; k += step_out) ks.push_back(k);
+  for (const auto& o : cfg.outages) {
+    const auto ks0 = std::size_t(std::llround(o.start * rate)), ke = std::size_t(std::llround(o.end * rate));
+    for (std::size_t k = ks0; k < ke; k += step_in) ks.push_back(k);
+    ks.push_back(std::min(ke, n));
+  }
+  std::sort(ks.begin(), ks.end());
+  ks.erase(std::unique(ks.begin(), ks.end()), ks.end());
+  for (std::size_t k : ks) {
+    const double t = plan->t0 + double(k) / rate;
+    plan->truth.t.push_back(t);
+    plan->truth.x.push_back(emulation::truthNavState(tr, t));
+    meta.epochs.push_back(t);
+  }
+  plan->truth0 = emulation::truthNavState(tr, plan->t0);
+
+  // Filter options.
+  NavRunOptions& nav = plan->nav;
+  nav.ekf = cfg.ekf;
+  nav.P0_nav = cfg.initial_sigma.cwiseAbs2().asDiagonal();
+  nav.outages = meta.outages;
+  nav.lever_arm_B = cfg.gnss.lever_arm_B;
+  nav.baro_in_outage = cfg.baro_in_outage;
+
+  meta.version = version;
+  meta.config_file = cfg.config_file;
+  meta.config_text = cfg.config_text;
+  meta.seed = cfg.seed;
+  meta.runs_total = cfg.runs;
+  meta.sets = cfg.sets;
+  meta.margin = cfg.margin;
+  meta.plot_before_s = cfg.plot_before_s;
+  meta.plot_after_s = cfg.plot_after_s;
+  std::ostringstream st;
+  st << "IMU " << num(rate) << " Hz; GNSS " << num(cfg.gnss.rate_hz) << " Hz, position sigma "
+     << num(cfg.gnss.sigma_pos_h_m) << " m horizontal / " << num(cfg.gnss.sigma_pos_v_m)
+     << " m vertical, velocity sigma " << num(cfg.gnss.sigma_vel_h_mps) << " / " << num(cfg.gnss.sigma_vel_v_mps)
+     << " m/s\n"
+     << "barometer " << num(cfg.baro.rate_hz) << " Hz, sigma " << num(cfg.baro.sigma_m) << " m, "
+     << (cfg.baro_in_outage ? "kept during GNSS outages" : "off during GNSS outages") << "\n"
+     << "EKF: covariance propagated every " << cfg.ekf.propagate_every << " IMU samples ("
+     << (cfg.ekf.discretization == filter::Discretization::Series ? "series" : "Van Loan")
+     << " discretisation); initial error sigmas " << num(cfg.initial_sigma(0)) << " m, "
+     << num(cfg.initial_sigma(3)) << " m/s, roll/pitch " << num(cfg.initial_sigma(6) / units::kDeg)
+     << " deg, yaw " << num(cfg.initial_sigma(8) / units::kDeg) << " deg (drawn per run, same for all models)";
+  meta.settings = st.str();
+  return plan;
+}
+
+// ---------------------------------------------------------------------------
+// One run: the shared realisation, then every candidate model.
+
+namespace {
+
+RunRecord doRun(const StudyPlan& p, std::uint64_t index) {
+  const StudyConfig& cfg = p.cfg;
+  RunRecord rec;
+  rec.index = index;
+  rec.seed = stochastic::deriveSeed(cfg.seed, index);
+  const std::size_t n = p.perfect.size();
+
+  // IMU errors, shared by every candidate model.
+  std::array<std::vector<double>, 6> err;
+  if (p.recording) {
+    err = measuredWindow(*p.recording, p.rec_block, n, stochastic::deriveSeed(rec.seed, 4));
+  } else {
+    err = emulation::modelImuErrors(p.truth_model, cfg.imu_rate_hz, n, stochastic::deriveSeed(rec.seed, 0)).axis;
+  }
+  std::vector<ins::ImuSample> imu = p.perfect;
+  for (std::size_t k = 0; k < n; ++k) {
+    ins::ImuSample& s = imu[k];
+    for (int a = 0; a < 3; ++a) {
+      s.dtheta_B(a) += err[a][k] * s.dt;
+      s.dv_B(a) += err[3 + a][k] * s.dt;
+    }
+  }
+  emulation::GnssOptions g = cfg.gnss;
+  g.seed = stochastic::deriveSeed(rec.seed, 1);
+  emulation::BaroOptions b = cfg.baro;
+  b.seed = stochastic::deriveSeed(rec.seed, 2);
+  const auto gnss = emulation::simulateGnss(*p.traj, g, p.t0, p.t1);
+  const auto baro = emulation::simulateBaro(*p.traj, b, p.t0, p.t1);
+  const auto z = emulation::standardNormal(9, stochastic::deriveSeed(rec.seed, 3));
+  filter::Vector9d dx0;
+  for (int i = 0; i < 9; ++i) dx0(i) = cfg.initial_sigma(i) * z[i];
+  NavRunInput in;
+  in.x0 = filter::applyNavError(p.truth0, dx0);
+  in.x0.t = p.t0;
+  in.imu = &imu;
+  in.gnss = &gnss;
+  in.baro = &baro;
+  in.truth = &p.truth;
+
+  const std::size_t E = p.truth.t.size(), O = p.nav.outages.size();
+  for (const auto& model : p.filter_models) {
+    const NavRunResult r = runNav(in, model, p.nav);
+    if (r.epochs.size() != E)
+      throw Error("study: run " + std::to_string(index) + " recorded " + std::to_string(r.epochs.size()) +
+                  " epochs, expected " + std::to_string(E));
+    RunRecord::Model m;
+    m.epochs.resize(E * detail::kEpochValues);
+    for (std::size_t k = 0; k < E; ++k) {
+      double* d = &m.epochs[k * detail::kEpochValues];
+      for (int j = 0; j < 9; ++j) {
+        d[j] = r.epochs[k].err(j);
+        d[9 + j] = r.epochs[k].sigma(j);
+      }
+      for (int j = 0; j < 4; ++j) d[18 + j] = r.epochs[k].nees[j];
+    }
+    for (std::size_t o = 0; o < O; ++o) {
+      m.drift.push_back(r.outages[o].max_drift_h);
+      m.drift.push_back(r.outages[o].max_drift_3d);
+    }
+    m.wall_s = r.wall_s;
+    m.steps = r.steps;
+    rec.models.push_back(std::move(m));
+  }
+  return rec;
+}
+
+}  // namespace
+
+void StudyAccumulator::add(const RunRecord& r, std::size_t E, std::size_t O) {
+  static const double q68[2] = {detail::chi2Quantile(0.6826894921370859, 3),
+                                detail::chi2Quantile(0.6826894921370859, 9)};
+  static const double q95[2] = {detail::chi2Quantile(0.95, 3), detail::chi2Quantile(0.95, 9)};
+  if (models.empty()) {
+    models.resize(r.models.size());
+    for (auto& m : models) {
+      m.e.assign(9 * E, 0.0);
+      m.e2.assign(9 * E, 0.0);
+      m.s2.assign(9 * E, 0.0);
+      m.nees.assign(4 * E, 0.0);
+      m.n_valid.assign(4 * E, 0.0);
+      m.in68.assign(4 * E, 0.0);
+      m.in95.assign(4 * E, 0.0);
+      m.drift_h.assign(O, 0.0);
+      m.drift_h2.assign(O, 0.0);
+      m.drift_3d.assign(O, 0.0);
+    }
+  }
+  if (r.models.size() != models.size()) throw Error("study: run record with a different number of models");
+  for (std::size_t mi = 0; mi < models.size(); ++mi) {
+    Model& a = models[mi];
+    const RunRecord::Model& x = r.models[mi];
+    if (x.epochs.size() != E * detail::kEpochValues || x.drift.size() != 2 * O)
+      throw Error("study: run record " + std::to_string(r.index) + " has the wrong size");
+    for (std::size_t k = 0; k < E; ++k) {
+      const double* d = &x.epochs[k * detail::kEpochValues];
+      for (int j = 0; j < 9; ++j) {
+        a.e[9 * k + j] += d[j];
+        a.e2[9 * k + j] += d[j] * d[j];
+        a.s2[9 * k + j] += d[9 + j] * d[9 + j];
+      }
+      for (int b = 0; b < 4; ++b) {
+        const double v = d[18 + b];
+        if (!std::isfinite(v)) continue;
+        const int q = b == 3 ? 1 : 0;
+        a.nees[4 * k + b] += v;
+        a.n_valid[4 * k + b] += 1.0;
+        a.in68[4 * k + b] += v <= q68[q] ? 1.0 : 0.0;
+        a.in95[4 * k + b] += v <= q95[q] ? 1.0 : 0.0;
+      }
+    }
+    for (std::size_t o = 0; o < O; ++o) {
+      a.drift_h[o] += x.drift[2 * o];
+      a.drift_h2[o] += x.drift[2 * o] * x.drift[2 * o];
+      a.drift_3d[o] += x.drift[2 * o + 1];
+    }
+    a.wall_s += x.wall_s;
+    a.steps += double(x.steps);
+  }
+  ++runs;
+}
+
+StudyResults runStudy(const std::shared_ptr<const StudyPlan>& plan, const Shard& shard, unsigned threads,
+                      const ProgressFn& progress) {
+  if (!plan) throw Error("study: no plan");
+  const StudyPlan& p = *plan;
+  StudyResults res;
+  res.meta = p.meta;
+  res.shard = shard;
+  for (std::size_t i = 0; i < p.cfg.runs; ++i)
+    if (shard.contains(i)) res.run_indices.push_back(i);
+  const std::size_t N = res.run_indices.size();
+  if (N == 0) throw Error("study: shard " + std::to_string(shard.k) + "/" + std::to_string(shard.n) +
+                          " holds no run (only " + std::to_string(p.cfg.runs) + " runs)");
+  const std::size_t E = p.truth.t.size(), O = p.nav.outages.size();
+  threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(N)));
+
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::mutex mu;
+  std::map<std::size_t, RunRecord> pending;  // finished out of order, by position
+  std::size_t merged = 0;
+  std::exception_ptr failure;
+  auto worker = [&]() {
+    for (;;) {
+      if (stop) return;
+      const std::size_t pos = next++;
+      if (pos >= N) return;
+      RunRecord rec;
+      try {
+        rec = doRun(p, res.run_indices[pos]);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mu);
+        if (!failure) failure = std::current_exception();
+        stop = true;
+        return;
+      }
+      std::lock_guard<std::mutex> lock(mu);
+      pending.emplace(pos, std::move(rec));
+      // Add in run-index order: the sums do not depend on scheduling.
+      for (auto it = pending.find(merged); it != pending.end(); it = pending.find(merged)) {
+        res.acc.add(it->second, E, O);
+        if (!shard.whole()) res.records.push_back(std::move(it->second));
+        pending.erase(it);
+        ++merged;
+        if (progress) progress(merged, N);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+  return res;
+}
+
+// ---------------------------------------------------------------------------
+// Shards
+
+namespace {
+constexpr char kMagic[8] = {'N', 'I', 'S', 'T', 'U', 'D', 'Y', '1'};
+
+void putU64(std::ostream& o, std::uint64_t v) { o.write(reinterpret_cast<const char*>(&v), 8); }
+void putD(std::ostream& o, const double* v, std::size_t n) {
+  o.write(reinterpret_cast<const char*>(v), static_cast<std::streamsize>(8 * n));
+}
+std::uint64_t getU64(std::istream& i, const std::string& f) {
+  std::uint64_t v = 0;
+  if (!i.read(reinterpret_cast<char*>(&v), 8)) throw Error(f + ": truncated");
+  return v;
+}
+void getD(std::istream& i, double* v, std::size_t n, const std::string& f) {
+  if (!i.read(reinterpret_cast<char*>(v), static_cast<std::streamsize>(8 * n))) throw Error(f + ": truncated");
+}
+}  // namespace
+
+void writeShard(const StudyResults& r, OutputSet& out) {
+  json j;
+  j["navimpact_study_shard"] = 1;
+  j["meta"] = detail::metaToJson(r.meta);
+  j["shard"] = {{"k", r.shard.k}, {"n", r.shard.n}};
+  j["run_indices"] = r.run_indices;
+  j["byte_order"] = "native little-endian IEEE-754 doubles";
+  out.writeText("shard.json", j.dump(1) + "\n");
+  const std::size_t E = r.meta.epochs.size(), O = r.meta.outages.size();
+  std::ofstream f(out.stage("runs.bin"), std::ios::binary);
+  f.write(kMagic, 8);
+  putU64(f, r.records.size());
+  putU64(f, r.meta.labels.size());
+  putU64(f, E);
+  putU64(f, O);
+  for (const RunRecord& rec : r.records) {
+    putU64(f, rec.index);
+    putU64(f, rec.seed);
+    for (const auto& m : rec.models) {
+      putD(f, &m.wall_s, 1);
+      putU64(f, m.steps);
+      putD(f, m.epochs.data(), m.epochs.size());
+      putD(f, m.drift.data(), m.drift.size());
+    }
+  }
+  if (!f) throw Error(out.dir().string() + "/runs.bin: write failed");
+}
+
+StudyResults mergeShards(const std::vector<std::string>& dirs) {
+  if (dirs.empty()) throw Error("study-merge: no shard folders given");
+  struct In {
+    std::string dir;
+    std::unique_ptr<std::ifstream> f;
+    std::vector<std::uint64_t> idx;
+    std::size_t pos = 0;
+  };
+  std::vector<In> ins;
+  StudyResults res;
+  json first_meta;
+  for (const auto& d : dirs) {
+    const std::string sj = d + "/shard.json";
+    std::ifstream fj(sj);
+    if (!fj) throw Error(sj + ": cannot open (is " + d + " a folder written by navimpact study --shard?)");
+    json j;
+    try {
+      fj >> j;
+    } catch (const json::exception& e) {
+      throw Error(sj + ": not valid JSON (" + e.what() + ")");
+    }
+    if (!j.contains("navimpact_study_shard")) throw Error(sj + ": not a navimpact study shard");
+    const json meta = j.at("meta");
+    if (ins.empty()) {
+      first_meta = meta;
+      res.meta = detail::metaFromJson(meta, sj);
+    } else {
+      for (const char* k : {"config_text", "seed", "runs_total", "labels", "epochs", "outages", "version"})
+        if (meta.at(k) != first_meta.at(k))
+          throw Error(sj + ": shard of a different study (" + std::string(k) + " differs from " + dirs[0] + ")");
+    }
+    In in;
+    in.dir = d;
+    in.idx = j.at("run_indices").get<std::vector<std::uint64_t>>();
+    const std::string bin = d + "/runs.bin";
+    in.f = std::make_unique<std::ifstream>(bin, std::ios::binary);
+    if (!*in.f) throw Error(bin + ": cannot open");
+    char magic[8];
+    if (!in.f->read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0) throw Error(bin + ": not a study run file");
+    const auto nr = getU64(*in.f, bin), nm = getU64(*in.f, bin), E = getU64(*in.f, bin), O = getU64(*in.f, bin);
+    if (nr != in.idx.size() || nm != res.meta.labels.size() || E != res.meta.epochs.size() ||
+        O != res.meta.outages.size())
+      throw Error(bin + ": header does not match shard.json");
+    ins.push_back(std::move(in));
+  }
+  // Every run exactly once.
+  const std::size_t R = res.meta.runs_total;
+  std::vector<int> owner(R, -1);
+  for (std::size_t s = 0; s < ins.size(); ++s)
+    for (auto i : ins[s].idx) {
+      if (i >= R) throw Error(ins[s].dir + ": run index " + std::to_string(i) + " out of range");
+      if (owner[i] >= 0)
+        throw Error("run " + std::to_string(i) + " is in both " + ins[owner[i]].dir + " and " + ins[s].dir);
+      owner[i] = static_cast<int>(s);
+    }
+  for (std::size_t i = 0; i < R; ++i)
+    if (owner[i] < 0) throw Error("study-merge: run " + std::to_string(i) + " of " + std::to_string(R) +
+                                  " is in no shard (give every shard folder)");
+  const std::size_t E = res.meta.epochs.size(), O = res.meta.outages.size(), M = res.meta.labels.size();
+  for (std::size_t i = 0; i < R; ++i) {
+    In& in = ins[owner[i]];
+    const std::string bin = in.dir + "/runs.bin";
+    RunRecord rec;
+    rec.index = getU64(*in.f, bin);
+    rec.seed = getU64(*in.f, bin);
+    if (rec.index != i) throw Error(bin + ": runs not in index order (found " + std::to_string(rec.index) + ")");
+    rec.models.resize(M);
+    for (auto& m : rec.models) {
+      getD(*in.f, &m.wall_s, 1, bin);
+      m.steps = getU64(*in.f, bin);
+      m.epochs.resize(E * detail::kEpochValues);
+      m.drift.resize(2 * O);
+      getD(*in.f, m.epochs.data(), m.epochs.size(), bin);
+      getD(*in.f, m.drift.data(), m.drift.size(), bin);
+    }
+    res.acc.add(rec, E, O);
+    res.run_indices.push_back(i);
+  }
+  res.shard = Shard{1, 1};
+  return res;
+}
+
+}  // namespace navimpact::analysis
