@@ -1,7 +1,7 @@
 // navimpact fit: GMWM fit of an IMU error model to a static recording.
 //   navimpact fit --input FILE [--rate HZ] [--gyro-unit U] [--acc-unit U] [--axes SPEC]
 //                 [--label L] [--channels gyro_x,...] --structure SPEC|auto
-//                 [--max-gm N] [--bootstrap N] [--seed S] --out DIR
+//                 [--max-gm N] [--bootstrap N] [--intervals profile|asymptotic] [--seed S] --out DIR
 // Writes DIR/model.yaml (stochastic::loadImuModel reads it back), DIR/fit.json
 // (estimates, intervals, WV and model WV per channel) and one WV figure per
 // sensor (fit_gyroscope.png, fit_accelerometer.png), all or nothing.
@@ -42,6 +42,7 @@ struct Opts {
   std::string structure;
   int max_gm = 3;
   int bootstrap = 0;
+  std::string intervals = "profile";
   std::uint64_t seed = 20190101;
   std::string out;
 };
@@ -158,6 +159,12 @@ int run(const Opts& o) {
 
   gm::FitOptions fo;
   fo.bootstrap = o.bootstrap;
+  if (o.intervals == "profile")
+    fo.intervals = gm::IntervalMethod::Profile;
+  else if (o.intervals == "asymptotic")
+    fo.intervals = gm::IntervalMethod::Asymptotic;
+  else
+    throw navimpact::Error("--intervals: expected 'profile' or 'asymptotic', got '" + o.intervals + "'");
   fo.seed = o.seed;
   const auto cands = gm::defaultCandidates(o.max_gm);
 
@@ -303,6 +310,9 @@ navimpact::cli::Registrar reg({
           ->required();
       app.add_option("--max-gm", o->max_gm, "auto: largest number of GM terms among the candidates (0..3)");
       app.add_option("--bootstrap", o->bootstrap, "parametric bootstrap replicates for the intervals (0: asymptotic)");
+      app.add_option("--intervals", o->intervals,
+                     "95 % intervals without --bootstrap: profile (default; follows the objective along "
+                     "GM/RW ridges) or asymptotic (delta method)");
       app.add_option("--seed", o->seed, "seed of the bootstrap");
       app.add_option("--out", o->out, "output directory (model.yaml, fit.json, fit_*.png)")->required();
       return [o]() -> int { return run(*o); };

@@ -215,13 +215,26 @@ void clampToBounds(Eigen::VectorXd& th, const Layout& L, const Data& d) {
 
 /// Minimise sum (w_j (nu_hat_j - nu_j))^2 from @p th (in place); returns the criterion.
 double solve(const Layout& L, Eigen::VectorXd& th, const Data& d, const Eigen::VectorXd& w,
-             bool* converged = nullptr) {
+             bool* converged = nullptr, int fixed = -1,
+             const std::vector<std::pair<double, double>>* bands = nullptr) {
   clampToBounds(th, L, d);
+  if (bands)
+    for (int k = 0; k < L.p; ++k) th[k] = std::clamp(th[k], (*bands)[k].first, (*bands)[k].second);
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem pb(po);
   pb.AddResidualBlock(new WvCost(L, d.tau, d.nu_hat, w), nullptr, th.data());
   setBounds(pb, th.data(), L, d);
+  if (bands)
+    for (int k = 0; k < L.p; ++k)
+      if (std::isfinite((*bands)[k].first)) {
+        pb.SetParameterLowerBound(th.data(), k, (*bands)[k].first);
+        pb.SetParameterUpperBound(th.data(), k, (*bands)[k].second);
+      }
+  if (fixed >= 0) {
+    if (L.p == 1) return criterion(L, th, d, w);
+    pb.SetManifold(th.data(), new ceres::SubsetManifold(L.p, {fixed}));
+  }
   ceres::Solver::Options so;
   so.minimizer_type = ceres::TRUST_REGION;
   so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
@@ -574,6 +587,56 @@ std::vector<std::vector<ParamInterval>> intervalsFromTheta(const Layout& L, cons
   return ci;
 }
 
+/**
+ * Profile interval of parameter k (transformed space): the set of values
+ * where the objective, minimised over the other parameters, stays within
+ * c_k of the optimum. c_k = z^2 Psi_kk / (B^+)_kk calibrates the threshold
+ * to the sandwich variance Psi (the objective is not a likelihood: Omega is
+ * not V^-1): for a locally quadratic objective the interval equals the
+ * delta-method one, but it follows the objective along the ridges where a
+ * GM with a long T trades against a RW/DR or another GM (where the Wald
+ * interval is far too narrow). Walks outward in steps of se_k (doubling
+ * after 8 steps) up to +-30 (a factor e^30), interpolating the crossing.
+ * GM terms keep their identity: each log T stays between the neighbouring
+ * GMs' estimated T (no label switching).
+ */
+void profileInterval(const Layout& L, const Data& d, const Eigen::VectorXd& th, double obj, int k,
+                     double c, double se, const std::vector<std::pair<double, double>>& bands, double& lo,
+                     double& hi) {
+  const double step0 = std::clamp(se, 0.02, 1.0);
+  for (int dir : {-1, +1}) {
+    Eigen::VectorXd t = th;
+    double prev_x = th[k], prev_d = 0.0, x = th[k], step = step0;
+    double edge = th[k] + dir * 30.0;
+    if (std::isfinite(bands[k].first)) edge = dir < 0 ? std::max(edge, bands[k].first) : std::min(edge, bands[k].second);
+    bool crossed = false;
+    for (int it = 0; it < 40; ++it) {
+      if (it >= 8) step *= 2.0;
+      x = prev_x + dir * step;
+      if ((x - edge) * dir > 0) x = edge;
+      t[k] = x;
+      clampToBounds(t, L, d);
+      if (t[k] != x) {  // hit a parameter bound: the interval extends to it
+        x = t[k];
+        edge = x;
+      }
+      solve(L, t, d, d.w_obj, nullptr, k, &bands);
+      const double delta = criterion(L, t, d, d.w_obj) - obj;
+      if (delta > c) {
+        const double f = (c - prev_d) / (delta - prev_d);
+        x = prev_x + std::clamp(f, 0.0, 1.0) * (x - prev_x);
+        crossed = true;
+        break;
+      }
+      prev_x = x;
+      prev_d = std::max(delta, 0.0);
+      if (x == edge) break;
+    }
+    if (!crossed) x = prev_x;
+    (dir < 0 ? lo : hi) = x;
+  }
+}
+
 constexpr double kZ975 = 1.959963984540054;  // standard normal 97.5 % quantile
 
 }  // namespace
@@ -659,12 +722,34 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
     }
     r.ci_method = "bootstrap(" + std::to_string(opt.bootstrap) + ")";
   } else {
+    Eigen::MatrixXd Binv;
+    if (opt.intervals == IntervalMethod::Profile) {
+      const Eigen::MatrixXd A = detail::jacobian(L, th, wv.tau);
+      Binv = pinvSym(A.transpose() * d.omega.asDiagonal() * A);
+    }
+    const double obj = criterion(L, th, d, d.w_obj);
+    // Identity bands of the GM log T (th is sorted by T): between the neighbours.
+    std::vector<std::pair<double, double>> bands(p, {-HUGE_VAL, HUGE_VAL});
+    std::vector<int> gmT;
+    for (std::size_t i = 0; i < L.kinds.size(); ++i)
+      if (L.kinds[i] == ProcessKind::GM) gmT.push_back(L.offset[i] + 1);
+    for (std::size_t q = 0; q < gmT.size(); ++q) {
+      bands[gmT[q]].first = q == 0 ? std::log(0.05) : th[gmT[q - 1]];
+      bands[gmT[q]].second = q + 1 == gmT.size() ? std::log(1000.0 * d.n) : th[gmT[q + 1]];
+    }
     for (int k = 0; k < p; ++k) {
       const double se = std::sqrt(std::max(r.cov_transformed(k, k), 0.0));
       lo[k] = th[k] - kZ975 * se;
       hi[k] = th[k] + kZ975 * se;
+      if (opt.intervals == IntervalMethod::Profile && Binv(k, k) > 0 && se > 0) {
+        const double c = kZ975 * kZ975 * se * se / Binv(k, k);
+        double plo = lo[k], phi = hi[k];
+        profileInterval(L, d, th, obj, k, c, se, bands, plo, phi);
+        lo[k] = std::min(plo, th[k]);
+        hi[k] = std::max(phi, th[k]);
+      }
     }
-    r.ci_method = "asymptotic";
+    r.ci_method = opt.intervals == IntervalMethod::Profile ? "profile" : "asymptotic";
   }
   r.ci = intervalsFromTheta(L, th, lo, hi, d.rate);
   return r;

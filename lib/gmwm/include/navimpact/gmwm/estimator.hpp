@@ -20,8 +20,15 @@
 
 namespace navimpact::gmwm {
 
+/// How the 95 % intervals are formed (all in the transformed space, so they stay positive).
+enum class IntervalMethod {
+  Asymptotic,  ///< delta method (sandwich covariance), theta_hat +- 1.96 se
+  Profile,     ///< objective profile with the threshold calibrated to the sandwich variance
+};
+
 struct FitOptions {
-  int bootstrap = 0;             ///< parametric bootstrap replicates for CIs (0 = asymptotic)
+  int bootstrap = 0;             ///< parametric bootstrap replicates for CIs (0 = asymptotic/profile)
+  IntervalMethod intervals = IntervalMethod::Asymptotic;  ///< used when bootstrap == 0
   std::uint64_t seed = 20190101; ///< seed of the bootstrap / random starts
   int max_starts = 0;            ///< 0 = automatic multi-start count
   /// Extra starting points: fitted models of sub-structures (e.g. the same
@@ -43,7 +50,7 @@ struct FitResult {
   stochastic::Model model;                       ///< estimated model, per-sample SI at rate_hz
   double objective = 0.0;                        ///< value of the weighted objective
   std::vector<std::vector<ParamInterval>> ci;    ///< per term, per parameter
-  std::string ci_method;                         ///< "asymptotic" or "bootstrap(N)"
+  std::string ci_method;                         ///< "asymptotic", "profile" or "bootstrap(N)"
   int starts = 0;                                ///< starting points tried
   bool converged = false;
   /// Parameter covariance in the transformed space (log sigma, log T, ...),
