@@ -40,6 +40,8 @@ struct ErrorStateEkf::Cache {
   double nominal_dt = 0.0;
   Transition T;
   Transition tmp;                   // scratch
+  MatrixXd Fni, FniFii, FniQii, FniQiiFii, FniFiiQii;  // scratch of the series form
+  MatrixXd Mni;                     // scratch of the propagation
 };
 
 namespace {
@@ -160,12 +162,26 @@ void ErrorStateEkf::buildTransition(double dt, Transition& T) const {
   // Qd to third order, computed block by block.
   const Matrix9d Fnn = navErrorDynamics(state(), f_B_);
   const Eigen::Matrix3d C = state().C_BtoN();
-  MatrixXd Fni = MatrixXd::Zero(9, m), FniFii = MatrixXd::Zero(9, m), FniQii = MatrixXd::Zero(9, m),
-           FniQiiFii = MatrixXd::Zero(9, m), FniFiiQii = MatrixXd::Zero(9, m);
+  MatrixXd& Fni = c.Fni;
+  MatrixXd& FniFii = c.FniFii;
+  MatrixXd& FniQii = c.FniQii;
+  MatrixXd& FniQiiFii = c.FniQiiFii;
+  MatrixXd& FniFiiQii = c.FniFiiQii;
+  for (MatrixXd* M : {&Fni, &FniFii, &FniQii, &FniQiiFii, &FniFiiQii}) M->setZero(9, m);
   for (const ProcessBlock& b : blocks) {
     const int o = b.offset - kNav, n = b.ss.n;
     const int row = b.channel < 3 ? kAtt : kVel;
-    Fni.block(row, o, 3, n) = -C.col(b.channel % 3) * b.ss.H;
+    const Vector3d col = -C.col(b.channel % 3);
+    if (n == 1) {  // GM, RW, turn-on bias: scalar block, no temporaries
+      const double h = b.ss.H(0), f = b.ss.F(0, 0), q = b.ss.Qc(0, 0);
+      Fni.block<3, 1>(row, o) = col * h;
+      FniFii.block<3, 1>(row, o) = col * (h * f);
+      FniQii.block<3, 1>(row, o) = col * (h * q);
+      FniQiiFii.block<3, 1>(row, o) = col * (h * q * f);
+      FniFiiQii.block<3, 1>(row, o) = col * (h * f * q);
+      continue;
+    }
+    Fni.block(row, o, 3, n) = col * b.ss.H;
     FniFii.block(row, o, 3, n) = Fni.block(row, o, 3, n) * b.ss.F;
     FniQii.block(row, o, 3, n) = Fni.block(row, o, 3, n) * b.ss.Qc;
     FniQiiFii.block(row, o, 3, n) = FniQii.block(row, o, 3, n) * b.ss.F.transpose();
@@ -195,7 +211,7 @@ void ErrorStateEkf::buildTransition(double dt, Transition& T) const {
 
 namespace {
 // X <- X * D' for block-diagonal D (blocks given by the layout), columns in place.
-void rightMulDt(MatrixXd& X, const MatrixXd& D, const std::vector<ProcessBlock>& blocks) {
+void rightMulDt(Eigen::Ref<MatrixXd> X, const MatrixXd& D, const std::vector<ProcessBlock>& blocks) {
   for (const ProcessBlock& b : blocks) {
     const int o = b.offset - kNav, n = b.ss.n;
     if (n == 1) {
@@ -206,7 +222,7 @@ void rightMulDt(MatrixXd& X, const MatrixXd& D, const std::vector<ProcessBlock>&
   }
 }
 // X <- D * X (rows in place).
-void leftMulD(MatrixXd& X, const MatrixXd& D, const std::vector<ProcessBlock>& blocks) {
+void leftMulD(Eigen::Ref<MatrixXd> X, const MatrixXd& D, const std::vector<ProcessBlock>& blocks) {
   for (const ProcessBlock& b : blocks) {
     const int o = b.offset - kNav, n = b.ss.n;
     if (n == 1) {
@@ -220,6 +236,10 @@ void leftMulD(MatrixXd& X, const MatrixXd& D, const std::vector<ProcessBlock>& b
 
 void ErrorStateEkf::accumulate(const Transition& T) {
   const auto& blocks = layout_.blocks();
+  if (pending_ == 0 && cfg_.propagate_every == 1) {  // no accumulation: apply directly
+    propagate(T.A, T.B, T.D, T.Q);
+    return;
+  }
   if (pending_ == 0) {
     A_acc_ = T.A;
     B_acc_ = T.B;
@@ -263,6 +283,12 @@ void ErrorStateEkf::accumulate(const Transition& T) {
 
 void ErrorStateEkf::applyTransition() {
   if (pending_ == 0) return;
+  propagate(A_acc_, B_acc_, D_acc_, Q_acc_);
+  pending_ = 0;
+}
+
+void ErrorStateEkf::propagate(const Matrix9d& A_acc_, const MatrixXd& B_acc_, const MatrixXd& D_acc_,
+                              const MatrixXd& Q_acc_) {
   const int m = layout_.imuSize();
   const auto& blocks = layout_.blocks();
   // P <- Phi P Phi' + Q with Phi = [A B; 0 D] (Groves 3.46), block by block:
@@ -270,22 +296,22 @@ void ErrorStateEkf::applyTransition() {
   //  P'ni = (A Pni + B Pii) D'
   //  P'ii = D Pii D'
   const Matrix9d Pnn = P_.topLeftCorner<9, 9>();
-  MatrixXd Pni = P_.topRightCorner(9, m);
-  MatrixXd Pii = P_.bottomRightCorner(m, m);
-  const Matrix9d Mnn = A_acc_ * Pnn + B_acc_ * Pni.transpose();
-  MatrixXd Mni = A_acc_ * Pni;
+  const auto Pni = P_.topRightCorner(9, m);
+  auto Pii = P_.bottomRightCorner(m, m);
+  MatrixXd& Mni = cache_->Mni;
+  Matrix9d Mnn = A_acc_ * Pnn;
+  Mnn.noalias() += B_acc_ * Pni.transpose();
+  Mni.noalias() = A_acc_ * Pni;
   Mni.noalias() += B_acc_ * Pii;
   Matrix9d Pnn1 = Mnn * A_acc_.transpose();
   Pnn1.noalias() += Mni * B_acc_.transpose();
   rightMulDt(Mni, D_acc_, blocks);
-  leftMulD(Pii, D_acc_, blocks);
+  leftMulD(Pii, D_acc_, blocks);   // in place on P
   rightMulDt(Pii, D_acc_, blocks);
   P_.topLeftCorner<9, 9>() = Pnn1;
   P_.topRightCorner(9, m) = Mni;
   P_.bottomLeftCorner(m, 9) = Mni.transpose();
-  P_.bottomRightCorner(m, m) = Pii;
   P_ += Q_acc_;
-  pending_ = 0;
   checkP("propagation");
 }
 
@@ -317,10 +343,10 @@ void ErrorStateEkf::predict(const ins::ImuSample& raw) {
   Transition& T = cache_->tmp;
   buildTransition(raw.dt, T);
   // deterministic propagation of the IMU-error estimates with the exact blocks
-  if (x_imu_.size() > 0) {
-    MatrixXd xm = x_imu_;
-    leftMulD(xm, T.D, layout_.blocks());
-    x_imu_ = xm.col(0);
+  for (const ProcessBlock& b : layout_.blocks()) {
+    const int o = b.offset - kNav, n = b.ss.n;
+    if (n == 1) x_imu_(o) *= T.D(o, o);
+    else x_imu_.segment(o, n) = (T.D.block(o, o, n, n) * x_imu_.segment(o, n)).eval();
   }
   accumulate(T);
 }

@@ -184,6 +184,8 @@ class ErrorStateEkf {
   void buildTransition(double dt, Transition& T) const;
   void accumulate(const Transition& T);
   void applyTransition();
+  void propagate(const Matrix9d& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& D,
+                 const Eigen::MatrixXd& Q);
   void checkP(const char* where) const;
 
   EkfConfig cfg_;
