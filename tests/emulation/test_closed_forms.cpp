@@ -41,13 +41,29 @@ emu::SampledTrajectory sampled(double dur, const std::function<Sample(double)>& 
   return s;
 }
 
+double gMaxRel[2] = {0.0, 0.0};  // largest |got - want| / |want| seen for f_B and w_IB_B
+
 void expectClose(const Vector3d& got, const Vector3d& want, const char* what, double t) {
   const double tol = 1e-7 * want.norm();
+  double& m = gMaxRel[what[0] == 'f' ? 0 : 1];
+  m = std::max(m, (got - want).norm() / want.norm());
   EXPECT_LE((got - want).norm(), tol) << what << " at t=" << t << "\n got  " << got.transpose()
                                       << "\n want " << want.transpose();
 }
 
 const double lat0 = 46.57 * M_PI / 180, lon0 = 6.54 * M_PI / 180, h0 = 600.0;
+
+struct Report : ::testing::EmptyTestEventListener {
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    if (std::string(info.test_suite_name()) != "ClosedForms") return;
+    std::printf("  max relative error: f_B %.2e, w_IB_B %.2e\n", gMaxRel[0], gMaxRel[1]);
+    gMaxRel[0] = gMaxRel[1] = 0.0;
+  }
+};
+const bool kReportInstalled = [] {
+  ::testing::UnitTest::GetInstance()->listeners().Append(new Report);
+  return true;
+}();
 
 }  // namespace
 
