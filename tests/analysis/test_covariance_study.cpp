@@ -1,0 +1,99 @@
+// Covariance study: Euler-angle sigmas, closed-form growth for white-noise
+// models through the whole study path, model ordering, config errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "navimpact/analysis/covariance_study.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/units.hpp"
+#include "test_support.hpp"
+
+using namespace navimpact;
+using Eigen::Matrix3d;
+
+TEST(CovarianceStudy, EulerSigmasOfLevelAttitude) {
+  ins::NavState x;
+  x.setRollPitchYaw(0.0, 0.0, 90.0 * units::kDeg);
+  // heading east: roll is about east (psi_E), pitch about north (-psi_N)
+  Matrix3d P = Eigen::Vector3d(4.0, 9.0, 16.0).asDiagonal();
+  const Eigen::Vector3d s = analysis::eulerSigmas(P, x);
+  EXPECT_NEAR(s.x(), 3.0, 1e-12);
+  EXPECT_NEAR(s.y(), 2.0, 1e-12);
+  EXPECT_NEAR(s.z(), 4.0, 1e-12);
+  x.setRollPitchYaw(0.0, 0.0, 0.0);
+  const Eigen::Vector3d s0 = analysis::eulerSigmas(P, x);
+  EXPECT_NEAR(s0.x(), 2.0, 1e-12);
+  EXPECT_NEAR(s0.y(), 3.0, 1e-12);
+}
+
+namespace {
+analysis::CovarianceStudyConfig shortConfig(double T) {
+  const std::string path = (test::tempDir() / "cov.yaml").string();
+  std::ofstream(path) << "model_file: " << test::sourcePath("config/models/navchip_table1.yaml")
+                      << "\nduration_s: " << T
+                      << "\nsummary_times_s: [1]\n"
+                         "static_state: {lat_deg: 46.52, lon_deg: 6.57, h_m: 400, yaw_deg: 20}\n"
+                         "baro: {rate_hz: 0, sigma_m: 1}\n"
+                         "model_sets:\n"
+                         "  - {name: accelerometer, models: [acc_model1, acc_model2, acc_model3, acc_ref]}\n"
+                         "  - {name: gyroscope, models: [gyro_model1, gyro_ref]}\n";
+  return analysis::loadCovarianceStudyConfig(path);
+}
+}  // namespace
+
+// White-noise-only models (Table 1 model 1) follow the textbook closed forms
+// through the whole study path; richer models are never more optimistic.
+TEST(CovarianceStudy, WhiteNoiseModelsFollowClosedFormsAndRicherModelsGrowFaster) {
+  const analysis::CovarianceStudyConfig cfg = shortConfig(30.0);
+  const analysis::CovarianceStudyResult r = analysis::runCovarianceStudy(cfg);
+  ASSERT_EQ(r.runs.size(), 6u);
+  const double T = 30.0, dt = 1.0 / 200.0;
+  const double Na = 5.526e-3 * std::sqrt(dt), Ng = 9.791e-4 * std::sqrt(dt);
+  const auto& a1 = r.runs[0].sigma.back();
+  const auto& g1 = r.runs[4].sigma.back();
+  EXPECT_NEAR(r.runs[0].t.back(), T, 1e-9);
+  EXPECT_NEAR(a1[3] / (Na * std::sqrt(T)), 1.0, 0.02);                      // vel N
+  EXPECT_NEAR(a1[0] / (Na * std::pow(T, 1.5) / std::sqrt(3.0)), 1.0, 0.02);  // pos N
+  EXPECT_NEAR(g1[8] / (Ng * std::sqrt(T)), 1.0, 0.02);                      // yaw
+  EXPECT_NEAR(g1[6] / (Ng * std::sqrt(T)), 1.0, 0.02);                      // roll
+  // reference models add correlated terms on top of the same white noise
+  for (int c : {0, 3}) {
+    EXPECT_GT(r.runs[3].sigma.back()[c], r.runs[0].sigma.back()[c]);
+    EXPECT_GT(r.runs[5].sigma.back()[c], r.runs[4].sigma.back()[c]);
+  }
+  EXPECT_EQ(r.runs[3].states, 9 + 15);
+  EXPECT_EQ(r.runs[5].states, 9 + 9);
+}
+
+TEST(CovarianceStudy, WritesAllOutputsOrNothing) {
+  const analysis::CovarianceStudyConfig cfg = shortConfig(2.0);
+  const analysis::CovarianceStudyResult r = analysis::runCovarianceStudy(cfg);
+  const auto dir = test::tempDir() / "out";
+  {
+    OutputSet out(dir);
+    analysis::writeCovarianceStudy(cfg, r, out);
+    // not committed: nothing may appear
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "covariance.csv"));
+  OutputSet out(dir);
+  analysis::writeCovarianceStudy(cfg, r, out);
+  out.commit();
+  for (const char* f : {"covariance.csv", "summary.json", "covariance_accelerometer.png",
+                        "covariance_gyroscope.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+}
+
+TEST(CovarianceStudy, ConfigErrorsNameTheKey) {
+  const std::string path = (test::tempDir() / "bad.yaml").string();
+  std::ofstream(path) << "model_file: " << test::sourcePath("config/models/navchip_table1.yaml")
+                      << "\nduration_s: 10\nstatic_state: {lat_deg: 46, h_ft: 3}\n"
+                         "model_sets: [{name: a, models: [acc_ref]}]\n";
+  try {
+    analysis::loadCovarianceStudyConfig(path);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("static_state.h_ft"), std::string::npos) << e.what();
+  }
+}
