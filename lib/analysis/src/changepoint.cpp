@@ -111,7 +111,13 @@ std::vector<StepResult> detectSteps(std::vector<double>& x, double alpha,
       sub.reserve(M / stride + 1);
       for (std::size_t i = 0; i < M; i += stride) sub.push_back(W[i]);
       double med = 0;
-      const double s = robustScale(sub, &med);
+      double s = robustScale(sub, &med);
+      // Quantised data can make the MAD of short averages far smaller than
+      // their spread: never use less than the classical rms of the
+      // coefficients (a few steps hardly change it; Gaussian noise gives both equal).
+      double ms = 0;
+      for (double w : sub) ms += (w - med) * (w - med);
+      s = std::max(s, std::sqrt(ms / static_cast<double>(sub.size())));
       if (!(s > 0.0)) continue;
       // Threshold: Bonferroni over the M positions; the scale is estimated
       // (MAD, 37 % efficient, from about M/m independent windows), hence a
@@ -150,6 +156,7 @@ std::vector<StepResult> detectSteps(std::vector<double>& x, double alpha,
       for (std::size_t k = best.index - L; k < best.index; ++k) b += x[k];
       best.size = (a - b) / static_cast<double>(L);
     }
+    if (!(std::abs(best.size) > 0.0)) break;  // nothing left to remove
     for (std::size_t k = best.index; k < n; ++k) x[k] -= best.size;
     found.push_back(best);
   }

@@ -195,6 +195,7 @@ struct Candidate {
   double deviance = kNaN;
   int params = 1;
   double T_lo = kNaN, T_hi = kNaN;  ///< GM: profile interval of T
+  bool T_hi_open = false;            ///< GM: interval reaches the top of the T grid
   double scale = 1;          ///< retune: new / old variance parameter
 };
 
@@ -343,6 +344,7 @@ Candidate fitCandidate(bool retune, int term, ProcessKind kind, const Model& mod
       }
     c.T_lo = lo;
     c.T_hi = hi;
+    c.T_hi_open = devs[G] <= best + 3.84;
   }
   if (retune) {
     const Process& old = model.terms[term];
@@ -730,8 +732,13 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
       // AIC; retuning a term of the user's model discards what they had, so it
       // is charged as if it cost two more parameters (added terms keep the
       // parts that were right and are preferred unless clearly worse).
-      const double crit =
+      double crit =
           cands[i].deviance + 2.0 * cands[i].params + (cands[i].retune ? 4.0 : 0.0);
+      // A GM whose T the data do not bound from above (95 % profile interval
+      // reaching the end of the grid, 10x the record) is a random walk over
+      // this record: left to the RW candidate, which has one parameter less.
+      if (!cands[i].retune && cands[i].kind == ProcessKind::GM && cands[i].T_hi_open)
+        crit = std::numeric_limits<double>::infinity();
       if (crit < best_crit - 1e-9) {
         best_crit = crit;
         best = static_cast<int>(i);
@@ -739,6 +746,12 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     }
     if (best < 0) break;
     const Candidate& ch = cands[best];
+    // Stop when no family improves the first-half AIC of the current model.
+    {
+      Process pp = ch.proc;
+      const double cur = wvDeviance(h1.nu, wvOf(m_half, h1.tau), h1.dof);
+      if (!(mainParam(pp) > 0) || !(best_crit < cur)) break;
+    }
     // Same family refitted on the whole (cleaned) record for the reported parameters.
     Candidate cf = fitCandidate(ch.retune, ch.term, ch.kind, m_full, full);
     const Model before = m_full;

@@ -1,0 +1,178 @@
+// navimpact diagnose: what a simulation with today's IMU error model gets wrong
+// on a measured static recording, the cause, the extended model and its gain.
+//   navimpact diagnose --input STATIC.csv[.gz] [--rate HZ] [--gyro-unit U] [--acc-unit U]
+//                      --model FILE[:NAME] | fit:SPEC  --out DIR
+//                      [--simulations N] [--seed S] [--alpha A] [--threads N]
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.hpp"
+#include "navimpact/analysis/diagnosis.hpp"
+#include "navimpact/core/csv_reader.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/output.hpp"
+#include "navimpact/gmwm/estimator.hpp"
+#include "navimpact/gmwm/wavelet_variance.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+
+namespace {
+
+namespace na = navimpact::analysis;
+namespace st = navimpact::stochastic;
+
+struct Opts {
+  std::string input;
+  double rate_hz = 0;
+  std::string gyro_unit, acc_unit, axes;
+  std::string model;
+  std::string trajectory;
+  std::vector<std::string> outages;
+  std::string out;
+  int simulations = 16;
+  std::uint64_t seed = 20261121;
+  double alpha = 0.01;
+  int threads = 0;
+};
+
+/// `fit:SPEC`: fit the structure to each channel of the data first (GMWM).
+st::ImuModel fitModel(const std::string& spec, const navimpact::ImuSeries& s) {
+  const auto structure = st::parseStructure(spec);
+  if (structure.empty()) throw navimpact::Error("--model fit:" + spec + ": empty structure");
+  st::ImuModel m;
+  m.source = "fit:" + spec;
+  m.rate_hz = s.rate_hz;
+  for (std::size_t i = 0; i < navimpact::kChannelNames.size(); ++i) m.axis[i].rate_hz = s.rate_hz;
+  for (const auto& ch : s.channels) {
+    const auto wv = navimpact::gmwm::waveletVariance(ch.x.data(), ch.x.size(), s.rate_hz);
+    m.forChannel(ch.name) = navimpact::gmwm::fit(structure, wv).model;
+    m.forChannel(ch.name).rate_hz = s.rate_hz;
+  }
+  return m;
+}
+
+void checkOutages(const Opts& o) {
+  if (!o.outages.empty() && o.trajectory.empty())
+    throw navimpact::Error("--outage needs --trajectory (the navigation part runs along it)");
+  for (const auto& spec : o.outages) {
+    const auto c = spec.find(':');
+    double a = NAN, b = NAN;
+    try {
+      if (c == std::string::npos) throw std::invalid_argument("no colon");
+      std::size_t p1 = 0, p2 = 0;
+      a = std::stod(spec.substr(0, c), &p1);
+      b = std::stod(spec.substr(c + 1), &p2);
+      if (p1 != c || p2 != spec.size() - c - 1) throw std::invalid_argument("trailing text");
+    } catch (const std::exception&) {
+      throw navimpact::Error("--outage '" + spec + "': expected START:DURATION in seconds");
+    }
+    if (!(a >= 0) || !(b > 0))
+      throw navimpact::Error("--outage '" + spec + "': START must be >= 0 and DURATION > 0");
+  }
+  if (!o.trajectory.empty()) {
+    if (!std::filesystem::exists(o.trajectory))
+      throw navimpact::Error("--trajectory " + o.trajectory + ": no such file");
+    throw navimpact::Error(
+        "--trajectory: the navigation gain of diagnose is not available in this build yet "
+        "(the WV gain is); run without --trajectory");
+  }
+}
+
+int run(const Opts& o) {
+  if (o.simulations < 0 || o.simulations == 1)
+    throw navimpact::Error("--simulations must be 0 or >= 2");
+  if (!(o.alpha > 0 && o.alpha < 0.5)) throw navimpact::Error("--alpha must be in (0, 0.5)");
+  checkOutages(o);
+  // Model file problems are reported before the (long) data read.
+  const bool fit = o.model.rfind("fit:", 0) == 0;
+  st::ImuModel model;
+  if (fit) st::parseStructure(o.model.substr(4));
+  else model = st::loadImuModel(o.model);
+
+  navimpact::CsvImuOptions copt;
+  if (o.rate_hz > 0) copt.rate_hz = o.rate_hz;
+  copt.gyro_unit = o.gyro_unit;
+  copt.acc_unit = o.acc_unit;
+  copt.axes = o.axes;
+  const navimpact::ImuSeries data = navimpact::readImuCsv(o.input, copt);
+  if (fit) model = fitModel(o.model.substr(4), data);
+
+  navimpact::cli::Progress bar("diagnose", 1000);
+  na::DiagnoseOptions dopt;
+  dopt.simulations = o.simulations;
+  dopt.seed = o.seed;
+  dopt.alpha = o.alpha;
+  dopt.threads = o.threads;
+  dopt.progress = [&bar](double f, const std::string&) {
+    bar.update(static_cast<std::size_t>(f * 1000));
+  };
+  const na::Diagnosis d = na::diagnose(data, model, dopt);
+  bar.finish();
+
+  navimpact::OutputSet out(o.out);
+  nlohmann::json in = {{"file", o.input},
+                       {"model", o.model},
+                       {"model_rate_hz", model.rate_hz},
+                       {"gyro_unit", o.gyro_unit},
+                       {"acc_unit", o.acc_unit},
+                       {"seed", o.seed},
+                       {"simulations", o.simulations},
+                       {"alpha", o.alpha}};
+  const auto figs =
+      na::diagnosisFigures(d, [&out](const std::string& n) { return out.stage(n).string(); });
+  out.writeText("diagnosis.json", na::diagnosisJson(d, in.dump()));
+  out.writeText("report.md", na::diagnosisReport(d, figs));
+  std::string comment = "extended by navimpact diagnose from " + o.input + " (model " + o.model +
+                        ", seed " + std::to_string(o.seed) + ")";
+  out.writeText("model_extended.yaml", st::toYaml(d.model_after, comment));
+  out.commit();
+
+  for (const auto& n : d.notices) std::cerr << "navimpact: notice: " << n << "\n";
+  std::cout << "verdict: " << (d.adequate ? "adequate" : "inadequate") << "\n";
+  for (const auto& c : d.channels) {
+    std::cout << "  " << c.name << ": " << (c.adequate ? "adequate" : "inadequate");
+    for (const auto& f : c.findings) std::cout << " " << na::causeName(f.cause);
+    if (!c.adequate)
+      std::cout << "  (scales outside CI " << c.gain.outside_before << " -> "
+                << c.gain.outside_after << ", " << c.gain.basis << ", gain "
+                << (c.gain.significant ? "significant" : "not significant") << ")";
+    std::cout << "\n";
+  }
+  std::cout << "wrote " << (std::filesystem::path(o.out) / "diagnosis.json").string()
+            << ", report.md, model_extended.yaml and " << figs.size() << " figure(s)\n";
+  return 0;
+}
+
+navimpact::cli::Registrar reg(
+    {"diagnose",
+     "What a simulation with today's IMU error model gets wrong on static data, the cause, "
+     "the extended model and its held-out gain",
+     [](CLI::App& app) {
+       auto o = std::make_shared<Opts>();
+       app.add_option("--input", o->input, "static recording (CSV, optionally gzip)")->required();
+       app.add_option("--rate", o->rate_hz, "sampling rate [Hz] (files without a time column)");
+       app.add_option("--gyro-unit", o->gyro_unit, "gyroscope unit in the file (rad/s, deg/s, ...)");
+       app.add_option("--acc-unit", o->acc_unit, "accelerometer unit in the file (m/s2, g, ...)");
+       app.add_option("--axes", o->axes, "axis remapping to body FRD, e.g. x,-y,-z");
+       app.add_option("--model", o->model,
+                      "model simulated today: FILE[:NAME], or fit:SPEC (e.g. fit:WN+GM) to fit "
+                      "that structure to the data first")
+           ->required();
+       app.add_option("--trajectory", o->trajectory, "trajectory for the navigation gain");
+       app.add_option("--outage", o->outages, "GNSS outage START:DURATION [s] (repeatable)");
+       app.add_option("--out", o->out, "output directory")->required();
+       app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel")
+           ->capture_default_str();
+       app.add_option("--seed", o->seed, "root seed")->capture_default_str();
+       app.add_option("--alpha", o->alpha, "family-wise level for the whole record")
+           ->capture_default_str();
+       app.add_option("--threads", o->threads, "worker threads (0 = all cores)");
+       return [o]() { return run(*o); };
+     }});
+
+}  // namespace
