@@ -1,6 +1,6 @@
 // navimpact covariance: covariance analysis of navigation uncertainty per IMU
 // error model in static conditions (paper Figures 5 and 6).
-//   navimpact covariance --config config/paper/covariance_static.yaml --out DIR
+//   navimpact covariance --config config/paper/covariance_static.yaml --out DIR [--trajectory CSV]
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -17,6 +17,7 @@ struct Opts {
   std::string config;
   std::string out;
   bool print_states = false;
+  std::string trajectory;
 };
 
 navimpact::cli::Registrar reg({
@@ -29,6 +30,9 @@ navimpact::cli::Registrar reg({
           ->required();
       app.add_option("--out", o->out, "output directory (covariance.csv, summary.json, PNGs)")
           ->required();
+      app.add_option("--trajectory", o->trajectory,
+                     "propagate along this trajectory CSV (time_s, lat_rad, lon_rad, alt_m, "
+                     "roll_rad, pitch_rad, yaw_rad) instead of the static state");
       app.add_flag("--print-states", o->print_states,
                    "print the filter state layout of every model before running");
       return [o]() -> int {
@@ -46,8 +50,10 @@ navimpact::cli::Registrar reg({
         int total = 0;
         for (const auto& s : cfg.model_sets) total += static_cast<int>(s.models.size());
         navimpact::cli::Progress bar("covariance", static_cast<std::size_t>(total));
+        auto tick = [&bar](int done, int) { bar.update(done); };
         const an::CovarianceStudyResult res =
-            an::runCovarianceStudy(cfg, [&bar](int done, int) { bar.update(done); });
+            o->trajectory.empty() ? an::runCovarianceStudy(cfg, tick)
+                                  : an::runCovarianceStudyAlongTrajectory(cfg, o->trajectory, tick);
         bar.finish();
         navimpact::OutputSet out(o->out);
         an::writeCovarianceStudy(cfg, res, out);

@@ -73,3 +73,14 @@ _cov_bad(wrong_type "model_file: ${_models}\nduration_s: sixty\nstatic_state: {l
          "duration_s.*expected a number in s")
 _cov_bad(negative_baro_sigma "model_file: ${_models}\n${_base}baro: {rate_hz: 10, sigma_m: -1}\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
          "baro\\.sigma_m.*> 0")
+
+# covariance-only propagation along the committed UAV trajectory (5 s)
+add_test(NAME cli_covariance_trajectory
+         COMMAND ${NI} covariance --config ${_cdir}/short.yaml --out ${_cdir}/out_traj
+                 --trajectory ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz)
+set_tests_properties(cli_covariance_trajectory PROPERTIES PASS_REGULAR_EXPRESSION "gyro_ref +5\\.0")
+add_test(NAME cli_covariance_bad_trajectory
+         COMMAND ${CMAKE_COMMAND} -DNI=${NI}
+                 "-DARGS=covariance|--config|${_cdir}/short.yaml|--out|${_cdir}/out_badtraj|--trajectory|${_cdir}/no_such.csv"
+                 "-DREGEX=no_such.csv" -DOUTDIR=${_cdir}/out_badtraj
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_fail.cmake)

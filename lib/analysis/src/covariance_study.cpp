@@ -12,6 +12,8 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/units.hpp"
+#include "navimpact/emulation/perfect_imu.hpp"
+#include "navimpact/emulation/trajectory.hpp"
 #include "navimpact/plot/figure.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/model_text.hpp"
@@ -244,25 +246,26 @@ Eigen::Vector3d eulerSigmas(const Matrix3d& P_psi, const ins::NavState& x) {
   return (Mi * P_psi * Mi.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 
-CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,
-                                         const std::function<void(int, int)>& progress) {
+namespace {
+/// Nominal state and rates at sample k (k = 0 .. n) of the horizon.
+using NominalFn = std::function<void(long k, ins::NavState& x, Vector3d& w_B, Vector3d& f_B)>;
+
+CovarianceStudyResult runAlong(const CovarianceStudyConfig& cfg, long n, const NominalFn& nominal,
+                               const std::function<void(int, int)>& progress) {
   CovarianceStudyResult res;
   int total = 0, done = 0;
   for (const auto& s : cfg.model_sets) total += static_cast<int>(s.models.size());
   const double dt = 1.0 / cfg.imu_rate_hz;
-  const long n = std::lround(cfg.duration_s * cfg.imu_rate_hz);
   const long every_out = std::max(1L, std::lround(cfg.imu_rate_hz / cfg.output_rate_hz));
   const long every_baro =
       cfg.baro_rate_hz > 0.0 ? std::max(1L, std::lround(cfg.imu_rate_hz / cfg.baro_rate_hz)) : 0;
-  const ins::NavState& x0 = cfg.nominal;
-  // perfect static rates: f_B = -C_NtoB g_N, w_IB_B = C_NtoB w_IE_N
-  const Matrix3d C_NtoB = x0.C_BtoN().transpose();
-  const Vector3d f_B = -(C_NtoB * earth::gravity_N(x0.lat, x0.h));
-  const Vector3d w_B = C_NtoB * earth::w_IE_N(x0.lat);
   filter::Vector9d s0;
   s0 << Vector3d::Constant(cfg.sigma0_position_m), Vector3d::Constant(cfg.sigma0_velocity_mps),
       Vector3d::Constant(cfg.sigma0_attitude_rad);
   const filter::Matrix9d P0 = s0.cwiseAbs2().asDiagonal();
+  ins::NavState x0;
+  Vector3d w_B, f_B;
+  nominal(0, x0, w_B, f_B);
 
   for (const ModelSet& set : cfg.model_sets) {
     for (const std::string& name : set.models) {
@@ -273,15 +276,15 @@ CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,
       run.model = name;
       run.model_text = modelText(model);
       run.states = ekf.size();
-      const Eigen::MatrixXd Hb = ekf.H_baro();
       const Eigen::MatrixXd Rb = Eigen::MatrixXd::Constant(1, 1, cfg.baro_sigma_m * cfg.baro_sigma_m);
       const Eigen::VectorXd dz0 = Eigen::VectorXd::Zero(1);
+      ins::NavState xk = x0;
       auto record = [&](double t) {
         ekf.flushPropagation();
         const Eigen::MatrixXd& P = ekf.P();
         std::array<double, 9> s{};
         for (int i = 0; i < 6; ++i) s[i] = std::sqrt(std::max(0.0, P(i, i)));
-        const Vector3d e = eulerSigmas(P.block<3, 3>(filter::kAtt, filter::kAtt), x0);
+        const Vector3d e = eulerSigmas(P.block<3, 3>(filter::kAtt, filter::kAtt), xk);
         s[6] = e.x();
         s[7] = e.y();
         s[8] = e.z();
@@ -289,11 +292,10 @@ CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,
         run.sigma.push_back(s);
       };
       record(0.0);
-      ins::NavState xk = x0;
       for (long k = 1; k <= n; ++k) {
-        xk.t = k * dt;
+        nominal(k, xk, w_B, f_B);
         ekf.predictCovariance(xk, w_B, f_B, dt);
-        if (every_baro > 0 && k % every_baro == 0) ekf.update(dz0, Hb, Rb, /*feedback=*/false);
+        if (every_baro > 0 && k % every_baro == 0) ekf.update(dz0, ekf.H_baro(), Rb, /*feedback=*/false);
         if (k % every_out == 0) record(k * dt);
       }
       res.runs.push_back(std::move(run));
@@ -301,6 +303,50 @@ CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,
     }
   }
   return res;
+}
+}  // namespace
+
+CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,
+                                         const std::function<void(int, int)>& progress) {
+  const double dt = 1.0 / cfg.imu_rate_hz;
+  const long n = std::lround(cfg.duration_s * cfg.imu_rate_hz);
+  const ins::NavState& x0 = cfg.nominal;
+  // perfect static rates: f_B = -C_NtoB g_N, w_IB_B = C_NtoB w_IE_N
+  const Matrix3d C_NtoB = x0.C_BtoN().transpose();
+  const Vector3d f0 = -(C_NtoB * earth::gravity_N(x0.lat, x0.h));
+  const Vector3d w0 = C_NtoB * earth::w_IE_N(x0.lat);
+  return runAlong(cfg, n,
+                  [&](long k, ins::NavState& x, Vector3d& w, Vector3d& f) {
+                    x = x0;
+                    x.t = k * dt;
+                    w = w0;
+                    f = f0;
+                  },
+                  progress);
+}
+
+CovarianceStudyResult runCovarianceStudyAlongTrajectory(
+    const CovarianceStudyConfig& cfg, const std::string& trajectory_csv,
+    const std::function<void(int, int)>& progress) {
+  emulation::TrajectorySpec spec;
+  spec.file = trajectory_csv;
+  const emulation::SmoothTrajectory tr(emulation::readTrajectoryCsv(spec),
+                                       emulation::SmoothingOptions{});
+  const double dt = 1.0 / cfg.imu_rate_hz;
+  const double t0 = tr.tBegin();
+  const long n = std::lround(std::min(cfg.duration_s, tr.tEnd() - t0) * cfg.imu_rate_hz);
+  if (n < 1) throw Error(trajectory_csv + ": trajectory shorter than one IMU interval");
+  return runAlong(cfg, n,
+                  [&](long k, ins::NavState& x, Vector3d& w, Vector3d& f) {
+                    // nominal at the end of interval k; rates at its middle
+                    const double t = t0 + k * dt;
+                    x = emulation::truthNavState(tr, t);
+                    x.t = k * dt;
+                    const emulation::TruthState s = tr.at(k > 0 ? t - 0.5 * dt : t);
+                    w = s.w_IB_B;
+                    f = s.f_B;
+                  },
+                  progress);
 }
 
 namespace {

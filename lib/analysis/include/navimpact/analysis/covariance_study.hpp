@@ -95,6 +95,18 @@ CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,
                                          const std::function<void(int, int)>& progress = {});
 
 /**
+ * Covariance-only propagation along a trajectory instead of the static state
+ * (static_state of the configuration is ignored): the trajectory CSV (columns
+ * time_s, lat_rad, lon_rad, alt_m, roll_rad, pitch_rad, yaw_rad, as read by
+ * lib/emulation) is smoothed and its kinematics give the nominal state and the
+ * perfect IMU rates at every IMU interval, over min(duration_s, trajectory length).
+ * @throws navimpact::Error for an unreadable or too short trajectory.
+ */
+CovarianceStudyResult runCovarianceStudyAlongTrajectory(
+    const CovarianceStudyConfig& cfg, const std::string& trajectory_csv,
+    const std::function<void(int, int)>& progress = {});
+
+/**
  * Write covariance.csv, summary.json and one PNG per model set
  * (covariance_<set>.png) into @p out (staged; the caller commits).
  */
