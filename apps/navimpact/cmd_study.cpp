@@ -1,0 +1,104 @@
+// navimpact study: Monte Carlo comparison of IMU error models on an emulated flight.
+//   navimpact study --config config/paper/study_navchip_uav.yaml --out DIR [--runs N] [--seed S]
+//                   [--threads T] [--shard K/N]
+//   navimpact study-merge DIR1 DIR2 ... --out DIR
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include "cli_common.hpp"
+#include "navimpact/analysis/study.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/output.hpp"
+
+namespace {
+
+namespace an = navimpact::analysis;
+
+struct StudyOpts {
+  std::string config, out, shard;
+  long long runs = -1;
+  long long seed = -1;
+  int threads = -1;
+};
+
+struct MergeOpts {
+  std::vector<std::string> dirs;
+  std::string out;
+};
+
+void printSummary(const an::StudyResults& r, const std::string& dir) {
+  std::cout << "study: " << r.acc.runs << " runs x " << r.meta.labels.size() << " models on "
+            << r.meta.trajectory << "\n";
+  std::cout << "report: " << dir << "/report.md\n";
+}
+
+int runStudyCmd(const StudyOpts& o) {
+  an::StudyConfig cfg = an::loadStudyConfig(o.config);
+  if (o.runs >= 0) {
+    if (o.runs < 1) throw navimpact::Error("--runs must be >= 1, got " + std::to_string(o.runs));
+    cfg.runs = static_cast<std::size_t>(o.runs);
+  }
+  if (o.seed >= 0) cfg.seed = static_cast<std::uint64_t>(o.seed);
+  if (o.threads >= 0) cfg.threads = static_cast<unsigned>(o.threads);
+  const an::Shard shard = o.shard.empty() ? an::Shard{} : an::parseShard(o.shard);
+  unsigned threads = cfg.threads;
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+
+  const auto plan = an::prepareStudy(cfg, NAVIMPACT_VERSION);  // every input error is thrown here
+  std::size_t todo = 0;
+  for (std::size_t i = 0; i < cfg.runs; ++i) todo += shard.contains(i) ? 1 : 0;
+  navimpact::cli::Progress bar("study", todo);
+  const an::StudyResults res =
+      an::runStudy(plan, shard, threads, [&bar](std::size_t done, std::size_t) { bar.update(done); });
+  bar.finish();
+
+  navimpact::OutputSet out(o.out);
+  if (shard.whole()) {
+    an::writeStudyOutputs(res, out);
+    out.commit();
+    printSummary(res, o.out);
+  } else {
+    an::writeShard(res, out);
+    out.commit();
+    std::cout << "study shard " << shard.k << "/" << shard.n << ": " << res.acc.runs << " of " << cfg.runs
+              << " runs written to " << o.out << "/ (merge with: navimpact study-merge DIR... --out DIR)\n";
+  }
+  return 0;
+}
+
+int runMergeCmd(const MergeOpts& o) {
+  const an::StudyResults res = an::mergeShards(o.dirs);
+  navimpact::OutputSet out(o.out);
+  an::writeStudyOutputs(res, out);
+  out.commit();
+  printSummary(res, o.out);
+  return 0;
+}
+
+navimpact::cli::Registrar regStudy({"study",
+                                    "Monte Carlo emulation study: compare IMU error models in a GNSS/INS filter",
+                                    [](CLI::App& app) {
+                                      auto o = std::make_shared<StudyOpts>();
+                                      app.add_option("--config", o->config, "study YAML (e.g. config/paper/study_navchip_uav.yaml)")
+                                          ->required();
+                                      app.add_option("--out", o->out, "output folder")->required();
+                                      app.add_option("--runs", o->runs, "Monte Carlo runs (overrides the config)");
+                                      app.add_option("--seed", o->seed, "study seed (overrides the config)");
+                                      app.add_option("--threads", o->threads,
+                                                     "worker threads, 0 = all cores (overrides the config)");
+                                      app.add_option("--shard", o->shard,
+                                                     "K/N: run only the run indices i with i % N == K-1 and write "
+                                                     "partial results for study-merge");
+                                      return [o]() -> int { return runStudyCmd(*o); };
+                                    }});
+
+navimpact::cli::Registrar regMerge({"study-merge", "Merge study shards (navimpact study --shard K/N) into one study",
+                                    [](CLI::App& app) {
+                                      auto o = std::make_shared<MergeOpts>();
+                                      app.add_option("dirs", o->dirs, "shard folders")->required();
+                                      app.add_option("--out", o->out, "output folder")->required();
+                                      return [o]() -> int { return runMergeCmd(*o); };
+                                    }});
+
+}  // namespace
