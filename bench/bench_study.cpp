@@ -1,0 +1,47 @@
+// Cost of one filter step inside the emulation study (analysis::runNav via
+// runStudy): the UAV excerpt (first 60 s), 200 Hz IMU, one run, one candidate
+// model, covariance propagated every k samples. Reports us per filter step.
+//   build-*/bin/navimpact_bench --benchmark_filter=Study
+#include <benchmark/benchmark.h>
+
+#include "navimpact/analysis/study.hpp"
+
+namespace an = navimpact::analysis;
+
+namespace {
+
+std::shared_ptr<const an::StudyPlan> makePlan(const std::string& model, int every) {
+  an::StudyConfig cfg;
+  const std::string src = NAVIMPACT_SOURCE_DIR;
+  cfg.trajectory.file = src + "/datasets/uav_flight_260s.csv.gz";
+  cfg.trajectory.end_s = 60.0;
+  cfg.imu_rate_hz = 200.0;
+  cfg.truth.model = src + "/config/models/navchip_table1.yaml:ref";
+  an::CandidateSpec c;
+  c.label = model;
+  c.model = src + "/config/models/navchip_table1.yaml:" + model;
+  cfg.candidates = {c};
+  cfg.sets = {{"all", "all", {model}, model, model}};
+  cfg.outages = {{30.0, 50.0}};
+  cfg.runs = 1;
+  cfg.ekf.propagate_every = every;
+  return an::prepareStudy(cfg, "bench");
+}
+
+void BM_StudyFilterStep(benchmark::State& st, const std::string& model) {
+  const auto plan = makePlan(model, static_cast<int>(st.range(0)));
+  double wall = 0.0, steps = 0.0;
+  for (auto _ : st) {
+    const an::StudyResults r = an::runStudy(plan, an::Shard{}, 1);
+    wall += r.acc.models[0].wall_s;
+    steps += r.acc.models[0].steps;
+  }
+  st.counters["us_per_step"] = 1e6 * wall / steps;
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(BM_StudyFilterStep, ref_both, std::string("ref"))
+    ->Arg(1)->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_StudyFilterStep, gyro_wn, std::string("gyro_model1"))
+    ->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
