@@ -1,14 +1,38 @@
 #!/usr/bin/env bash
-# Install dependencies, build, and run navimpact's main job on the bundled data.
+# Install dependencies, build, and run navimpact's main job on the bundled data
+# (datasets/): model the bundled ADIS16405 static excerpt with GMWM, run the
+# paper's static covariance study, replay the bundled emulated UAV rawlog with
+# a 60 s GNSS outage after 200 s of GNSS, and run the paper's Monte Carlo
+# model comparison with a modest run count.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh
 bash scripts/build.sh
 OUT=${OUT:-out/demo}
-mkdir -p "$OUT"
+RUNS=${RUNS:-20}
 NI=build/bin/navimpact
-echo "== navimpact wv + fit on the bundled ADIS16405 excerpt (datasets/) =="
-"$NI" wv --input datasets/adis16405_static_excerpt.csv.gz --rate 100 --gyro-unit deg/s --acc-unit g --out "$OUT/wv"
-"$NI" fit --input datasets/adis16405_static_excerpt.csv.gz --rate 100 --gyro-unit deg/s --acc-unit g \
-  --structure auto --out "$OUT/fit"
-echo "demo outputs in $OUT/"
+mkdir -p "$OUT"
+
+echo
+echo "== 1/4 GMWM model of the bundled ADIS16405 static excerpt (navimpact fit) =="
+"$NI" fit --input datasets/adis16405_static_excerpt.csv.gz --rate 100 \
+  --gyro-unit deg/s --acc-unit g --structure auto --out "$OUT/fit"
+
+echo
+echo "== 2/4 static covariance analysis, paper Figs. 5-6 (navimpact covariance) =="
+"$NI" covariance --config config/paper/covariance_static.yaml --out "$OUT/covariance"
+
+echo
+echo "== 3/4 replay of the emulated UAV rawlog with a 60 s GNSS outage (navimpact replay) =="
+"$NI" replay --config config/replay/default.yaml --out "$OUT/replay"
+
+echo
+echo "== 4/4 Monte Carlo model comparison, paper Figs. 8-9 (navimpact study, $RUNS runs) =="
+"$NI" study --config config/paper/study_navchip_uav.yaml --runs "$RUNS" --out "$OUT/study"
+
+echo
+echo "demo outputs in $OUT/:"
+echo "  $OUT/fit/fit.json, model.yaml, fit_*.png"
+echo "  $OUT/covariance/summary.json, covariance_*.png"
+echo "  $OUT/replay/summary.json, *.png"
+echo "  $OUT/study/report.md   <- read this first"
