@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -15,7 +16,7 @@
 #include <sstream>
 
 #include "cli_common.hpp"
-#include "navimpact/core/csv_reader.hpp"
+#include "input.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/imu_series.hpp"
 #include "navimpact/core/output.hpp"
@@ -36,9 +37,8 @@ namespace gm = navimpact::gmwm;
 using json = nlohmann::json;
 
 struct Opts {
-  std::string input;
-  double rate_hz = 0.0;
-  std::string gyro_unit, acc_unit, axes, label, channels;
+  navimpact::cli::InputOpts in;  // --input --rate --gyro-unit --acc-unit --axes --label (input.hpp)
+  std::string channels;
   std::string structure;
   int max_gm = 3;
   int bootstrap = 0;
@@ -137,12 +137,9 @@ int run(const Opts& o) {
   if (o.bootstrap < 0) throw navimpact::Error("--bootstrap must be >= 0, got " + std::to_string(o.bootstrap));
   if (o.max_gm < 0 || o.max_gm > 3) throw navimpact::Error("--max-gm must be in 0..3");
 
-  navimpact::CsvImuOptions ro;
-  if (o.rate_hz > 0) ro.rate_hz = o.rate_hz;
-  ro.gyro_unit = o.gyro_unit;
-  ro.acc_unit = o.acc_unit;
-  ro.axes = o.axes;
-  const navimpact::ImuSeries s = navimpact::readImuCsv(o.input, ro);
+  navimpact::cli::InputFormat fmt{};
+  const navimpact::ImuSeries s = navimpact::cli::loadInput(o.in, &fmt);
+  const std::string& input = o.in.input;
 
   std::vector<const navimpact::ImuChannel*> chans;
   if (o.channels.empty()) {
@@ -155,7 +152,7 @@ int run(const Opts& o) {
       chans.push_back(&s.channel(n));
     }
   }
-  if (chans.empty()) throw navimpact::Error(o.input + ": no IMU channel to fit");
+  if (chans.empty()) throw navimpact::Error(input + ": no IMU channel to fit");
 
   gm::FitOptions fo;
   fo.bootstrap = o.bootstrap;
@@ -184,7 +181,7 @@ int run(const Opts& o) {
         c.fit = gm::fit(structure, c.wv, fi);
       }
     } catch (const navimpact::Error& e) {
-      throw navimpact::Error(o.input + ": channel " + c.ch->name + ": " + e.what());
+      throw navimpact::Error(input + ": channel " + c.ch->name + ": " + e.what());
     }
     prog.update(i + 1);
   }
@@ -197,9 +194,13 @@ int run(const Opts& o) {
   for (const auto& c : fits) im.forChannel(c.ch->name) = c.fit.model;
 
   json j;
-  j["input"] = {{"file", o.input},      {"rate_hz", s.rate_hz},     {"samples", s.size()},
-                {"gyro_unit", o.gyro_unit}, {"acc_unit", o.acc_unit}, {"axes", o.axes},
-                {"label", o.label}};
+  j["input"] = {{"file", input},
+                {"format", fmt == navimpact::cli::InputFormat::Rawlog ? "rawlog" : "csv"},
+                {"rate_hz", s.rate_hz},
+                {"samples", s.size()},
+                {"units", navimpact::cli::inputUnitsNote(o.in, fmt)},
+                {"axes", o.in.axes},
+                {"label", o.in.label}};
   j["seed"] = o.seed;
   j["structure"] = autoSel ? std::string("auto") : st::formatStructure(structure);
   j["conventions"] =
@@ -255,8 +256,7 @@ int run(const Opts& o) {
 
   navimpact::OutputSet outs(o.out);
   std::ostringstream comment;
-  comment << "GMWM fit by navimpact " << NAVIMPACT_VERSION << " of " << o.input
-          << (o.label.empty() ? "" : " (" + o.label + ")") << ", structure " << j["structure"].get<std::string>()
+  comment << "GMWM fit by navimpact " << NAVIMPACT_VERSION << " of " << input << ", structure " << j["structure"].get<std::string>()
           << ", seed " << o.seed;
   outs.writeText("model.yaml", st::toYaml(im, comment.str()));
   outs.writeText("fit.json", j.dump(2) + "\n");
@@ -272,7 +272,7 @@ int run(const Opts& o) {
     fig.cols = static_cast<int>(fig.axes.size());
     fig.width = 650 * fig.cols;
     fig.height = 620;
-    fig.title = "GMWM fit, " + sname + (o.label.empty() ? "" : " — " + o.label);
+    fig.title = "GMWM fit, " + sname + " — " + std::filesystem::path(input).filename().string();
     navimpact::plot::savePng(fig, outs.stage("fit_" + sname + ".png").string());
   }
   outs.commit();
@@ -297,13 +297,7 @@ navimpact::cli::Registrar reg({
     "GMWM fit of IMU error models (WN, QN, RW, DR, GM, SIN) to a static recording",
     [](CLI::App& app) {
       auto o = std::make_shared<Opts>();
-      app.add_option("--input", o->input, "static IMU recording (CSV or CSV.gz, columns gyro_x..acc_z)")
-          ->required();
-      app.add_option("--rate", o->rate_hz, "sampling rate [Hz] (needed without a time column)");
-      app.add_option("--gyro-unit", o->gyro_unit, "unit of the gyro columns (rad/s, deg/s, deg/h, ...)");
-      app.add_option("--acc-unit", o->acc_unit, "unit of the accelerometer columns (m/s2, g, mg, ...)");
-      app.add_option("--axes", o->axes, "axis remapping file -> body FRD, e.g. x,-y,-z");
-      app.add_option("--label", o->label, "label for reports and figures");
+      navimpact::cli::addInputOptions(app, o->in);
       app.add_option("--channels", o->channels, "comma-separated channels to fit (default: all in the file)");
       app.add_option("--structure", o->structure,
                      "model structure for every channel, e.g. WN+GM+GM+DR, or 'auto' (WIC selection)")

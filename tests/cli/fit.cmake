@@ -58,7 +58,7 @@ endforeach()
 
 add_test(NAME cli_fit_wn_gm
   COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GM
-          --seed 7 --label "ADIS16405 excerpt" --out ${_fdir}/wn_gm)
+          --seed 7 --out ${_fdir}/wn_gm)
 set_tests_properties(cli_fit_wn_gm PROPERTIES
   PASS_REGULAR_EXPRESSION "gyro_x: WN\\(sigma=[0-9.e-]+\\) \\+ GM\\(sigma=[0-9.e-]+, T=[0-9.e+-]+\\).*objective.*ARW.*acc_z: WN"
   FIXTURES_SETUP fit_wn_gm)
