@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -723,6 +724,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
 
   Model m_full = m0, m_half = m0;
   int added_params = 0;
+  std::map<int, std::size_t> added_by;  ///< term index added here -> its finding
   auto chk = chk_cl;
   for (int it = 0; it < opt.max_terms && countSignificant(chk) > 0; ++it) {
     auto cands = allCandidates(m_half, h1);
@@ -755,12 +757,26 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     // Same family refitted on the whole (cleaned) record for the reported parameters.
     Candidate cf = fitCandidate(ch.retune, ch.term, ch.kind, m_full, full);
     const Model before = m_full;
-    cd.findings.push_back(broadbandFinding(cd.name, cf, before, chk, tau, rate));
-    cd.findings.back().statistic = 0;
+    Finding nf = broadbandFinding(cd.name, cf, before, chk, tau, rate);
     double pmin = 1;
     for (const auto& s : chk) pmin = std::min(pmin, s.p_value);
-    cd.findings.back().statistic = pmin;
-    cd.findings.back().threshold = p_thr;
+    nf.statistic = pmin;
+    nf.threshold = p_thr;
+    // Retuning a term this diagnosis added itself refines that finding
+    // (same cause, better parameters) instead of naming a new one.
+    auto own = added_by.find(cf.retune ? cf.term : -1);
+    if (cf.retune && own != added_by.end()) {
+      Finding& old = cd.findings[own->second];
+      old.params = nf.params;
+      old.T_interval_s = nf.T_interval_s;
+      if (cf.kind == ProcessKind::GM)
+        old.explanation += " (refined after the next term: GM sigma = " +
+                           fmtNum(cf.proc.sigma, 3) + ", T ≈ " + fmtNum(cf.proc.T, 3) + " s)";
+    } else {
+      cd.findings.push_back(nf);
+      if (!cf.retune && !(cf.kind != ProcessKind::GM && m_full.count(cf.kind) > 0))
+        added_by[static_cast<int>(m_full.terms.size())] = cd.findings.size() - 1;
+    }
     m_full = applyCandidate(m_full, cf);
     m_half = applyCandidate(m_half, ch);
     added_params += ch.params;
