@@ -212,7 +212,7 @@ std::vector<std::string> diagnosisFigures(
       plot::Axes ax;
       ax.title = c.name + (c.adequate ? " — adequate" : " — inadequate");
       ax.xlabel = "tau [s]";
-      ax.ylabel = "WV [" + channelUnit(c.name) + "^2]";
+      ax.ylabel = "WV [(" + channelUnit(c.name) + ")^2]";
       ax.logx = ax.logy = true;
       plot::Band env{"simulated envelope", {}, {}, {}, plot::palette(0), 0.25};
       plot::Band ci{"model 95 % CI", {}, {}, {}, plot::palette(1), 0.15};
@@ -266,7 +266,7 @@ std::vector<std::string> diagnosisFigures(
       fig.title = c.name + ": extended model vs cleaned record";
       plot::Axes ax;
       ax.xlabel = "tau [s]";
-      ax.ylabel = "WV [" + channelUnit(c.name) + "^2]";
+      ax.ylabel = "WV [(" + channelUnit(c.name) + ")^2]";
       ax.logx = ax.logy = true;
       plot::Band ci{"extended model 95 % CI", {}, {}, {}, plot::palette(2), 0.2};
       plot::Series meas{"measured (cleaned)", {}, {}, {0, 0, 0}};
@@ -325,7 +325,7 @@ std::vector<std::string> diagnosisFigures(
       fig.title = c.name + ": Welch spectrum, lines beyond the family-wise threshold";
       plot::Axes ax;
       ax.xlabel = "frequency [Hz]";
-      ax.ylabel = "PSD [" + channelUnit(c.name) + "^2/Hz]";
+      ax.ylabel = "PSD [(" + channelUnit(c.name) + ")^2/Hz]";
       ax.logx = ax.logy = true;
       plot::Series psd{"measured PSD", {}, {}, {0, 0, 0}};
       psd.width = 1.0;
