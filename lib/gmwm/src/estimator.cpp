@@ -147,7 +147,7 @@ class WvCost final : public ceres::CostFunction {
 
 /// Everything one fit needs about the data.
 struct Data {
-  Eigen::VectorXd tau, nu_hat, w_rel, w_obj, omega;
+  Eigen::VectorXd tau, nu_hat, w_rel, w_obj, omega, eta;
   double rate = 0;
   double n = 0;
   int J = 0;
@@ -171,6 +171,9 @@ Data makeData(const WaveletVariance& wv) {
   d.w_obj = d.omega.cwiseSqrt();
   d.rate = wv.rate_hz;
   d.n = wv.n > 0 ? double(wv.n) : std::pow(2.0, d.J + 1);
+  d.eta.resize(d.J);
+  for (int j = 0; j < d.J; ++j)
+    d.eta[j] = (wv.eta.size() == d.J && wv.eta[j] > 0) ? wv.eta[j] : std::max((d.n - d.tau[j] + 1) / d.tau[j], 1.0);
   return d;
 }
 
@@ -541,6 +544,53 @@ Eigen::VectorXd fitPoint(const Layout& L, const Data& d, const FitOptions& opt, 
   return best_th;
 }
 
+/// Omega_jj = eta_j / (2 nu_j(theta)^2): inverse chi-square variance of nu_hat_j
+/// under the model theta (Percival & Walden 2000, eq. 313c). Sets d.omega and d.w_obj.
+void setModelWeights(const Layout& L, const Eigen::VectorXd& th, Data& d) {
+  const Eigen::VectorXd nu = detail::wvOf(L, th, d.tau);
+  for (int j = 0; j < d.J; ++j) {
+    // Guard against a model WV of ~0 at a scale (a term pinned at a bound).
+    const double v = std::max(nu[j], 1e-6 * d.nu_hat[j]);
+    d.omega[j] = d.eta[j] / (2.0 * v * v);
+  }
+  d.w_obj = d.omega.cwiseSqrt();
+}
+
+/**
+ * Iteratively reweighted GMWM: from the fast-weight estimate th, set the
+ * model-based weights at th, refit from th (on the first pass also from the
+ * multi-start points of @p multi under the new weights, keeping the lower
+ * objective: a fast fit that spent a GM on the white noise, T < 1 sample,
+ * is left that way by a local refit), repeat until the largest change
+ * of a transformed parameter is below 1e-3 (0.1 %) or after @p passes passes.
+ * Leaves d.omega / d.w_obj at the weights of the last refit.
+ */
+int reweight(const Layout& L, Eigen::VectorXd& th, Data& d, int passes, bool* converged,
+             const FitOptions* multi = nullptr) {
+  int done = 0;
+  for (int it = 0; it < std::max(passes, 1); ++it) {
+    setModelWeights(L, th, d);
+    Eigen::VectorXd t = th;
+    double v = solve(L, t, d, d.w_obj, converged);
+    sortTerms(L, t);
+    if (multi && it == 0) {  // the fast basin need not be the best one under the new weights
+      bool c2 = false;
+      Eigen::VectorXd t2 = fitPoint(L, d, *multi, nullptr, &c2);
+      const double v2 = criterion(L, t2, d, d.w_obj);
+      if (v2 < v) {
+        t = t2;
+        v = v2;
+        if (converged) *converged = c2;
+      }
+    }
+    const double change = (t - th).cwiseAbs().maxCoeff();
+    th = t;
+    ++done;
+    if (change < 1e-3) break;
+  }
+  return done;
+}
+
 Eigen::MatrixXd pinvSym(const Eigen::MatrixXd& M) {
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (M + M.transpose()));
   const Eigen::VectorXd ev = es.eigenvalues();
@@ -653,12 +703,28 @@ double objective(const Model& m, const WaveletVariance& wv) {
   return ((wv.wv - nu).array().square() * w.array()).sum();
 }
 
+Eigen::VectorXd modelWeights(const Model& m, const WaveletVariance& wv) {
+  const Data d = makeData(wv);
+  const Eigen::VectorXd nu = stochastic::haarWv(m, wv.tau);
+  Eigen::VectorXd w(d.J);
+  for (int j = 0; j < d.J; ++j) w[j] = d.eta[j] / (2.0 * nu[j] * nu[j]);
+  return w;
+}
+
+std::string weightingName(Weighting w) { return w == Weighting::ModelBased ? "model" : "fast"; }
+
+Weighting parseWeighting(const std::string& s) {
+  if (s == "fast") return Weighting::Fast;
+  if (s == "model") return Weighting::ModelBased;
+  throw Error("GMWM weights: '" + s + "' is not one of fast, model");
+}
+
 namespace detail {
 /// Asymptotic covariance of theta_hat (transformed space), sandwich form.
-Eigen::MatrixXd sandwich(const Layout& L, const Eigen::VectorXd& th, const WaveletVariance& wv) {
+Eigen::MatrixXd sandwich(const Layout& L, const Eigen::VectorXd& th, const WaveletVariance& wv,
+                         const Eigen::VectorXd& om) {
   const Eigen::MatrixXd A = jacobian(L, th, wv.tau);
   const Eigen::VectorXd nu = wvOf(L, th, wv.tau);
-  const Eigen::VectorXd om = wv.weights();
   Eigen::VectorXd V(wv.scales());
   for (int j = 0; j < wv.scales(); ++j) {
     const double eta = (wv.eta.size() == wv.scales() && wv.eta[j] > 0) ? wv.eta[j] : 1.0;
@@ -683,13 +749,17 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
   if (p > kMaxParams)
     throw Error("GMWM fit of " + sname + ": " + std::to_string(p) + " parameters, at most " +
                 std::to_string(kMaxParams) + " supported");
-  const Data d = makeData(wv);
+  Data d = makeData(wv);
   const Layout L(structure);
   FitResult r;
-  const Eigen::VectorXd th = fitPoint(L, d, opt, &r.starts, &r.converged);
+  Eigen::VectorXd th = fitPoint(L, d, opt, &r.starts, &r.converged);
+  r.weighting = opt.weighting;
+  if (opt.weighting == Weighting::ModelBased)
+    r.weight_passes = reweight(L, th, d, opt.weight_iterations, &r.converged, &opt);
   r.model = detail::toModel(L, th, d.rate);
-  r.objective = objective(r.model, wv);
-  r.cov_transformed = detail::sandwich(L, th, wv);
+  r.objective_fast = objective(r.model, wv);
+  r.objective = opt.weighting == Weighting::Fast ? r.objective_fast : criterion(L, th, d, d.w_obj);
+  r.cov_transformed = detail::sandwich(L, th, wv, d.omega);
   Eigen::VectorXd lo(p), hi(p);
   if (opt.bootstrap > 0) {
     // Parametric bootstrap: simulate the fitted model at the data length,
@@ -701,10 +771,11 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
       const std::vector<double> x =
           stochastic::simulate(r.model, n, stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(b)));
       const WaveletVariance wb = waveletVariance(x.data(), n, wv.rate_hz, 0.05, wv.scales());
-      const Data db = makeData(wb);
+      Data db = makeData(wb);
       Eigen::VectorXd t = th;
       solve(L, t, db, db.w_obj);
       sortTerms(L, t);
+      if (opt.weighting == Weighting::ModelBased) reweight(L, t, db, opt.weight_iterations, nullptr);
       reps.push_back(t);
     }
     for (int k = 0; k < p; ++k) {
