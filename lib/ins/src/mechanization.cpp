@@ -9,18 +9,56 @@ using Eigen::Vector3d;
 
 NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
                    const MechanizationOptions& opt) {
+  return mechanize(prev, cur, last, nullptr, opt);
+}
+
+NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
+                   const ImuSample* last2, const MechanizationOptions& opt) {
   const double tau = cur.dt;
   const Vector3d& a = cur.dtheta_B;  // alpha_IB_B
   const Vector3d& u = cur.dv_B;      // upsilon_IB_B
 
-  // Two-sample coning and sculling (Groves 5.97, 5.98; Savage 1998), using
-  // the previous interval's increments.
+  // Coning and sculling from the previous intervals' increments. The
+  // coefficients make 1/2 int (alpha(t) x omega(t)) dt (coning) and
+  // 1/2 int (alpha x f + upsilon x omega) dt (sculling; the same bilinear form)
+  // exact for rates polynomial in time over the samples used:
+  //  - two-sample, rates linear in time: 1/12 x_{n-1} x y_n
+  //    (Groves 2013 eq. 5.97-5.98; Savage 1998);
+  //  - three-sample with the two previous intervals, rates quadratic in time:
+  //    k1 = -1/24 on x_{n-2}, k2 = 1/6 on x_{n-1} (Ignagni 1996 class of
+  //    previous-interval algorithms; derived by matching the a x b and a x c
+  //    terms of omega(t) = a + b t + c t^2, see docs in the header).
   Vector3d a_c = a;
-  Vector3d u_c = u + 0.5 * a.cross(u);  // rotation correction (Groves 5.85 first order)
+  Vector3d scul = Vector3d::Zero();
   if (opt.coning_sculling && last != nullptr) {
-    a_c += (1.0 / 12.0) * last->dtheta_B.cross(a);
-    u_c += (1.0 / 12.0) * (last->dtheta_B.cross(u) + last->dv_B.cross(a));
+    double k1 = 0.0, k2 = 1.0 / 12.0;
+    if (last2 != nullptr && std::abs(last2->dt - tau) <= 1e-9 * tau &&
+        std::abs(last->dt - tau) <= 1e-9 * tau) {
+      k1 = -1.0 / 24.0;
+      k2 = 1.0 / 6.0;
+      a_c += k1 * last2->dtheta_B.cross(a);
+      scul += k1 * (last2->dtheta_B.cross(u) + last2->dv_B.cross(a));
+    }
+    a_c += k2 * last->dtheta_B.cross(a);
+    scul += k2 * (last->dtheta_B.cross(u) + last->dv_B.cross(a));
   }
+
+  // Velocity-increment rotation to the start-of-interval body frame, exact for
+  // a constant rate over the interval (Groves 2013 eq. 5.84-5.85 with the full
+  // series instead of the first-order 1/2 [alpha x] term):
+  //   C_b(-)b(t) integrated = I + (1-cos|a|)/|a|^2 [a x] + (1 - sin|a|/|a|)/|a|^2 [a x]^2
+  const double n2 = a.squaredNorm();
+  double c1 = 0.5, c2 = 1.0 / 6.0;  // series limits for |a| -> 0
+  if (n2 > 1e-8) {
+    const double n = std::sqrt(n2);
+    c1 = (1.0 - std::cos(n)) / n2;
+    c2 = (1.0 - std::sin(n) / n) / n2;
+  } else {
+    c1 = 0.5 - n2 / 24.0;
+    c2 = 1.0 / 6.0 - n2 / 120.0;
+  }
+  const Vector3d axu = a.cross(u);
+  const Vector3d u_c = u + c1 * axu + c2 * a.cross(axu) + scul;
 
   const earth::Radii r0 = earth::radii(prev.lat);
   const Vector3d w_ie0 = earth::w_IE_N(prev.lat);
@@ -64,7 +102,11 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
 }
 
 void Mechanization::step(const ImuSample& s) {
-  x_ = mechanize(x_, s, has_last_ ? &last_ : nullptr, opt_);
+  x_ = mechanize(x_, s, has_last_ ? &last_ : nullptr, has_last2_ ? &last2_ : nullptr, opt_);
+  if (has_last_) {
+    last2_ = last_;
+    has_last2_ = true;
+  }
   last_ = s;
   has_last_ = true;
 }

@@ -20,8 +20,9 @@
 namespace navimpact::ins {
 
 struct MechanizationOptions {
-  /// Two-sample coning and sculling corrections using the previous interval's
-  /// increments (Groves 5.97-5.98 / Savage 1998). Off = single-sample form.
+  /// Coning and sculling corrections using the previous intervals' increments
+  /// (two-sample: Groves 5.97-5.98 / Savage 1998; three-sample once two
+  /// previous intervals are known). Off = single-sample form.
   bool coning_sculling = true;
 };
 
@@ -37,6 +38,21 @@ struct MechanizationOptions {
 NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
                    const MechanizationOptions& opt = {});
 
+/**
+ * As above, with the increments of the two previous intervals: three-sample
+ * coning and sculling (exact for rates quadratic in time over the three
+ * intervals; falls back to the two-sample form when @p last2 is nullptr).
+ * @param[in] prev   state at cur.t - cur.dt.
+ * @param[in] cur    (already error-corrected) increments of this interval.
+ * @param[in] last   increments of the interval before (nullptr = none).
+ * @param[in] last2  increments of the interval before @p last (nullptr = none);
+ *                   all three intervals of equal length.
+ * @param[in] opt    options.
+ * @return the state at cur.t.
+ */
+NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
+                   const ImuSample* last2, const MechanizationOptions& opt = {});
+
 /// Stateful wrapper: keeps the current state and the previous increments.
 class Mechanization {
  public:
@@ -50,15 +66,23 @@ class Mechanization {
   const NavState& state() const { return x_; }
   /// Overwrite the state (closed-loop correction); the increment history is kept.
   void setState(const NavState& x) { x_ = x; }
+  /// Provide the increments that preceded state().t (older first), so that the
+  /// first step() is a regular multi-sample step. @p last2 may be nullptr.
+  void setHistory(const ImuSample& last, const ImuSample* last2 = nullptr) {
+    last_ = last;
+    has_last_ = true;
+    if (last2 != nullptr) last2_ = *last2;
+    has_last2_ = last2 != nullptr;
+  }
   /// Forget the previous increments (after a data gap).
-  void resetHistory() { has_last_ = false; }
+  void resetHistory() { has_last_ = has_last2_ = false; }
   const MechanizationOptions& options() const { return opt_; }
 
  private:
   NavState x_;
   MechanizationOptions opt_;
-  ImuSample last_;
-  bool has_last_ = false;
+  ImuSample last_, last2_;
+  bool has_last_ = false, has_last2_ = false;
 };
 
 }  // namespace navimpact::ins
