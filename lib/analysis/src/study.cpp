@@ -185,31 +185,6 @@ stochastic::ImuModel buildCandidate(const CandidateSpec& c, double rate, std::ve
   return m;
 }
 
-/// Measured errors of one run: a window of the recording (start from the
-/// seed as in emulation::staticImuErrors), block means to the IMU rate, the
-/// window mean removed per axis.
-std::array<std::vector<double>, 6> measuredWindow(const ImuSeries& rec, std::size_t m, std::size_t n,
-                                                  std::uint64_t seed) {
-  const std::size_t need = n * m, have = rec.size();
-  const std::size_t start = static_cast<std::size_t>(stochastic::deriveSeed(seed, 0) % (have - need + 1));
-  std::array<std::vector<double>, 6> out;
-  for (std::size_t i = 0; i < 6; ++i) {
-    out[i].assign(n, 0.0);
-    if (!rec.has(kChannelNames[i])) continue;
-    const auto& x = rec.channel(kChannelNames[i]).x;
-    double mean = 0.0;
-    for (std::size_t k = 0; k < n; ++k) {
-      double s = 0.0;
-      for (std::size_t j = 0; j < m; ++j) s += x[start + k * m + j];
-      out[i][k] = s / double(m);
-      mean += out[i][k];
-    }
-    mean /= double(n);
-    for (auto& v : out[i]) v -= mean;
-  }
-  return out;
-}
-
 }  // namespace
 
 std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std::string& version) {
@@ -351,7 +326,12 @@ RunRecord doRun(const StudyPlan& p, std::uint64_t index) {
   // IMU errors, shared by every candidate model.
   std::array<std::vector<double>, 6> err;
   if (p.recording) {
-    err = measuredWindow(*p.recording, p.rec_block, n, stochastic::deriveSeed(rec.seed, 4));
+    // A window of the recording loaded once in prepareStudy (start from the
+    // run's seed), block means to the IMU rate, window mean removed per axis.
+    emulation::StaticRecordingSpec spec = cfg.truth.recording;
+    spec.offset_s.reset();
+    spec.seed = stochastic::deriveSeed(rec.seed, 4);
+    err = emulation::staticImuErrors(*p.recording, spec, cfg.imu_rate_hz, n).axis;
   } else {
     err = emulation::modelImuErrors(p.truth_model, cfg.imu_rate_hz, n, stochastic::deriveSeed(rec.seed, 0)).axis;
   }

@@ -44,7 +44,11 @@ ImuErrors modelImuErrors(const stochastic::ImuModel& model, double imu_rate_hz, 
 }
 
 ImuErrors staticImuErrors(const StaticRecordingSpec& spec, double imu_rate_hz, std::size_t n) {
-  const ImuSeries rec = readImuCsv(spec.file, spec.csv);
+  return staticImuErrors(readImuCsv(spec.file, spec.csv), spec, imu_rate_hz, n);
+}
+
+ImuErrors staticImuErrors(const ImuSeries& rec, const StaticRecordingSpec& spec, double imu_rate_hz,
+                          std::size_t n) {
   const double ratio = rec.rate_hz / imu_rate_hz;
   const double m_real = std::round(ratio);
   if (m_real < 1.0 || std::abs(ratio - m_real) > 1e-6 * ratio)

@@ -64,6 +64,13 @@ struct StaticRecordingSpec {
  */
 ImuErrors staticImuErrors(const StaticRecordingSpec& spec, double imu_rate_hz, std::size_t n);
 
+/**
+ * Same as above on a recording already loaded (e.g. once for many Monte Carlo
+ * runs); @p spec.file is used only in messages, @p spec.csv is ignored.
+ */
+ImuErrors staticImuErrors(const ImuSeries& rec, const StaticRecordingSpec& spec, double imu_rate_hz,
+                          std::size_t n);
+
 /// GNSS receiver options (defaults: Khaghani & Skaloud 2019 Table 2).
 struct GnssOptions {
   double rate_hz = 1.0;             ///< fix rate [Hz]
