@@ -4,11 +4,15 @@
 #include <iostream>
 
 #include "cli_common.hpp"
+#include "navimpact/core/build_info.hpp"
 #include "navimpact/core/error.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"navimpact — IMU error models judged by their impact on GNSS/INS navigation"};
-  app.set_version_flag("--version", std::string("navimpact ") + NAVIMPACT_VERSION);
+  std::string version = std::string("navimpact ") + NAVIMPACT_VERSION + "\nbuilt with:";
+  for (const auto& [name, ver] : navimpact::buildVersions())
+    if (name != "navimpact") version += "\n  " + name + " " + (ver.empty() ? "(unknown)" : ver);
+  app.set_version_flag("--version", version);
   app.require_subcommand(1);
   auto& cmds = navimpact::cli::registry();
   std::sort(cmds.begin(), cmds.end(), [](const auto& a, const auto& b) { return a.name < b.name; });

@@ -58,6 +58,14 @@ string(JSON runs GET "${b}" study runs)
 if(NOT runs EQUAL 3)
   message(FATAL_ERROR "merged study has ${runs} runs, expected 3")
 endif()
+# The outputs record what produced them: seed and library versions.
+string(JSON seed GET "${b}" study seed)
+string(JSON mrpt GET "${b}" study versions MRPT)
+string(JSON eigen GET "${b}" study versions Eigen)
+string(JSON gl GET "${b}" study versions GeographicLib)
+if(NOT seed EQUAL 5 OR NOT mrpt MATCHES "^[0-9]+\\.[0-9]+" OR NOT eigen MATCHES "^3\\." OR NOT gl MATCHES "^[0-9]+\\.")
+  message(FATAL_ERROR "study.json lacks the seed or library versions: seed=${seed} MRPT=${mrpt} Eigen=${eigen} GeographicLib=${gl}")
+endif()
 ]=])
 add_test(NAME cli_study_short_and_shards
          COMMAND ${CMAKE_COMMAND} -DNI=${NI} -DCONFIG=${_sdir}/short.yaml -DD=${_sdir}/out

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "navimpact/core/build_info.hpp"
 #include "navimpact/core/csv_reader.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/imu_series.hpp"
@@ -66,6 +67,7 @@ double chi2Quantile(double p, double dof) {
 json metaToJson(const StudyMeta& m) {
   json j;
   j["version"] = m.version;
+  j["versions"] = m.versions;
   j["config_file"] = m.config_file;
   j["config_text"] = m.config_text;
   j["seed"] = m.seed;
@@ -99,6 +101,7 @@ StudyMeta metaFromJson(const json& j, const std::string& where) {
   try {
     StudyMeta m;
     m.version = j.at("version");
+    m.versions = j.at("versions").get<std::vector<std::pair<std::string, std::string>>>();
     m.config_file = j.at("config_file");
     m.config_text = j.at("config_text");
     m.seed = j.at("seed");
@@ -287,6 +290,7 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
   nav.baro_in_outage = cfg.baro_in_outage;
 
   meta.version = version;
+  meta.versions = buildVersions();
   meta.config_file = cfg.config_file;
   meta.config_text = cfg.config_text;
   meta.seed = cfg.seed;
@@ -571,7 +575,7 @@ StudyResults mergeShards(const std::vector<std::string>& dirs) {
       first_meta = meta;
       res.meta = detail::metaFromJson(meta, sj);
     } else {
-      for (const char* k : {"config_text", "seed", "runs_total", "labels", "epochs", "outages", "version"})
+      for (const char* k : {"config_text", "seed", "runs_total", "labels", "epochs", "outages", "version", "versions"})
         if (meta.at(k) != first_meta.at(k))
           throw Error(sj + ": shard of a different study (" + std::string(k) + " differs from " + dirs[0] + ")");
     }

@@ -176,6 +176,9 @@ json buildJson(const View& v, bool with_cost) {
   json j;
   json study;
   study["navimpact_version"] = meta.version;
+  json versions = json::object();
+  for (const auto& [name, ver] : meta.versions) versions[name] = ver;
+  study["versions"] = versions;
   study["config_file"] = meta.config_file;
   study["config_text"] = meta.config_text;
   study["runs"] = v.r.acc.runs;
@@ -472,7 +475,10 @@ std::string report(const View& v, const std::vector<std::string>& figs_per_set_f
     while (std::getline(s, l)) md << "- " << l << "\n";
   }
   for (const auto& n : meta.notices) md << "- note: " << n << "\n";
-  md << "- configuration: `" << meta.config_file << "`; navimpact " << meta.version << "\n\n";
+  md << "- configuration: `" << meta.config_file << "`; navimpact " << meta.version;
+  for (const auto& [name, ver] : meta.versions)
+    if (name != "navimpact" && name != "build_type") md << ", " << name << " " << ver;
+  md << "\n\n";
   md << "Candidate models (the filter's IMU error model; an axis without a model is treated as perfect "
         "by the filter although the emulated data carry errors on all six axes):\n\n";
   md << "| model | filter states | error model |\n|---|---:|---|\n";

@@ -42,6 +42,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -166,6 +167,7 @@ struct RunRecord {
 /// Description of the study needed to interpret and write results (JSON-serialisable).
 struct StudyMeta {
   std::string version, config_file, config_text;
+  std::vector<std::pair<std::string, std::string>> versions;  ///< navimpact + libraries (core/build_info.hpp)
   std::uint64_t seed = 0;
   std::size_t runs_total = 0;
   double t0 = 0.0;                            ///< first trajectory time [s]
