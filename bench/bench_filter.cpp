@@ -20,12 +20,13 @@ ins::NavState benchState() {
   return x;
 }
 
-void filterStep(benchmark::State& st, filter::Discretization d, int every) {
+void filterStep(benchmark::State& st, filter::Discretization d, int every,
+                const std::string& model = "ref") {
   filter::EkfConfig cfg;
   cfg.discretization = d;
   cfg.propagate_every = every;
   filter::ErrorStateEkf ekf(benchState(), filter::Matrix9d::Identity(),
-                            stochastic::loadImuModel(kModels + ":ref"), cfg);
+                            stochastic::loadImuModel(kModels + ":" + model), cfg);
   const double dt = 0.005;
   const Eigen::Vector3d w(0.01, -0.02, 0.03), f(0.3, -0.1, -9.8);
   double t = 0.0;
@@ -50,6 +51,24 @@ static void BM_FilterStepRefEvery10(benchmark::State& st) {
 }
 BENCHMARK(BM_FilterStepRefEvery10)->Unit(benchmark::kMicrosecond);
 
+/// Same with covariance propagation every 20th sample.
+static void BM_FilterStepRefEvery20(benchmark::State& st) {
+  filterStep(st, filter::Discretization::Series, 20);
+}
+BENCHMARK(BM_FilterStepRefEvery20)->Unit(benchmark::kMicrosecond);
+
+/// A small model: gyroscope white noise only (9 states), every sample and every 10th.
+static void BM_FilterStepGyroWn(benchmark::State& st) {
+  filterStep(st, filter::Discretization::Series, static_cast<int>(st.range(0)), "gyro_model1");
+}
+BENCHMARK(BM_FilterStepGyroWn)->Arg(1)->Arg(10)->Unit(benchmark::kMicrosecond);
+
+/// Accelerometer model 2 (WN + GM + drift: 9 + 9 states), every sample and every 10th.
+static void BM_FilterStepAcc2(benchmark::State& st) {
+  filterStep(st, filter::Discretization::Series, static_cast<int>(st.range(0)), "acc_model2");
+}
+BENCHMARK(BM_FilterStepAcc2)->Arg(1)->Arg(10)->Unit(benchmark::kMicrosecond);
+
 /// Same with exact Van Loan discretisation (66 x 66 matrix exponential per sample).
 static void BM_FilterStepRefVanLoan(benchmark::State& st) {
   filterStep(st, filter::Discretization::VanLoan, 1);
@@ -68,6 +87,17 @@ static void BM_GnssUpdateRef(benchmark::State& st) {
   }
 }
 BENCHMARK(BM_GnssUpdateRef)->Unit(benchmark::kMicrosecond);
+
+/// One barometer update, Ref models.
+static void BM_BaroUpdateRef(benchmark::State& st) {
+  const ins::NavState x = benchState();
+  filter::ErrorStateEkf ekf(x, filter::Matrix9d::Identity(), stochastic::loadImuModel(kModels + ":ref"));
+  for (auto _ : st) {
+    ekf.updateBaro(x.h, 0.5);
+    benchmark::DoNotOptimize(ekf.P().data());
+  }
+}
+BENCHMARK(BM_BaroUpdateRef)->Unit(benchmark::kMicrosecond);
 
 /// The full static covariance study: 8 models, 60 s at 200 Hz, baro at 10 Hz (no file output).
 static void BM_CovarianceStudy(benchmark::State& st) {

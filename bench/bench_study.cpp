@@ -45,3 +45,29 @@ BENCHMARK_CAPTURE(BM_StudyFilterStep, ref_both, std::string("ref"))
     ->Arg(1)->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_StudyFilterStep, gyro_wn, std::string("gyro_model1"))
     ->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
+
+/// One Monte Carlo run of the paper study (config/paper/study_navchip_uav.yaml:
+/// 260 s at 200 Hz, all its candidate models, propagate_every from the file):
+/// emulation of the run's IMU errors, GNSS and baro plus every model's filter.
+/// Counters: filter us per step (summed over models) and the share of the run
+/// spent in the filters.
+static void BM_StudyOneRunPaper(benchmark::State& st) {
+  an::StudyConfig cfg =
+      an::loadStudyConfig(std::string(NAVIMPACT_SOURCE_DIR) + "/config/paper/study_navchip_uav.yaml");
+  cfg.runs = 1;
+  cfg.threads = 1;
+  if (st.range(0) > 0) cfg.ekf.propagate_every = static_cast<int>(st.range(0));
+  const auto plan = an::prepareStudy(cfg, "bench");
+  double wall = 0.0, steps = 0.0;
+  for (auto _ : st) {
+    const an::StudyResults r = an::runStudy(plan, an::Shard{}, 1);
+    for (const auto& m : r.acc.models) {
+      wall += m.wall_s;
+      steps += m.steps;
+    }
+  }
+  st.counters["models"] = static_cast<double>(cfg.candidates.size());
+  st.counters["us_per_step"] = 1e6 * wall / steps;
+  st.counters["filter_s_per_run"] = wall / static_cast<double>(st.iterations());
+}
+BENCHMARK(BM_StudyOneRunPaper)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(2);

@@ -31,8 +31,14 @@ struct ErrorStateEkf::Transition {
 };
 
 struct ErrorStateEkf::Cache {
-  double dt = -1.0;                 // dt of the cached exact IMU-error blocks
-  std::vector<MatrixXd> Phi, Qd;    // per process block
+  /// Exact discrete IMU-error blocks (from stochastic) for one interval length.
+  struct Blocks {
+    double dt = -1.0;
+    std::vector<MatrixXd> Phi, Qd;  // per process block
+  };
+  std::vector<Blocks> blocks;       // a few interval lengths (sample, k samples, ...)
+  std::size_t next_slot = 0;
+  const Blocks& blocksFor(const std::vector<ProcessBlock>& layout_blocks, double dt);
   // covariance-only propagation along an unchanged nominal
   bool nominal_valid = false;
   ins::NavState nominal;
@@ -40,9 +46,35 @@ struct ErrorStateEkf::Cache {
   double nominal_dt = 0.0;
   Transition T;
   Transition tmp;                   // scratch
-  MatrixXd Fni, FniFii, FniQii, FniQiiFii, FniFiiQii;  // scratch of the series form
+  MatrixXd Fni, FniFii, FniQii, FniQiiFii, FniFiiQii, Qni;  // scratch of the series form
   MatrixXd Mni;                     // scratch of the propagation
 };
+
+/// The cached exact IMU-error blocks for @p dt (relative tolerance 1e-9, far
+/// below any effect on the covariance: Phi = exp(-dt/T) changes by 1e-9 dt/T).
+const ErrorStateEkf::Cache::Blocks& ErrorStateEkf::Cache::blocksFor(
+    const std::vector<ProcessBlock>& layout_blocks, double dt) {
+  for (const Blocks& b : blocks)
+    if (std::abs(b.dt - dt) <= 1e-9 * dt) return b;
+  constexpr std::size_t kSlots = 4;
+  Blocks* e = nullptr;
+  if (blocks.size() < kSlots) {
+    blocks.emplace_back();
+    e = &blocks.back();
+  } else {
+    e = &blocks[next_slot];
+    next_slot = (next_slot + 1) % kSlots;
+  }
+  e->Phi.clear();
+  e->Qd.clear();
+  for (const ProcessBlock& b : layout_blocks) {
+    const bool constant = b.ss.F.cwiseAbs().maxCoeff() == 0.0 && b.ss.Qc.cwiseAbs().maxCoeff() == 0.0;
+    e->Phi.push_back(constant ? MatrixXd::Identity(b.ss.n, b.ss.n) : b.ss.Phi(dt));
+    e->Qd.push_back(constant ? MatrixXd::Zero(b.ss.n, b.ss.n) : b.ss.Qd(dt));
+  }
+  e->dt = dt;
+  return *e;
+}
 
 namespace {
 std::string tstr(double t) {
@@ -88,58 +120,60 @@ Eigen::Matrix<double, 6, 1> ErrorStateEkf::sensorErrors() const {
   return e;
 }
 
-MatrixXd ErrorStateEkf::F() const {
+ErrorStateEkf::Lin ErrorStateEkf::currentLin() const {
+  Lin L;
+  L.Fnn = navErrorDynamics(state(), f_B_);
+  L.C = state().C_BtoN();
+  const auto& psd = layout_.whitePsd();
+  const Vector3d pg(psd[0], psd[1], psd[2]), pa(psd[3], psd[4], psd[5]);
+  L.Qv = L.C * pa.asDiagonal() * L.C.transpose();
+  L.Qa = L.C * pg.asDiagonal() * L.C.transpose();
+  return L;
+}
+
+MatrixXd ErrorStateEkf::assembleF(const Lin& L) const {
   const int N = size();
   MatrixXd F = MatrixXd::Zero(N, N);
-  F.topLeftCorner<9, 9>() = navErrorDynamics(state(), f_B_);
-  const Eigen::Matrix3d C = state().C_BtoN();
+  F.topLeftCorner<9, 9>() = L.Fnn;
   for (const ProcessBlock& b : layout_.blocks()) {
     const int row = b.channel < 3 ? kAtt : kVel;
     // d(psi)/dt += C dw_B, d(dv)/dt += C df_B, with dsensor = -H dx_imu (Groves 14.64-14.65)
-    F.block(row, b.offset, 3, b.ss.n) = -C.col(b.channel % 3) * b.ss.H;
+    F.block(row, b.offset, 3, b.ss.n) = -L.C.col(b.channel % 3) * b.ss.H;
     F.block(b.offset, b.offset, b.ss.n, b.ss.n) = b.ss.F;
   }
   return F;
 }
 
-MatrixXd ErrorStateEkf::Qc() const {
+MatrixXd ErrorStateEkf::assembleQc(const Lin& L) const {
   const int N = size();
   MatrixXd Q = MatrixXd::Zero(N, N);
-  const Eigen::Matrix3d C = state().C_BtoN();
-  const auto& psd = layout_.whitePsd();
-  const Vector3d pg(psd[0], psd[1], psd[2]), pa(psd[3], psd[4], psd[5]);
-  Q.block<3, 3>(kVel, kVel) = C * pa.asDiagonal() * C.transpose();
-  Q.block<3, 3>(kAtt, kAtt) = C * pg.asDiagonal() * C.transpose();
+  Q.block<3, 3>(kVel, kVel) = L.Qv;
+  Q.block<3, 3>(kAtt, kAtt) = L.Qa;
   for (const ProcessBlock& b : layout_.blocks())
     Q.block(b.offset, b.offset, b.ss.n, b.ss.n) = b.ss.Qc;
   return Q;
 }
 
-void ErrorStateEkf::buildTransition(double dt, Transition& T) const {
+MatrixXd ErrorStateEkf::F() const { return assembleF(currentLin()); }
+
+MatrixXd ErrorStateEkf::Qc() const { return assembleQc(currentLin()); }
+
+void ErrorStateEkf::buildTransition(const Lin& L, double dt, Transition& T) const {
   const int m = layout_.imuSize();
   const auto& blocks = layout_.blocks();
   Cache& c = *cache_;
-  if (c.dt != dt) {  // exact discrete IMU-error blocks (from stochastic), cached per dt
-    c.Phi.clear();
-    c.Qd.clear();
-    for (const ProcessBlock& b : blocks) {
-      const bool constant = b.ss.F.cwiseAbs().maxCoeff() == 0.0 && b.ss.Qc.cwiseAbs().maxCoeff() == 0.0;
-      c.Phi.push_back(constant ? MatrixXd::Identity(b.ss.n, b.ss.n) : b.ss.Phi(dt));
-      c.Qd.push_back(constant ? MatrixXd::Zero(b.ss.n, b.ss.n) : b.ss.Qd(dt));
-    }
-    c.dt = dt;
-  }
+  const Cache::Blocks& cb = c.blocksFor(blocks, dt);
   T.D.setZero(m, m);
   T.Q.setZero(9 + m, 9 + m);
   for (std::size_t k = 0; k < blocks.size(); ++k) {
     const int o = blocks[k].offset - kNav, n = blocks[k].ss.n;
-    T.D.block(o, o, n, n) = c.Phi[k];
-    T.Q.block(9 + o, 9 + o, n, n) = c.Qd[k];
+    T.D.block(o, o, n, n) = cb.Phi[k];
+    T.Q.block(9 + o, 9 + o, n, n) = cb.Qd[k];
   }
 
   if (cfg_.discretization == Discretization::VanLoan) {
     // Van Loan (1978): expm([-F Qc; 0 F'] dt) = [.. Phi^-1 Qd; 0 Phi'] (Groves 3.? / 14.?)
-    const MatrixXd F = this->F(), Q = this->Qc();
+    const MatrixXd F = assembleF(L), Q = assembleQc(L);
     const int N = size();
     MatrixXd M = MatrixXd::Zero(2 * N, 2 * N);
     M.topLeftCorner(N, N) = -F * dt;
@@ -159,9 +193,10 @@ void ErrorStateEkf::buildTransition(double dt, Transition& T) const {
   }
 
   // Series form (Groves 3.34, 3.46-3.47 truncated): Phi to second order in dt,
-  // Qd to third order, computed block by block.
-  const Matrix9d Fnn = navErrorDynamics(state(), f_B_);
-  const Eigen::Matrix3d C = state().C_BtoN();
+  // Qd to third order, computed block by block; no heap allocation once the
+  // scratch matrices have their size.
+  const Matrix9d& Fnn = L.Fnn;
+  const Eigen::Matrix3d& C = L.C;
   MatrixXd& Fni = c.Fni;
   MatrixXd& FniFii = c.FniFii;
   MatrixXd& FniQii = c.FniQii;
@@ -181,41 +216,67 @@ void ErrorStateEkf::buildTransition(double dt, Transition& T) const {
       FniFiiQii.block<3, 1>(row, o) = col * (h * f * q);
       continue;
     }
-    Fni.block(row, o, 3, n) = col * b.ss.H;
-    FniFii.block(row, o, 3, n) = Fni.block(row, o, 3, n) * b.ss.F;
-    FniQii.block(row, o, 3, n) = Fni.block(row, o, 3, n) * b.ss.Qc;
-    FniQiiFii.block(row, o, 3, n) = FniQii.block(row, o, 3, n) * b.ss.F.transpose();
-    FniFiiQii.block(row, o, 3, n) = FniFii.block(row, o, 3, n) * b.ss.Qc;
+    // multi-state block (DR, SIN): (3 x 1) column times (1 x n) rows, n small
+    for (int j = 0; j < n; ++j) {
+      const double hF = b.ss.H.dot(b.ss.F.col(j)), hQ = b.ss.H.dot(b.ss.Qc.col(j));
+      double hQFt = 0.0, hFQ = 0.0;
+      for (int i = 0; i < n; ++i) {
+        hQFt += b.ss.H.dot(b.ss.Qc.col(i)) * b.ss.F(j, i);
+        hFQ += b.ss.H.dot(b.ss.F.col(i)) * b.ss.Qc(i, j);
+      }
+      Fni.block<3, 1>(row, o + j) = col * b.ss.H(j);
+      FniFii.block<3, 1>(row, o + j) = col * hF;
+      FniQii.block<3, 1>(row, o + j) = col * hQ;
+      FniQiiFii.block<3, 1>(row, o + j) = col * hQFt;
+      FniFiiQii.block<3, 1>(row, o + j) = col * hFQ;
+    }
   }
   const double dt2 = dt * dt, dt3 = dt2 * dt;
   const Matrix9d Fnn2 = Fnn * Fnn;
   T.A = Matrix9d::Identity() + Fnn * dt + Fnn2 * (0.5 * dt2);
-  T.B = Fni * dt + (Fnn * Fni + FniFii) * (0.5 * dt2);
-  const auto& psd = layout_.whitePsd();
-  const Vector3d pg(psd[0], psd[1], psd[2]), pa(psd[3], psd[4], psd[5]);
+  // B = Fni dt + (Fnn Fni + Fni Fii) dt^2/2
+  T.B.resize(9, m);
+  T.B.noalias() = Fnn * Fni;
+  T.B += FniFii;
+  T.B *= 0.5 * dt2;
+  T.B += Fni * dt;
   Matrix9d Qnn = Matrix9d::Zero();
-  Qnn.block<3, 3>(kVel, kVel) = C * pa.asDiagonal() * C.transpose();
-  Qnn.block<3, 3>(kAtt, kAtt) = C * pg.asDiagonal() * C.transpose();
+  Qnn.block<3, 3>(kVel, kVel) = L.Qv;
+  Qnn.block<3, 3>(kAtt, kAtt) = L.Qa;
   // Qd = Q dt + (FQ + QF') dt^2/2 + (F^2 Q + 2 F Q F' + Q F^2') dt^3/6 + O(dt^4),
   // with Q = blockdiag(Qnn, Qii) and F = [Fnn Fni; 0 Fii]:
   const Matrix9d FQ = Fnn * Qnn;
   const Matrix9d F2Q = Fnn2 * Qnn;
-  const Matrix9d FQFt = FQ * Fnn.transpose() + FniQii * Fni.transpose();
+  Matrix9d FQFt = FQ * Fnn.transpose();
+  FQFt.noalias() += FniQii * Fni.transpose();
   T.Q.topLeftCorner<9, 9>() = Qnn * dt + (FQ + FQ.transpose()) * (0.5 * dt2) +
                               (F2Q + F2Q.transpose() + 2.0 * FQFt) * (dt3 / 6.0);
-  const MatrixXd Qni = FniQii * (0.5 * dt2) +
-                       (Fnn * FniQii + FniFiiQii + 2.0 * FniQiiFii) * (dt3 / 6.0);
+  // Qni = Fni Qii dt^2/2 + (Fnn Fni Qii + Fni Fii Qii + 2 Fni Qii Fii') dt^3/6
+  MatrixXd& Qni = c.Qni;
+  Qni.resize(9, m);
+  Qni.noalias() = Fnn * FniQii;
+  Qni += FniFiiQii + 2.0 * FniQiiFii;
+  Qni *= dt3 / 6.0;
+  Qni += FniQii * (0.5 * dt2);
   T.Q.topRightCorner(9, m) = Qni;
   T.Q.bottomLeftCorner(m, 9) = Qni.transpose();
 }
 
 namespace {
+using SmallRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, 8>;
+using SmallCol = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
 // X <- X * D' for block-diagonal D (blocks given by the layout), columns in place.
 void rightMulDt(Eigen::Ref<MatrixXd> X, const MatrixXd& D, const std::vector<ProcessBlock>& blocks) {
   for (const ProcessBlock& b : blocks) {
     const int o = b.offset - kNav, n = b.ss.n;
     if (n == 1) {
       X.col(o) *= D(o, o);
+    } else if (n <= 8) {
+      const auto Db = D.block(o, o, n, n);
+      for (Eigen::Index r = 0; r < X.rows(); ++r) {
+        const SmallRow y = X.row(r).segment(o, n) * Db.transpose();
+        X.row(r).segment(o, n) = y;
+      }
     } else {
       X.middleCols(o, n) = (X.middleCols(o, n) * D.block(o, o, n, n).transpose()).eval();
     }
@@ -227,6 +288,12 @@ void leftMulD(Eigen::Ref<MatrixXd> X, const MatrixXd& D, const std::vector<Proce
     const int o = b.offset - kNav, n = b.ss.n;
     if (n == 1) {
       X.row(o) *= D(o, o);
+    } else if (n <= 8) {
+      const auto Db = D.block(o, o, n, n);
+      for (Eigen::Index j = 0; j < X.cols(); ++j) {
+        const SmallCol y = Db * X.col(j).segment(o, n);
+        X.col(j).segment(o, n) = y;
+      }
     } else {
       X.middleRows(o, n) = (D.block(o, o, n, n) * X.middleRows(o, n)).eval();
     }
@@ -315,10 +382,36 @@ void ErrorStateEkf::propagate(const Matrix9d& A_acc_, const MatrixXd& B_acc_, co
   checkP("propagation");
 }
 
-void ErrorStateEkf::flushPropagation() { applyTransition(); }
+void ErrorStateEkf::applyInterval() {
+  if (iv_n_ == 0) return;
+  // One transition over the whole interval T from the interval means of the
+  // specific force (NED), of C_BtoN and of the rotated white-noise PSDs,
+  // linearised at the end-of-interval state (Groves 2013 §14.2.4: the system
+  // model may be propagated at a lower rate than the mechanization).
+  const double T = iv_dt_, inv = 1.0 / T;
+  Lin L;
+  L.Fnn = navErrorDynamicsN(state(), iv_fN_ * inv);
+  L.C = iv_C_ * inv;
+  L.Qv = iv_Qv_ * inv;
+  L.Qa = iv_Qa_ * inv;
+  Transition& Tr = cache_->tmp;
+  buildTransition(L, T, Tr);
+  propagate(Tr.A, Tr.B, Tr.D, Tr.Q);
+  iv_n_ = 0;
+  iv_dt_ = 0.0;
+  iv_fN_.setZero();
+  iv_C_.setZero();
+  iv_Qv_.setZero();
+  iv_Qa_.setZero();
+}
+
+void ErrorStateEkf::flushPropagation() {
+  applyInterval();
+  applyTransition();
+}
 
 void ErrorStateEkf::checkP(const char* where) const {
-  const VectorXd d = P_.diagonal();
+  const auto d = P_.diagonal();
   const double scale = d.cwiseAbs().maxCoeff();
   for (int i = 0; i < d.size(); ++i) {
     if (!std::isfinite(d(i)) || d(i) < -1e-12 * (1.0 + scale))
@@ -331,6 +424,7 @@ void ErrorStateEkf::checkP(const char* where) const {
 void ErrorStateEkf::predict(const ins::ImuSample& raw) {
   if (!(raw.dt > 0.0) || !std::isfinite(raw.dt))
     throw Error("IMU sample at t = " + tstr(raw.t) + " s has non-positive interval dt");
+  if (pending_ > 0) applyTransition();  // left over from predictCovariance()
   // Corrected output = raw - estimated error (closed loop, Groves 14.? feedback).
   const Eigen::Matrix<double, 6, 1> e = sensorErrors();
   ins::ImuSample s = raw;
@@ -340,21 +434,56 @@ void ErrorStateEkf::predict(const ins::ImuSample& raw) {
   f_B_ = s.f_B();
   mech_.step(s);
   cache_->nominal_valid = false;
-  Transition& T = cache_->tmp;
-  buildTransition(raw.dt, T);
-  // deterministic propagation of the IMU-error estimates with the exact blocks
-  for (const ProcessBlock& b : layout_.blocks()) {
-    const int o = b.offset - kNav, n = b.ss.n;
-    if (n == 1) x_imu_(o) *= T.D(o, o);
-    else x_imu_.segment(o, n) = (T.D.block(o, o, n, n) * x_imu_.segment(o, n)).eval();
+  const auto& blocks = layout_.blocks();
+  if (cfg_.propagate_every == 1) {
+    Transition& T = cache_->tmp;
+    buildTransition(currentLin(), raw.dt, T);
+    // deterministic propagation of the IMU-error estimates with the exact blocks
+    for (const ProcessBlock& b : blocks) {
+      const int o = b.offset - kNav, n = b.ss.n;
+      if (n == 1) {
+        x_imu_(o) *= T.D(o, o);
+      } else if (n > 8) {
+        x_imu_.segment(o, n) = (T.D.block(o, o, n, n) * x_imu_.segment(o, n)).eval();
+      } else {
+        const SmallCol y = T.D.block(o, o, n, n) * x_imu_.segment(o, n);
+        x_imu_.segment(o, n) = y;
+      }
+    }
+    accumulate(T);
+    return;
   }
-  accumulate(T);
+  // Lower-rate covariance propagation: IMU-error estimates every sample with
+  // the exact blocks, covariance once per interval (applyInterval).
+  const Cache::Blocks& cb = cache_->blocksFor(blocks, raw.dt);
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const int o = blocks[k].offset - kNav, n = blocks[k].ss.n;
+    if (n == 1) {
+      x_imu_(o) *= cb.Phi[k](0, 0);
+    } else if (n > 8) {
+      x_imu_.segment(o, n) = (cb.Phi[k] * x_imu_.segment(o, n)).eval();
+    } else {
+      const SmallCol y = cb.Phi[k] * x_imu_.segment(o, n);
+      x_imu_.segment(o, n) = y;
+    }
+  }
+  const Eigen::Matrix3d C = state().C_BtoN();
+  const auto& psd = layout_.whitePsd();
+  iv_dt_ += raw.dt;
+  iv_fN_ += C * (f_B_ * raw.dt);
+  iv_C_ += C * raw.dt;
+  Eigen::Matrix3d Cs = C * Vector3d(psd[3], psd[4], psd[5]).asDiagonal();
+  iv_Qv_.noalias() += (Cs * raw.dt) * C.transpose();
+  Cs = C * Vector3d(psd[0], psd[1], psd[2]).asDiagonal();
+  iv_Qa_.noalias() += (Cs * raw.dt) * C.transpose();
+  if (++iv_n_ >= cfg_.propagate_every) applyInterval();
 }
 
 void ErrorStateEkf::predictCovariance(const ins::NavState& nominal, const Vector3d& w_IB_B,
                                       const Vector3d& f_B, double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt))
     throw Error("covariance propagation at t = " + tstr(nominal.t) + " s: dt must be > 0");
+  applyInterval();  // left over from predict()
   Cache& c = *cache_;
   const bool same = c.nominal_valid && c.nominal_dt == dt && c.w == w_IB_B && c.f == f_B &&
                     sameState(c.nominal, nominal);
@@ -362,7 +491,7 @@ void ErrorStateEkf::predictCovariance(const ins::NavState& nominal, const Vector
   w_IB_B_ = w_IB_B;
   f_B_ = f_B;
   if (!same) {
-    buildTransition(dt, c.T);
+    buildTransition(currentLin(), dt, c.T);
     c.nominal = nominal;
     c.w = w_IB_B;
     c.f = f_B;
@@ -502,7 +631,7 @@ UpdateResult ErrorStateEkf::updateBaro(double h_meas, double sigma) {
 
 void ErrorStateEkf::discretize(double dt, MatrixXd& Phi, MatrixXd& Qd) const {
   Transition T;
-  buildTransition(dt, T);
+  buildTransition(currentLin(), dt, T);
   const int m = layout_.imuSize(), N = size();
   Phi = MatrixXd::Zero(N, N);
   Phi.topLeftCorner<9, 9>() = T.A;

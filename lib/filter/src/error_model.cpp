@@ -13,6 +13,10 @@ using Eigen::Vector3d;
 using ins::skew;
 
 Matrix9d navErrorDynamics(const ins::NavState& x, const Vector3d& f_B) {
+  return navErrorDynamicsN(x, x.C_BtoN() * f_B);
+}
+
+Matrix9d navErrorDynamicsN(const ins::NavState& x, const Vector3d& f_N) {
   const earth::Radii r = earth::radii(x.lat);
   const double rN = r.R_N + x.h, rE = r.R_E + x.h;
   const double sL = std::sin(x.lat), cL = std::cos(x.lat), tL = sL / cL;
@@ -20,7 +24,6 @@ Matrix9d navErrorDynamics(const ins::NavState& x, const Vector3d& f_B) {
   const double W = earth::kOmegaIE;
   const Vector3d w_ie = earth::w_IE_N(x.lat);
   const Vector3d w_en = earth::w_EN_N(x.lat, x.h, x.v_N);
-  const Vector3d f_N = x.C_BtoN() * f_B;
 
   // d(omega)/d(dp): column 0 = d/dlat / rN, column 2 = -d/dh (dp_D = -dh).
   Matrix3d Wie_r = Matrix3d::Zero();

@@ -36,6 +36,14 @@ using Matrix9d = Eigen::Matrix<double, 9, 9>;
  */
 Matrix9d navErrorDynamics(const ins::NavState& x, const Eigen::Vector3d& f_B);
 
+/**
+ * Same as navErrorDynamics() with the specific force already resolved in NED
+ * (e.g. the mean over a propagation interval).
+ * @param[in] x    navigation state (linearisation point), |lat| < 89.9 deg.
+ * @param[in] f_N  specific force in NED [m/s^2].
+ */
+Matrix9d navErrorDynamicsN(const ins::NavState& x, const Eigen::Vector3d& f_N);
+
 /// Error of @p est relative to @p truth in the convention above (9 values).
 Vector9d navError(const ins::NavState& est, const ins::NavState& truth);
 

@@ -1,0 +1,110 @@
+// Where the time of `navimpact replay` goes: reading the rawlog (gzip + MRPT
+// deserialisation) versus the navigation loop (runNav: mechanization,
+// covariance propagation, updates), Table 1 Ref models, 200 Hz.
+//   build-*/bin/navimpact_bench --benchmark_filter=Replay
+// Default rawlog: the committed 260 s one; set NAVIMPACT_BENCH_RAWLOG to
+// another (e.g. a 600 s one made with `navimpact emulate`).
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "navimpact/analysis/nav_run.hpp"
+#include "navimpact/core/earth.hpp"
+#include "navimpact/rawlog/writer.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+
+namespace an = navimpact::analysis;
+using namespace navimpact;
+
+namespace {
+
+std::string benchRawlog() {
+  if (const char* e = std::getenv("NAVIMPACT_BENCH_RAWLOG")) return e;
+  return std::string(NAVIMPACT_SOURCE_DIR) + "/datasets/uav_flight_260s_ref.rawlog";
+}
+
+/// Inputs of runNav as the replay builds them (GT at every epoch as truth).
+struct Prepared {
+  std::vector<ins::ImuSample> imu;
+  emulation::EmulationData d;
+  an::TruthSeries truth;
+  ins::NavState x0;
+};
+
+Prepared prepare(const std::string& path) {
+  Prepared p;
+  p.d = rawlog::readRawlog(path);
+  const double dt = p.d.imu[1].t - p.d.imu[0].t;
+  double prev = p.d.imu.front().t - dt;
+  for (const auto& r : p.d.imu) {
+    p.imu.push_back(ins::ImuSample::fromRates(r.t, r.t - prev, r.w_IB_B, r.f_B));
+    prev = r.t;
+  }
+  for (auto& b : p.d.baro) b.sigma = 0.5;
+  for (const auto& g : p.d.truth) {
+    ins::NavState x;
+    x.t = g.t;
+    const earth::Geodetic q = earth::nedToGeodetic(p.d.origin, g.p_L);
+    x.lat = q.lat;
+    x.lon = q.lon;
+    x.h = q.h;
+    x.v_N = g.v_N;
+    x.q_BtoN = g.q_BtoN.normalized();
+    p.truth.t.push_back(g.t);
+    p.truth.x.push_back(x);
+  }
+  p.x0 = p.truth.x.front();
+  p.x0.t = p.d.imu.front().t - dt;
+  return p;
+}
+
+}  // namespace
+
+/// Reading the rawlog alone (gzip inflate + MRPT deserialisation + conversion).
+static void BM_ReplayRead(benchmark::State& st) {
+  const std::string path = benchRawlog();
+  if (!std::filesystem::exists(path)) {
+    st.SkipWithError(("no rawlog " + path).c_str());
+    return;
+  }
+  std::size_t n = 0;
+  for (auto _ : st) {
+    const emulation::EmulationData d = rawlog::readRawlog(path);
+    n = d.imu.size();
+    benchmark::DoNotOptimize(d.imu.data());
+  }
+  st.counters["imu_samples"] = static_cast<double>(n);
+}
+BENCHMARK(BM_ReplayRead)->Unit(benchmark::kMillisecond);
+
+/// The navigation loop of the replay on data already in memory, Ref model,
+/// covariance every k samples (argument), GNSS 1 Hz, baro 10 Hz, GT 10 Hz epochs.
+static void BM_ReplayFilter(benchmark::State& st) {
+  const std::string path = benchRawlog();
+  if (!std::filesystem::exists(path)) {
+    st.SkipWithError(("no rawlog " + path).c_str());
+    return;
+  }
+  const Prepared p = prepare(path);
+  const stochastic::ImuModel m =
+      stochastic::loadImuModel(std::string(NAVIMPACT_SOURCE_DIR) + "/config/models/navchip_table1.yaml:ref");
+  an::NavRunInput in;
+  in.x0 = p.x0;
+  in.imu = &p.imu;
+  in.gnss = &p.d.gnss;
+  in.baro = &p.d.baro;
+  in.truth = &p.truth;
+  an::NavRunOptions opt;
+  opt.ekf.propagate_every = static_cast<int>(st.range(0));
+  opt.outages = {{p.x0.t + 200.0, p.x0.t + 260.0}};
+  double steps = 0;
+  for (auto _ : st) {
+    const an::NavRunResult r = an::runNav(in, m, opt);
+    steps += static_cast<double>(r.steps);
+    benchmark::DoNotOptimize(r.epochs.data());
+  }
+  st.counters["us_per_step"] = benchmark::Counter(steps * 1e-6, benchmark::Counter::kIsRate |
+                                                                    benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_ReplayFilter)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
