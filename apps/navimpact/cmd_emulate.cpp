@@ -15,6 +15,7 @@ struct Opts {
   std::string config;
   std::string out;
   bool no_gzip = false;
+  bool no_gt = false;
 };
 
 navimpact::cli::Registrar reg({
@@ -26,10 +27,16 @@ navimpact::cli::Registrar reg({
           ->required();
       app.add_option("--out", o->out, "output rawlog (FILE.rawlog; gzip-compressed unless --no-gzip)")->required();
       app.add_flag("--no-gzip", o->no_gzip, "write the rawlog uncompressed");
+      app.add_flag("--no-gt", o->no_gt,
+                   "leave out the ground-truth records (label GT), like the rawlog of a real flight");
       return [o]() -> int {
         namespace fs = std::filesystem;
         const auto cfg = navimpact::emulation::loadEmulationConfig(o->config);
-        const auto data = navimpact::emulation::runEmulation(cfg, NAVIMPACT_VERSION);
+        auto data = navimpact::emulation::runEmulation(cfg, NAVIMPACT_VERSION);
+        if (o->no_gt) {
+          data.truth.clear();
+          data.notices.push_back("--no-gt: ground-truth records (label GT) left out of the rawlog");
+        }
         const fs::path outPath(o->out);
         navimpact::OutputSet outs(outPath.has_parent_path() ? outPath.parent_path() : fs::path("."));
         const auto staged = outs.stage(outPath.filename().string());

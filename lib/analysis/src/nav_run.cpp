@@ -48,9 +48,12 @@ std::array<double, 4> navNees(const filter::Vector9d& err, const filter::Matrix9
 NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
                     const NavRunOptions& opt) {
   if (!in.imu || in.imu->empty()) throw Error("navigation run: no IMU samples");
-  if (!in.truth) throw Error("navigation run: no truth series");
+  const TruthSeries noTruth;
+  const bool hasTruth = in.truth != nullptr;
+  if (!hasTruth && !(opt.record_interval_s > 0.0 && std::isfinite(opt.record_interval_s)))
+    throw Error("navigation run: record interval must be > 0 s without truth, got " + num(opt.record_interval_s));
   const auto& imu = *in.imu;
-  const auto& truth = *in.truth;
+  const auto& truth = hasTruth ? *in.truth : noTruth;
   if (truth.t.size() != truth.x.size())
     throw Error("navigation run: truth series has " + std::to_string(truth.t.size()) + " times but " +
                 std::to_string(truth.x.size()) + " states");
@@ -61,6 +64,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
   const auto t_start = std::chrono::steady_clock::now();
   filter::ErrorStateEkf ekf(in.x0, opt.P0_nav, model, opt.ekf);
   NavRunResult res;
+  res.has_truth = hasTruth;
   res.states = ekf.size();
   res.outages.resize(opt.outages.size());
   for (std::size_t i = 0; i < opt.outages.size(); ++i) res.outages[i].window = opt.outages[i];
@@ -92,7 +96,23 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       ++res.baro_updates;
     }
   };
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  double next_record = in.x0.t;  // without truth
   auto record = [&](double t_now, double half_dt) {
+    if (!hasTruth) {
+      if (t_now + half_dt < next_record) return;
+      while (next_record <= t_now + half_dt) next_record += opt.record_interval_s;
+      ekf.flushPropagation();
+      NavEpoch e;
+      e.t = t_now;
+      e.est = ekf.state();
+      e.err.setConstant(kNaN);
+      const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
+      e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
+      e.nees.fill(kNaN);
+      res.epochs.push_back(e);
+      return;
+    }
     while (it < truth.t.size() && truth.t[it] <= t_now + half_dt) {
       if (std::abs(truth.t[it] - t_now) > half_dt)
         throw Error("navigation run: truth epoch " + num(truth.t[it]) +
@@ -100,6 +120,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       ekf.flushPropagation();
       NavEpoch e;
       e.t = truth.t[it];
+      e.est = ekf.state();
       e.err = filter::navError(ekf.state(), truth.x[it]);
       const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
@@ -130,6 +151,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       const NavEpoch& e = res.epochs[k];
       if (e.t <= o.window.start || e.t > o.window.end + 1e-9) continue;
       o.end_epoch = static_cast<int>(k);
+      if (!hasTruth) continue;
       o.max_drift_h = std::max(o.max_drift_h, e.err.head<2>().norm());
       o.max_drift_3d = std::max(o.max_drift_3d, e.err.head<3>().norm());
     }

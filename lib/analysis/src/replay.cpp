@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -96,11 +97,12 @@ ReplayConfig loadReplayConfig(const std::string& path) {
   const fs::path dir = fs::path(path).parent_path();
   if (!root.IsMap()) throw keyError(path, "(root)", "expected a map");
   const std::set<std::string> allowed = {"rawlog", "model", "outages", "filter", "initial_sigma", "noise",
-                                         "gnss_lever_arm_B_m"};
+                                         "gnss_lever_arm_B_m", "initial_attitude_deg", "record_interval_s"};
   for (const auto& kv : root)
     if (!allowed.count(kv.first.as<std::string>()))
       throw keyError(path, kv.first.as<std::string>(),
-                     "unknown key (expected rawlog, model, outages, filter, initial_sigma, noise, gnss_lever_arm_B_m)");
+                     "unknown key (expected rawlog, model, outages, filter, initial_sigma, noise, gnss_lever_arm_B_m, "
+                     "initial_attitude_deg, record_interval_s)");
   auto num = [&](const YAML::Node& n, const std::string& key) {
     try {
       return n.as<double>();
@@ -162,19 +164,123 @@ ReplayConfig loadReplayConfig(const std::string& path) {
     c.lever_arm_B = Eigen::Vector3d(num(l[0], "gnss_lever_arm_B_m"), num(l[1], "gnss_lever_arm_B_m"),
                                     num(l[2], "gnss_lever_arm_B_m"));
   }
+  if (const auto a = root["initial_attitude_deg"]) {
+    if (!a.IsSequence() || a.size() != 3)
+      throw keyError(path, "initial_attitude_deg", "expected [roll, pitch, yaw] in degrees");
+    c.initial_attitude_deg = Eigen::Vector3d(num(a[0], "initial_attitude_deg"), num(a[1], "initial_attitude_deg"),
+                                             num(a[2], "initial_attitude_deg"));
+  }
+  if (root["record_interval_s"]) c.record_interval_s = pos(root["record_interval_s"], "record_interval_s");
   return c;
 }
 
+namespace {
+/// Initial state without GT: GNSS fix at time zero, levelling, GNSS course (see replay.hpp).
+ins::NavState initialWithoutTruth(const emulation::EmulationData& d, const ReplayConfig& cfg, double t_zero,
+                                  double dt, const Eigen::Vector3d& lever_B, filter::Matrix9d& P0,
+                                  std::vector<std::string>& notices) {
+  const emulation::GnssFix* fix = nullptr;
+  for (const auto& f : d.gnss)
+    if (std::abs(f.t - t_zero) <= 0.5 * dt) {
+      fix = &f;
+      break;
+    }
+  if (!fix)
+    throw Error(cfg.rawlog + ": no ground truth (label GT) and no GNSS fix at the start of the IMU data (t = " +
+                num(t_zero) + " s) to initialise the filter from");
+  if (!fix->v_N.allFinite())
+    throw Error(cfg.rawlog + ": no ground truth and the first GNSS fix has no velocity (GGA only)");
+  Eigen::Vector3d rpy;
+  std::string how;
+  if (cfg.initial_attitude_deg) {
+    rpy = *cfg.initial_attitude_deg * kDeg;
+    how = "attitude from initial_attitude_deg";
+  } else {
+    // Yaw from the GNSS course at time zero (no sideslip assumed). Roll and
+    // pitch: C_BtoN(0) maps the specific force integrated over the first GNSS
+    // interval, resolved in the time-zero body frame with the gyros
+    // (u = sum dC_k f_B,k dt), onto the measured velocity change minus gravity
+    // (v = v1 - v0 - g_N T; Coriolis and transport rate neglected) - levelling
+    // (Groves 2013 eq. 5.101) corrected for the vehicle's own acceleration.
+    const double vh = fix->v_N.head<2>().norm();
+    if (vh < 1.0)
+      throw Error(cfg.rawlog + ": no ground truth and a horizontal GNSS speed of " + num(vh) +
+                  " m/s at the start, too slow for a course: give initial_attitude_deg: [roll, pitch, yaw]");
+    rpy[2] = std::atan2(fix->v_N.y(), fix->v_N.x());
+    const emulation::GnssFix* fix1 = nullptr;
+    for (const auto& f : d.gnss)
+      if (f.t > fix->t + 0.5 * dt && f.v_N.allFinite()) {
+        fix1 = &f;
+        break;
+      }
+    if (!fix1 || fix1->t - fix->t > 5.0)
+      throw Error(cfg.rawlog + ": no ground truth and no second GNSS fix within 5 s of the start to level with: "
+                  "give initial_attitude_deg: [roll, pitch, yaw]");
+    Eigen::Quaterniond dq = Eigen::Quaterniond::Identity();
+    Eigen::Vector3d u = Eigen::Vector3d::Zero();
+    double prev = t_zero;
+    for (const auto& s : d.imu) {
+      if (s.t > fix1->t + 0.5 * dt) break;
+      const double h = s.t - prev;
+      dq = (dq * ins::quatFromRotVec(s.w_IB_B * h)).normalized();
+      u += dq * (s.f_B * h);
+      prev = s.t;
+    }
+    const double T = fix1->t - fix->t;
+    const Eigen::Vector3d v = fix1->v_N - fix->v_N - earth::gravity_N(fix->pos.lat, fix->pos.h) * T;
+    const Eigen::Vector3d uh = u.normalized(), vhat = v.normalized();
+    auto resid = [&](double r, double p) {
+      ins::NavState a;
+      a.setRollPitchYaw(r, p, rpy[2]);
+      return Eigen::Vector3d(a.C_BtoN() * uh - vhat);
+    };
+    double r = 0.0, p = 0.0;
+    for (int it = 0; it < 20; ++it) {  // Gauss-Newton on (roll, pitch)
+      const Eigen::Vector3d e = resid(r, p);
+      Eigen::Matrix<double, 3, 2> J;
+      J.col(0) = (resid(r + 1e-6, p) - e) / 1e-6;
+      J.col(1) = (resid(r, p + 1e-6) - e) / 1e-6;
+      const Eigen::Vector2d step = (J.transpose() * J).ldlt().solve(-J.transpose() * e);
+      r += step[0];
+      p = std::max(-1.5, std::min(1.5, p + step[1]));
+      if (step.norm() < 1e-10) break;
+    }
+    rpy[0] = ins::wrapAngle(r);
+    rpy[1] = p;
+    how = "yaw from the GNSS course, roll and pitch from the specific force over the first GNSS interval "
+          "matched to the GNSS velocity change minus gravity";
+  }
+  ins::NavState x;
+  x.t = t_zero;
+  x.setRollPitchYaw(rpy[0], rpy[1], rpy[2]);
+  // antenna -> IMU: p_imu = p_ant - C l (NED offset), velocity lever-arm term neglected
+  const earth::Geodetic p = earth::nedToGeodetic(fix->pos, -(x.C_BtoN() * lever_B));
+  x.lat = p.lat;
+  x.lon = p.lon;
+  x.h = p.h;
+  x.v_N = fix->v_N;
+  const double rp = std::max(cfg.p0_roll_pitch_deg, 2.0) * kDeg, yw = std::max(cfg.p0_yaw_deg, 5.0) * kDeg;
+  P0.setZero();
+  P0.topLeftCorner<3, 3>() = fix->cov_pos_N.diagonal().asDiagonal();
+  P0.block<3, 3>(3, 3) = fix->cov_vel_N.diagonal().asDiagonal();
+  P0.diagonal().tail<3>() << rp * rp, rp * rp, yw * yw;
+  notices.push_back("no ground truth in the rawlog: filter initialised from the GNSS fix at time zero, " + how +
+                    " (initial sigmas " + num(rp / kDeg) + " deg roll/pitch, " + num(yw / kDeg) +
+                    " deg yaw); errors and NEES are not available");
+  return x;
+}
+}  // namespace
+
 ReplayResult runReplay(const ReplayConfig& cfg) {
   if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
+  const std::clock_t c0 = std::clock();
   emulation::EmulationData d = rawlog::readRawlog(cfg.rawlog);
   ReplayResult r;
+  r.read_s = double(std::clock() - c0) / CLOCKS_PER_SEC;
   r.cfg = cfg;
   r.scenario_yaml = d.scenario_yaml;
   r.notices = d.notices;
   if (d.imu.size() < 2) throw Error(cfg.rawlog + ": no IMU data (label IMU) to replay");
-  if (d.truth.empty())
-    throw Error(cfg.rawlog + ": no ground truth (label GT): the replay reports errors against GT and needs it");
 
   YAML::Node scen;
   try {
@@ -252,6 +358,7 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   opt.lever_arm_B = lever;
 
   // Truth series from GT (tangent-plane NED at the origin -> geodetic).
+  const bool hasTruth = !d.truth.empty();
   TruthSeries truth;
   for (const auto& g : d.truth) {
     if (g.t < r.t_zero - 0.5 * dt || g.t > t_last + 0.5 * dt) continue;
@@ -266,17 +373,16 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
     truth.t.push_back(g.t);
     truth.x.push_back(x);
   }
-  if (truth.t.empty() || std::abs(truth.t.front() - r.t_zero) > 0.5 * dt)
+  if (hasTruth && (truth.t.empty() || std::abs(truth.t.front() - r.t_zero) > 0.5 * dt))
     throw Error(cfg.rawlog + ": no GT entry at the start of the IMU data (t = " + num(r.t_zero) +
                 " s) to initialise the filter from");
 
   NavRunInput in;
-  in.x0 = truth.x.front();
-  in.x0.t = r.t_zero;
   in.imu = &imu;
   in.gnss = &d.gnss;
   in.baro = &d.baro;
-  in.truth = &truth;
+  in.truth = hasTruth ? &truth : nullptr;
+  opt.record_interval_s = cfg.record_interval_s;
   opt.ekf.propagate_every = cfg.propagate_every;
   opt.ekf.gate_probability = cfg.gate_probability;
   opt.use_gnss_velocity = cfg.use_gnss_velocity;
@@ -284,13 +390,19 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   const double ph = cfg.p0_pos_h_m, pv = cfg.p0_pos_v_m, vv = cfg.p0_vel_mps;
   const double rp = cfg.p0_roll_pitch_deg * kDeg, yw = cfg.p0_yaw_deg * kDeg;
   opt.P0_nav.diagonal() << ph * ph, ph * ph, pv * pv, vv * vv, vv * vv, vv * vv, rp * rp, rp * rp, yw * yw;
+  if (hasTruth) {
+    in.x0 = truth.x.front();
+    in.x0.t = r.t_zero;
+  } else {
+    in.x0 = initialWithoutTruth(d, cfg, r.t_zero, dt, lever, opt.P0_nav, r.notices);
+  }
   r.run = runNav(in, model, opt);
+  std::size_t i = 0;
   for (const auto& e : r.run.epochs) {
-    std::size_t i = 0;
+    r.estimate.push_back(e.est);
+    if (!hasTruth) continue;
     while (i < truth.t.size() && truth.t[i] < e.t - 1e-9) ++i;
-    const ins::NavState& x = truth.x[std::min(i, truth.t.size() - 1)];
-    r.truth.push_back(x);
-    r.estimate.push_back(filter::applyNavError(x, e.err));
+    r.truth.push_back(truth.x[std::min(i, truth.t.size() - 1)]);
   }
   return r;
 }
@@ -306,8 +418,9 @@ std::string solutionCsv(const ReplayResult& r) {
     const auto& e = r.run.epochs[k];
     const auto& x = r.estimate[k];
     const Eigen::Vector3d rpy = x.rollPitchYaw() / kDeg;
-    const Eigen::Vector3d se = eulerSigma(r.truth[k], e.sigma.segment<3>(6)) / kDeg;
-    const Eigen::Vector3d ee = eulerError(x, r.truth[k]) / kDeg;
+    const bool truth = r.run.has_truth;
+    const Eigen::Vector3d se = eulerSigma(truth ? r.truth[k] : x, e.sigma.segment<3>(6)) / kDeg;
+    const Eigen::Vector3d ee = truth ? Eigen::Vector3d(eulerError(x, r.truth[k]) / kDeg) : Eigen::Vector3d::Zero();
     bool gnss = true;
     for (const auto& w : r.cfg.outages)
       if (e.t - r.t_zero > w.start_s + 1e-9 && e.t - r.t_zero <= w.start_s + w.duration_s + 1e-9) gnss = false;
@@ -316,9 +429,13 @@ std::string solutionCsv(const ReplayResult& r) {
       << ',' << rpy[1] << ',' << rpy[2];
     for (int i = 0; i < 6; ++i) o << ',' << e.sigma[i];
     for (int i = 0; i < 3; ++i) o << ',' << se[i];
-    for (int i = 0; i < 6; ++i) o << ',' << e.err[i];
-    for (int i = 0; i < 3; ++i) o << ',' << ee[i];
-    for (int i = 0; i < 4; ++i) o << ',' << e.nees[i];
+    if (truth) {
+      for (int i = 0; i < 6; ++i) o << ',' << e.err[i];
+      for (int i = 0; i < 3; ++i) o << ',' << ee[i];
+      for (int i = 0; i < 4; ++i) o << ',' << e.nees[i];
+    } else {
+      o << ",,,,,,,,,,,,,";  // no ground truth: errors and NEES empty
+    }
     o << ',' << (gnss ? 1 : 0) << '\n';
   }
   return o.str();
@@ -337,6 +454,8 @@ std::string summaryJson(const ReplayResult& r) {
   j["imu_steps"] = r.run.steps;
   j["ekf_states"] = r.run.states;
   j["filter_wall_s"] = r.run.wall_s;
+  j["rawlog_read_cpu_s"] = r.read_s;
+  j["ground_truth"] = r.run.has_truth;
   try {
     const YAML::Node s = YAML::Load(r.scenario_yaml)["navimpact_scenario"];
     if (s) {
@@ -358,11 +477,23 @@ std::string summaryJson(const ReplayResult& r) {
     jo["start_s"] = r.cfg.outages[i].start_s;
     jo["duration_s"] = r.cfg.outages[i].duration_s;
     if (o.end_epoch < 0) {
-      jo["note"] = "no GT epoch inside the outage";
+      jo["note"] = "no recorded epoch inside the outage";
       outs.push_back(jo);
       continue;
     }
     const std::size_t ke = static_cast<std::size_t>(o.end_epoch);
+    if (!r.run.has_truth) {  // predicted sigmas only
+      const auto& e = ep[ke];
+      const Eigen::Vector3d attSig = eulerSigma(r.estimate[ke], e.sigma.segment<3>(6)) / kDeg;
+      jo["end_epoch_s"] = e.t - r.t_zero;
+      jo["note"] = "no ground truth: predicted sigmas only";
+      jo["position"] = {{"horizontal_sigma_end_m", e.sigma.head<2>().norm()}, {"vertical_sigma_end_m", e.sigma[2]}};
+      jo["velocity"] = {{"horizontal_sigma_end_mps", e.sigma.segment<2>(3).norm()},
+                        {"vertical_sigma_end_mps", e.sigma[5]}};
+      jo["attitude_deg"] = {{"roll_pitch_yaw_sigma_end", {attSig[0], attSig[1], attSig[2]}}};
+      outs.push_back(jo);
+      continue;
+    }
     double maxPh = 0, maxPv = 0, maxVh = 0, maxVv = 0, neesSum = 0;
     Eigen::Vector3d maxAtt = Eigen::Vector3d::Zero();
     std::array<double, 4> neesB{};
@@ -402,6 +533,13 @@ std::string summaryJson(const ReplayResult& r) {
     outs.push_back(jo);
   }
   j["outages"] = outs;
+  if (!r.run.has_truth) {
+    j["note"] = "the rawlog has no ground truth (label GT): errors, NEES and RMS are not available; "
+                "solution.csv holds the estimate and the predicted sigmas, its error and NEES columns are empty";
+    j["epochs"] = ep.size();
+    j["notices"] = r.notices;
+    return j.dump(2) + "\n";
+  }
   // Overall RMS over all epochs.
   double sPh = 0, sPv = 0, sV = 0;
   Eigen::Vector3d sA = Eigen::Vector3d::Zero();
@@ -430,12 +568,14 @@ std::vector<std::string> writeReplayFigures(const ReplayResult& r, const std::st
   for (auto& v : sig) v.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     t[k] = ep[k].t - r.t_zero;
+    const bool truth = r.run.has_truth;
     for (int i = 0; i < 6; ++i) {
       err[i][k] = ep[k].err[i];
       sig[i][k] = ep[k].sigma[i];
     }
-    const Eigen::Vector3d ee = eulerError(r.estimate[k], r.truth[k]) / kDeg;
-    const Eigen::Vector3d se = eulerSigma(r.truth[k], ep[k].sigma.segment<3>(6)) / kDeg;
+    const Eigen::Vector3d ee =
+        truth ? Eigen::Vector3d(eulerError(r.estimate[k], r.truth[k]) / kDeg) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d se = eulerSigma(truth ? r.truth[k] : r.estimate[k], ep[k].sigma.segment<3>(6)) / kDeg;
     for (int i = 0; i < 3; ++i) {
       err[6 + i][k] = ee[i];
       sig[6 + i][k] = se[i];
@@ -464,7 +604,8 @@ std::vector<std::string> writeReplayFigures(const ReplayResult& r, const std::st
         hi[k] = sig[i][k];
       }
       ax.bands.push_back({"±1σ predicted", t, lo, hi, plot::palette(0), 0.22});
-      ax.series.push_back({"error", t, err[i], plot::palette(1), plot::LineStyle::Solid, plot::Marker::None, 1.6});
+      if (r.run.has_truth)
+        ax.series.push_back({"error", t, err[i], plot::palette(1), plot::LineStyle::Solid, plot::Marker::None, 1.6});
       ax.legend = i == 0 ? plot::LegendPos::Best : plot::LegendPos::None;
       fig.axes.push_back(ax);
     }
@@ -472,7 +613,10 @@ std::vector<std::string> writeReplayFigures(const ReplayResult& r, const std::st
   };
   std::vector<std::string> files;
   const double tEnd = n ? t.back() : 1.0;
-  plot::savePng(figure(0.0, tEnd, "Navigation errors (estimate − truth), filter model: " + r.model_source),
+  plot::savePng(figure(0.0, tEnd,
+                       (r.run.has_truth ? "Navigation errors (estimate − truth), filter model: "
+                                        : "Predicted ±1σ (no ground truth in the rawlog), filter model: ") +
+                           r.model_source),
                 (fs::path(dir) / "errors_full.png").string());
   files.push_back("errors_full.png");
   for (std::size_t i = 0; i < r.cfg.outages.size(); ++i) {

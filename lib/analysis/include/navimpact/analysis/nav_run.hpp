@@ -10,7 +10,9 @@
  * (`navimpact replay`) must run their filters through runNav(): the replay
  * converts its rawlog records to the inputs below (emulation::ImuRecord ->
  * ins::ImuSample::fromRates, GNSS/BARO records as they are, GT records to a
- * TruthSeries) and calls runNav() once.
+ * TruthSeries) and calls runNav() once. Without ground truth (a real
+ * flight's rawlog) the truth pointer is null and only the estimate and the
+ * predicted sigmas are recorded.
  *
  * Conventions (see filter/error_model.hpp): errors are estimate minus truth,
  * position in metres along local N, E, D, velocity in NED [m/s], attitude as
@@ -64,7 +66,10 @@ struct NavRunInput {
   const std::vector<ins::ImuSample>* imu = nullptr;        ///< raw samples (with errors), first covers (x0.t, x0.t + dt]
   const std::vector<emulation::GnssFix>* gnss = nullptr;   ///< may be null (no GNSS)
   const std::vector<emulation::BaroSample>* baro = nullptr;///< may be null (no baro)
-  const TruthSeries* truth = nullptr;                      ///< record epochs and truth; required
+  /// Record epochs and truth. May be null (data without ground truth): the
+  /// run then records the estimate and sigmas every NavRunOptions::record_interval_s,
+  /// with errors and NEES NaN.
+  const TruthSeries* truth = nullptr;
 };
 
 /// Options of one run.
@@ -75,14 +80,18 @@ struct NavRunOptions {
   Eigen::Vector3d lever_arm_B = Eigen::Vector3d::Zero();   ///< GNSS antenna in body FRD [m]
   bool baro_in_outage = true;                   ///< keep baro updates during GNSS outages
   bool use_gnss_velocity = true;                ///< apply GNSS velocity besides position
+  /// Record interval without truth [s], > 0: epochs at the IMU samples nearest
+  /// x0.t + k * record_interval_s (ignored when NavRunInput::truth is given).
+  double record_interval_s = 0.1;
 };
 
 /// Errors, sigmas and NEES at one record epoch.
 struct NavEpoch {
   double t = 0.0;                   ///< [s]
-  filter::Vector9d err;             ///< estimate minus truth: dp NED [m], dv NED [m/s], psi [rad]
+  ins::NavState est;                ///< the filter's estimate at t (after the updates of t)
+  filter::Vector9d err;             ///< estimate minus truth: dp NED [m], dv NED [m/s], psi [rad]; NaN without truth
   filter::Vector9d sigma;           ///< predicted 1-sigma of the same nine errors
-  std::array<double, 4> nees{};     ///< position (3 dof), velocity (3), attitude (3), all (9); NaN if P singular
+  std::array<double, 4> nees{};     ///< position (3 dof), velocity (3), attitude (3), all (9); NaN if P singular or no truth
 };
 
 /// What one outage did to this run.
@@ -95,7 +104,8 @@ struct OutageSummary {
 
 /// Result of one run.
 struct NavRunResult {
-  std::vector<NavEpoch> epochs;     ///< one per truth epoch inside the IMU span
+  bool has_truth = true;            ///< false: errors, NEES and outage drifts are absent (NaN / 0)
+  std::vector<NavEpoch> epochs;     ///< one per truth epoch inside the IMU span (or per record interval)
   std::vector<OutageSummary> outages;  ///< one per NavRunOptions::outages
   int states = 0;                   ///< EKF state count
   std::size_t steps = 0;            ///< IMU samples processed

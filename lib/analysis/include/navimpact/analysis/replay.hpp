@@ -23,6 +23,17 @@
  * @endcode
  * Without `noise`, the covariances recorded with each GNSS fix and the
  * scenario's barometer sigma are used.
+ *
+ * Rawlogs without ground truth (label GT absent, e.g. a real flight): the
+ * filter starts from the GNSS fix at time zero (position, velocity; lever arm
+ * removed), yaw from the GNSS course (needs >= 1 m/s horizontal speed, no
+ * sideslip assumed), roll and pitch from levelling corrected for the vehicle's
+ * acceleration (the gyro-rotated specific force over the first GNSS interval
+ * matched to the GNSS velocity change minus gravity), unless given by
+ * `initial_attitude_deg: [roll, pitch, yaw]`; its initial attitude sigmas are
+ * then at least 2 deg (roll, pitch) and 5 deg (yaw). The estimate and the
+ * predicted sigmas are recorded every `record_interval_s` (default 0.1 s);
+ * errors and NEES are empty in solution.csv and absent from summary.json.
  */
 #pragma once
 
@@ -57,6 +68,8 @@ struct ReplayConfig {
   double p0_roll_pitch_deg = 0.1, p0_yaw_deg = 0.5;
   std::optional<double> sigma_pos_h_m, sigma_pos_v_m, sigma_vel_h_mps, sigma_vel_v_mps, sigma_baro_m;
   std::optional<Eigen::Vector3d> lever_arm_B;
+  std::optional<Eigen::Vector3d> initial_attitude_deg;  ///< roll, pitch, yaw [deg]; used without GT
+  double record_interval_s = 0.1;               ///< record interval without GT [s], > 0
 };
 
 /// Read a replay configuration. @throws navimpact::Error naming file and key.
@@ -69,16 +82,17 @@ struct ReplayResult {
   std::string scenario_yaml;                ///< the rawlog's comment
   double t_zero = 0.0;                      ///< rawlog time of replay time zero [s]
   double imu_rate_hz = 0.0;
-  NavRunResult run;                         ///< errors, sigmas, NEES at the GT epochs
-  std::vector<ins::NavState> truth;         ///< truth at the epochs
-  std::vector<ins::NavState> estimate;      ///< estimate at the epochs (truth (+) error)
+  NavRunResult run;                         ///< errors, sigmas, NEES at the GT epochs (run.has_truth)
+  std::vector<ins::NavState> truth;         ///< truth at the epochs (empty without GT)
+  std::vector<ins::NavState> estimate;      ///< estimate at the epochs
+  double read_s = 0.0;                      ///< CPU time of reading the rawlog [s]
   std::vector<std::string> notices;
 };
 
 /**
  * Run a replay: read the rawlog, check outages against the data, run the EKF.
- * @throws navimpact::Error for a rawlog without IMU or GT, an outage outside
- *         the data, a missing model.
+ * @throws navimpact::Error for a rawlog without IMU, without GT and without a
+ *         GNSS fix at time zero, an outage outside the data, a missing model.
  */
 ReplayResult runReplay(const ReplayConfig& cfg);
 
