@@ -271,6 +271,13 @@ void rightMulDt(Eigen::Ref<MatrixXd> X, const MatrixXd& D, const std::vector<Pro
     const int o = b.offset - kNav, n = b.ss.n;
     if (n == 1) {
       X.col(o) *= D(o, o);
+    } else if (n == 2) {  // DR, SIN: explicit 2x2 (a generic product per row is a BLAS call)
+      const double d00 = D(o, o), d01 = D(o, o + 1), d10 = D(o + 1, o), d11 = D(o + 1, o + 1);
+      for (Eigen::Index r = 0; r < X.rows(); ++r) {
+        const double a = X(r, o), b = X(r, o + 1);
+        X(r, o) = a * d00 + b * d01;
+        X(r, o + 1) = a * d10 + b * d11;
+      }
     } else if (n <= 8) {
       const auto Db = D.block(o, o, n, n);
       for (Eigen::Index r = 0; r < X.rows(); ++r) {
@@ -288,6 +295,13 @@ void leftMulD(Eigen::Ref<MatrixXd> X, const MatrixXd& D, const std::vector<Proce
     const int o = b.offset - kNav, n = b.ss.n;
     if (n == 1) {
       X.row(o) *= D(o, o);
+    } else if (n == 2) {
+      const double d00 = D(o, o), d01 = D(o, o + 1), d10 = D(o + 1, o), d11 = D(o + 1, o + 1);
+      for (Eigen::Index j = 0; j < X.cols(); ++j) {
+        const double a = X(o, j), b = X(o + 1, j);
+        X(o, j) = d00 * a + d01 * b;
+        X(o + 1, j) = d10 * a + d11 * b;
+      }
     } else if (n <= 8) {
       const auto Db = D.block(o, o, n, n);
       for (Eigen::Index j = 0; j < X.cols(); ++j) {
@@ -460,6 +474,11 @@ void ErrorStateEkf::predict(const ins::ImuSample& raw) {
     const int o = blocks[k].offset - kNav, n = blocks[k].ss.n;
     if (n == 1) {
       x_imu_(o) *= cb.Phi[k](0, 0);
+    } else if (n == 2) {
+      const MatrixXd& F = cb.Phi[k];
+      const double a = x_imu_(o), b = x_imu_(o + 1);
+      x_imu_(o) = F(0, 0) * a + F(0, 1) * b;
+      x_imu_(o + 1) = F(1, 0) * a + F(1, 1) * b;
     } else if (n > 8) {
       x_imu_.segment(o, n) = (cb.Phi[k] * x_imu_.segment(o, n)).eval();
     } else {

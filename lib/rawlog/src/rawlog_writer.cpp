@@ -9,8 +9,12 @@
 #include <mrpt/serialization/CArchive.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <stdexcept>
+#include <vector>
 
 #include "navimpact/core/error.hpp"
 
@@ -32,6 +36,52 @@ double seconds(const mrpt::Clock::time_point& ts, long long startUnix) {
   const auto base = mrpt::Clock::fromDouble(static_cast<double>(startUnix));
   return static_cast<double>((ts - base).count()) * kTick;
 }
+
+/// Read-only stream over a gzip (or plain) file with a large read-ahead buffer.
+class BufferedGzInput : public mrpt::io::CStream {
+ public:
+  mrpt::io::CFileGZInputStream gz;
+  size_t Read(void* out, size_t n) override {
+    auto* dst = static_cast<unsigned char*>(out);
+    size_t done = 0;
+    while (done < n) {
+      if (head_ == buf_.size() && !refill()) break;
+      const size_t k = std::min(n - done, buf_.size() - head_);
+      std::memcpy(dst + done, buf_.data() + head_, k);
+      head_ += k;
+      done += k;
+    }
+    pos_ += done;
+    return done;
+  }
+  size_t Write(const void*, size_t) override { throw std::runtime_error("read-only stream"); }
+  uint64_t Seek(int64_t, mrpt::io::CStream::TSeekOrigin) override { throw std::runtime_error("not seekable"); }
+  uint64_t getTotalBytesCount() const override { return 0; }
+  uint64_t getPosition() const override { return pos_; }
+  /// True when no byte is left (reads ahead if needed).
+  bool atEnd() { return head_ == buf_.size() && !refill(); }
+
+ private:
+  bool refill() {
+    if (eof_) return false;
+    buf_.resize(kChunk);
+    size_t got = 0;
+    try {
+      got = gz.Read(buf_.data(), kChunk);
+    } catch (const std::exception&) {
+      got = 0;  // corrupt or truncated gzip: deserialising what came out names the entry
+    }
+    buf_.resize(got);
+    head_ = 0;
+    if (got == 0) eof_ = true;
+    return got > 0;
+  }
+  static constexpr size_t kChunk = size_t(1) << 20;
+  std::vector<unsigned char> buf_;
+  size_t head_ = 0;
+  uint64_t pos_ = 0;
+  bool eof_ = false;
+};
 
 struct Entry {
   double t;
@@ -165,8 +215,10 @@ void writeRawlog(const std::string& path, const emulation::EmulationData& d, con
 
 emulation::EmulationData readRawlog(const std::string& path) {
   if (!std::filesystem::exists(path)) throw Error(path + ": rawlog not found");
-  mrpt::io::CFileGZInputStream in;
-  if (!in.open(path)) throw Error(path + ": cannot open the rawlog");
+  // Read through a 1 MiB buffer: MRPT's archive reads every field with its own
+  // small Read() call, which on the bare gzip stream costs a gzread() each.
+  BufferedGzInput in;
+  if (!in.gz.open(path)) throw Error(path + ": cannot open the rawlog");
   auto arch = mrpt::serialization::archiveFrom(in);
   emulation::EmulationData d;
   bool haveComment = false, haveOrigin = false, haveBase = false;
@@ -185,12 +237,10 @@ emulation::EmulationData readRawlog(const std::string& path) {
   };
   for (;; ++entry) {
     mrpt::serialization::CSerializable::Ptr obj;
-    if (in.checkEOF()) break;  // clean end between entries (plain files)
-    const auto pos0 = in.getPosition();
+    if (in.atEnd()) break;  // clean end between entries
     try {
       obj = arch.ReadObject();
     } catch (const mrpt::serialization::CExceptionEOF&) {
-      if (in.getPosition() == pos0) break;  // clean end (gzip streams see EOF only on reading)
       throw Error(where("", NAN) + ": truncated entry (the file ends inside it)");
     } catch (const std::exception& e) {
       std::string msg = e.what();
