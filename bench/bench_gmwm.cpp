@@ -51,11 +51,14 @@ const gm::WaveletVariance* adisWv() {
   return wv.get();
 }
 
-void runFit(benchmark::State& state, const gm::WaveletVariance& wv, const char* structure) {
+void runFit(benchmark::State& state, const gm::WaveletVariance& wv, const char* structure,
+            gm::Weighting w = gm::Weighting::Fast) {
   const auto k = st::parseStructure(structure);
+  gm::FitOptions o;
+  o.weighting = w;
   double obj = 0;
   for (auto _ : state) {
-    const auto f = gm::fit(k, wv);
+    const auto f = gm::fit(k, wv, o);
     obj = f.objective;
     benchmark::DoNotOptimize(obj);
   }
@@ -68,6 +71,21 @@ static void BM_FitSimulated_WN_3GM_DR(benchmark::State& state) {
   runFit(state, simulatedWv(), "WN+GM+GM+GM+DR");
 }
 BENCHMARK(BM_FitSimulated_WN_3GM_DR)->Unit(benchmark::kMillisecond);
+
+// Efficient GMWM (full WV covariance, iterated): the fast fit plus reweighting passes.
+static void BM_FitSimulatedEfficient_WN_3GM_DR(benchmark::State& state) {
+  runFit(state, simulatedWv(), "WN+GM+GM+GM+DR", gm::Weighting::Efficient);
+}
+BENCHMARK(BM_FitSimulatedEfficient_WN_3GM_DR)->Unit(benchmark::kMillisecond);
+
+// Asymptotic WV covariance (19 x 19, quadrature per pair of scales).
+static void BM_WvCovariance(benchmark::State& state) {
+  st::Model m;
+  m.rate_hz = 100;
+  m.terms = st::parseTerms("WN(sigma=5.5e-3) + GM(sigma=4.8e-4, T=3.2) + GM(sigma=6.7e-4, T=47) + GM(sigma=4e-4, T=556)", 100);
+  for (auto _ : state) benchmark::DoNotOptimize(gm::wvCovariance(m, simulatedWv()).sum());
+}
+BENCHMARK(BM_WvCovariance)->Unit(benchmark::kMillisecond);
 
 static void BM_FitSimulated_WN_GM(benchmark::State& state) { runFit(state, simulatedWv(), "WN+GM"); }
 BENCHMARK(BM_FitSimulated_WN_GM)->Unit(benchmark::kMillisecond);

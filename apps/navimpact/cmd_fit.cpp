@@ -1,7 +1,8 @@
 // navimpact fit: GMWM fit of an IMU error model to a static recording.
 //   navimpact fit --input FILE [--rate HZ] [--gyro-unit U] [--acc-unit U] [--axes SPEC]
 //                 [--label L] [--channels gyro_x,...] --structure SPEC|auto
-//                 [--max-gm N] [--bootstrap N] [--intervals profile|asymptotic] [--seed S] --out DIR
+//                 [--max-gm N] [--bootstrap N] [--intervals profile|asymptotic]
+//                 [--weights r|model|efficient] [--seed S] --out DIR
 // Writes DIR/model.yaml (stochastic::loadImuModel reads it back), DIR/fit.json
 // (estimates, intervals, WV and model WV per channel) and one WV figure per
 // sensor (fit_gyroscope.png, fit_accelerometer.png), all or nothing.
@@ -43,6 +44,7 @@ struct Opts {
   int max_gm = 3;
   int bootstrap = 0;
   std::string intervals = "profile";
+  std::string weights = "r";
   std::uint64_t seed = 20190101;
   std::string out;
 };
@@ -110,6 +112,7 @@ navimpact::plot::Axes wvAxes(const ChannelFit& c) {
   ax.series.push_back({"empirical WV", tau_s, vec(c.wv.wv), pl::palette(0), pl::LineStyle::Solid,
                        pl::Marker::FilledCircle, 2.0});
   const Eigen::MatrixXd terms = st::haarWvTerms(c.fit.model, c.wv.tau);
+  const std::vector<bool> neg = gm::negligibleTerms(c.fit.model, c.wv);
   for (Eigen::Index i = 0; i < terms.cols(); ++i) {
     const auto& p = c.fit.model.terms[static_cast<std::size_t>(i)];
     std::string lab = st::kindName(p.kind);
@@ -118,6 +121,7 @@ navimpact::plot::Axes wvAxes(const ChannelFit& c) {
       std::snprintf(b, sizeof b, "GM (T = %.3g s)", p.T);
       lab = b;
     }
+    if (neg[static_cast<std::size_t>(i)]) lab += " (negligible)";
     ax.series.push_back({lab, tau_s, vec(terms.col(i)), pl::palette(static_cast<int>(i) + 2),
                          pl::LineStyle::Dashed, pl::Marker::None, 1.5});
   }
@@ -136,6 +140,8 @@ int run(const Opts& o) {
   if (!autoSel) structure = st::parseStructure(o.structure);
   if (o.bootstrap < 0) throw navimpact::Error("--bootstrap must be >= 0, got " + std::to_string(o.bootstrap));
   if (o.max_gm < 0 || o.max_gm > 3) throw navimpact::Error("--max-gm must be in 0..3");
+  if (o.weights != "r" && o.weights != "model" && o.weights != "efficient")
+    throw navimpact::Error("--weights: expected 'r', 'model' or 'efficient', got '" + o.weights + "'");
 
   navimpact::cli::InputFormat fmt{};
   const navimpact::ImuSeries s = navimpact::cli::loadInput(o.in, &fmt);
@@ -163,6 +169,16 @@ int run(const Opts& o) {
   else
     throw navimpact::Error("--intervals: expected 'profile' or 'asymptotic', got '" + o.intervals + "'");
   fo.seed = o.seed;
+  // r: the R package's objective (weights 1/(CI_hi - CI_lo)^2); model: iterated
+  // model-based diagonal weights; efficient: inverse of the full WV covariance.
+  if (o.weights == "r")
+    fo.weighting = gm::Weighting::Fast;
+  else if (o.weights == "model")
+    fo.weighting = gm::Weighting::ModelBased;
+  else if (o.weights == "efficient")
+    fo.weighting = gm::Weighting::Efficient;
+  else
+    throw navimpact::Error("--weights: expected 'r', 'model' or 'efficient', got '" + o.weights + "'");
   const auto cands = gm::defaultCandidates(o.max_gm);
 
   std::vector<ChannelFit> fits(chans.size());
@@ -175,8 +191,19 @@ int run(const Opts& o) {
     fi.seed = st::deriveSeed(o.seed, static_cast<std::uint64_t>(navimpact::channelIndex(c.ch->name)));
     try {
       if (autoSel) {
-        c.ranking = gm::selectModel(cands, c.wv, fi, &c.why);
+        // The WIC's optimism is derived for R's weights: rank with them, then
+        // refit the pick with the requested weights.
+        gm::FitOptions fr = fi;
+        fr.weighting = gm::Weighting::Fast;
+        c.ranking = gm::selectModel(cands, c.wv, fr, &c.why);
         c.fit = c.ranking.front().fit;
+        if (fi.weighting != gm::Weighting::Fast) {
+          std::vector<st::ProcessKind> k;
+          for (const auto& t : c.fit.model.terms) k.push_back(t.kind);
+          fi.warm_starts = {c.fit.model};
+          c.fit = gm::fit(k, c.wv, fi);
+          c.why += "; ranked with the R weights, the pick refit with --weights " + o.weights;
+        }
       } else {
         c.fit = gm::fit(structure, c.wv, fi);
       }
@@ -202,6 +229,13 @@ int run(const Opts& o) {
                 {"axes", o.in.axes},
                 {"label", o.in.label}};
   j["seed"] = o.seed;
+  j["weights"] = o.weights;
+  {
+    std::ostringstream rule;
+    rule << "a term is negligible when its WV is below " << gm::kNegligibleFraction
+         << " x (ci_high - ci_low) of the empirical WV at every scale";
+    j["negligible_rule"] = rule.str();
+  }
   j["structure"] = autoSel ? std::string("auto") : st::formatStructure(structure);
   j["conventions"] =
       "SI units; WN sigma, QN Q, RW gamma, DR omega per sample at input.rate_hz; GM sigma stationary, "
@@ -213,6 +247,8 @@ int run(const Opts& o) {
     cj["unit"] = navimpact::units::siUnit(c.ch->quantity);
     cj["model"] = st::formatTerms(c.fit.model.terms, 17);
     cj["objective"] = c.fit.objective;
+    cj["weights"] = o.weights;
+    cj["objective_r"] = c.fit.objective_fast;  // R's objective of this model
     std::vector<st::ProcessKind> k;
     for (const auto& t : c.fit.model.terms) k.push_back(t.kind);
     cj["structure"] = st::formatStructure(k);
@@ -220,8 +256,10 @@ int run(const Opts& o) {
     cj["converged"] = c.fit.converged;
     cj["starts"] = c.fit.starts;
     json terms = json::array();
+    const std::vector<bool> neg = gm::negligibleTerms(c.fit.model, c.wv);
     for (std::size_t i = 0; i < c.fit.model.terms.size(); ++i) {
       json t = termJson(c.fit.model.terms[i], c.fit.ci[i]);
+      t["negligible"] = static_cast<bool>(neg[i]);
       if (c.fit.model.terms[i].kind == st::ProcessKind::GM)  // AR1 form: phi = exp(-dt/T)
         t["phi"] = std::exp(-1.0 / (s.rate_hz * c.fit.model.terms[i].T));
       terms.push_back(t);
@@ -280,7 +318,16 @@ int run(const Opts& o) {
   for (const auto& c : fits) {
     std::cout << c.ch->name << ": " << st::formatTerms(c.fit.model.terms) << "   ["
               << navimpact::units::siUnit(c.ch->quantity) << ", per sample at " << s.rate_hz << " Hz]\n";
-    std::cout << "    objective " << c.fit.objective << "  (" << c.fit.ci_method << " 95 % intervals in fit.json)\n";
+    std::cout << "    objective " << c.fit.objective << " (" << gm::weightingName(c.fit.weighting) << " weights"
+              << (c.fit.weighting == gm::Weighting::Fast ? "" : ", R objective " + std::to_string(c.fit.objective_fast))
+              << ")  (" << c.fit.ci_method << " 95 % intervals in fit.json)\n";
+    const std::vector<bool> neg = gm::negligibleTerms(c.fit.model, c.wv);
+    for (std::size_t i = 0; i < neg.size(); ++i)
+      if (neg[i])
+        std::cout << "    negligible: term " << i + 1 << " " << st::formatTerms({c.fit.model.terms[i]})
+                  << " (its WV is below " << gm::kNegligibleFraction
+                  << " of the WV's 95 % CI width at every scale: the data cannot tell it from its absence;"
+                     " kept because the structure asks for it)\n";
     if (autoSel) std::cout << "    " << c.why << "\n";
     std::istringstream lines(st::formatDatasheet(st::datasheetFigures(c.fit.model), c.ch->quantity));
     std::string l;
@@ -307,6 +354,9 @@ navimpact::cli::Registrar reg({
       app.add_option("--intervals", o->intervals,
                      "95 % intervals without --bootstrap: profile (default; follows the objective along "
                      "GM/RW ridges) or asymptotic (delta method)");
+      app.add_option("--weights", o->weights,
+                     "GMWM weights: r (default, the R package's 1/(CI_hi-CI_lo)^2), model (iterated "
+                     "model-based diagonal) or efficient (inverse of the full WV covariance)");
       app.add_option("--seed", o->seed, "seed of the bootstrap");
       app.add_option("--out", o->out, "output directory (model.yaml, fit.json, fit_*.png)")->required();
       return [o]() -> int { return run(*o); };

@@ -99,3 +99,60 @@ add_test(NAME cli_fit_bad_channel
   COMMAND ${CMAKE_COMMAND} -DNI=${NI}
           "-DARGS=fit|--input|${_fdata}|--rate|100|--gyro-unit|deg/s|--acc-unit|g|--structure|WN|--channels|gyro_q|--out|${_fdir}/badch"
           "-DREGEX=navimpact: error: --channels: unknown channel 'gyro_q'" -P ${_fdir}/expect_fail.cmake)
+
+# --weights: default r (the R package's objective) is recorded; efficient is
+# recorded with the R objective of the same model next to it; every term
+# carries its negligible flag and the rule is stated.
+file(WRITE ${_fdir}/check_fit_weights.cmake [=[
+file(READ ${DIR}/fit.json j)
+string(JSON w GET "${j}" weights)
+if(NOT w STREQUAL "${WEIGHTS}")
+  message(FATAL_ERROR "fit.json weights '${w}', expected '${WEIGHTS}'")
+endif()
+string(JSON rule GET "${j}" negligible_rule)
+if(NOT rule MATCHES "negligible when its WV is below 0.1")
+  message(FATAL_ERROR "negligible rule not stated: ${rule}")
+endif()
+string(JSON n LENGTH "${j}" channels)
+math(EXPR last "${n} - 1")
+foreach(i RANGE ${last})
+  string(JSON cw GET "${j}" channels ${i} weights)
+  string(JSON obj GET "${j}" channels ${i} objective)
+  string(JSON objr GET "${j}" channels ${i} objective_r)
+  if(NOT cw STREQUAL "${WEIGHTS}")
+    message(FATAL_ERROR "channel ${i}: weights '${cw}'")
+  endif()
+  if(WEIGHTS STREQUAL "r" AND NOT obj EQUAL objr)
+    message(FATAL_ERROR "channel ${i}: with r weights the objective ${obj} must be the R objective ${objr}")
+  endif()
+  string(JSON nt LENGTH "${j}" channels ${i} terms)
+  math(EXPR tl "${nt} - 1")
+  foreach(t RANGE ${tl})
+    string(JSON neg TYPE "${j}" channels ${i} terms ${t} negligible)
+    if(NOT neg STREQUAL "BOOLEAN")
+      message(FATAL_ERROR "channel ${i} term ${t}: no boolean 'negligible' (${neg})")
+    endif()
+  endforeach()
+endforeach()
+]=])
+
+add_test(NAME cli_fit_weights_default_r
+  COMMAND ${CMAKE_COMMAND} -DDIR=${_fdir}/wn_gm -DWEIGHTS=r -P ${_fdir}/check_fit_weights.cmake)
+set_tests_properties(cli_fit_weights_default_r PROPERTIES FIXTURES_REQUIRED fit_wn_gm)
+
+add_test(NAME cli_fit_weights_efficient
+  COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GM+DR
+          --channels gyro_x,acc_z --weights efficient --out ${_fdir}/eff)
+set_tests_properties(cli_fit_weights_efficient PROPERTIES
+  PASS_REGULAR_EXPRESSION "gyro_x: WN.*objective [0-9.e+-]+ \\(efficient weights, R objective [0-9.e+-]+\\).*acc_z: WN"
+  FIXTURES_SETUP fit_eff)
+add_test(NAME cli_fit_weights_efficient_json
+  COMMAND ${CMAKE_COMMAND} -DDIR=${_fdir}/eff -DWEIGHTS=efficient -P ${_fdir}/check_fit_weights.cmake)
+set_tests_properties(cli_fit_weights_efficient_json PROPERTIES FIXTURES_REQUIRED fit_eff)
+
+# an unknown weighting is a one-line error before any output
+add_test(NAME cli_fit_bad_weights
+  COMMAND ${CMAKE_COMMAND} -DNI=${NI}
+          "-DARGS=fit|--input|${_fdata}|--rate|100|--gyro-unit|deg/s|--acc-unit|g|--structure|WN|--weights|optimal|--out|${_fdir}/badw"
+          "-DREGEX=navimpact: error: --weights: expected 'r', 'model' or 'efficient', got 'optimal'"
+          -DNOFILE=${_fdir}/badw/fit.json -P ${_fdir}/expect_fail.cmake)

@@ -4,6 +4,8 @@
 // Seeds are fixed lists written before any tuning.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -131,6 +133,75 @@ TEST(GmwmFit, ModelBasedWeights) {
   EXPECT_THROW(gmwm::parseWeighting("optimal"), Error);
 }
 
+// wvCovariance against Monte Carlo: 400 simulated series of WN + GM (T = 20
+// samples) + RW, 2^14 samples. Variances at the scales with eta_j >= 16 within
+// 25 % (the Monte Carlo se of a variance from 400 replicates is 7 %) and the
+// neighbour correlations within 0.12 (se ~0.04); the eta3 chi-square variance
+// 2 nu^2 / eta_j that the diagonal weights assume is off by more than 25 % at
+// the first scale (it ignores the filter's autocorrelation: 3/8 vs 1/2).
+TEST(GmwmFit, WvCovarianceMatchesMonteCarlo) {
+  Model m;
+  m.rate_hz = 100;
+  m.terms = stochastic::parseTerms("WN(sigma=0.01) + GM(sigma=0.004, T=0.2) + RW(gamma=2e-5)", 100);
+  const std::size_t n = 1u << 14;
+  const int R = 400;
+  std::vector<Eigen::VectorXd> reps;
+  gmwm::WaveletVariance w0;
+  for (int r = 0; r < R; ++r) {
+    const auto wv = simulatedWv(m, n, stochastic::deriveSeed(424242, static_cast<std::uint64_t>(r)));
+    reps.push_back(wv.wv);
+    if (r == 0) w0 = wv;
+  }
+  const int J = w0.scales();
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(J);
+  for (auto& v : reps) mean += v / R;
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(J, J);
+  for (auto& v : reps) C += (v - mean) * (v - mean).transpose() / (R - 1);
+  const Eigen::MatrixXd V = gmwm::wvCovariance(m, w0);
+  const Eigen::VectorXd nu = stochastic::haarWv(m, w0.tau);
+  for (int j = 0; j < J; ++j) {
+    EXPECT_NEAR(gmwm::spectralWv(m, w0.tau[j]) / nu[j], 1.0, 1e-3) << "scale " << j + 1;
+    if (w0.eta[j] < 16) continue;
+    EXPECT_NEAR(V(j, j) / C(j, j), 1.0, 0.25) << "scale " << j + 1;
+    if (j + 1 < J && w0.eta[j + 1] >= 16) {
+      const double rv = V(j, j + 1) / std::sqrt(V(j, j) * V(j + 1, j + 1));
+      const double rc = C(j, j + 1) / std::sqrt(C(j, j) * C(j + 1, j + 1));
+      EXPECT_NEAR(rv, rc, 0.12) << "scales " << j + 1 << "," << j + 2;
+      EXPECT_GT(rv, 0.3) << "neighbouring scales are strongly correlated";
+    }
+  }
+  EXPECT_GT(2.0 * nu[0] * nu[0] / w0.eta[0] / C(0, 0), 1.25);
+}
+
+// Efficient weights (Omega = V^-1, full matrix): exact at the truth, the
+// reported objective is the quadratic form under the full Omega (O(J) on
+// simulated data: a chi-square-like sum), and the intervals come from (A' V^-1 A)^-1.
+TEST(GmwmFit, EfficientWeights) {
+  Model truth;
+  truth.rate_hz = 100;
+  truth.terms = stochastic::parseTerms("WN(sigma=0.01) + GM(sigma=0.002, T=0.5) + GM(sigma=0.004, T=40)", 100);
+  gmwm::FitOptions o;
+  o.weighting = gmwm::Weighting::Efficient;
+  const auto fe = gmwm::fit(kinds(truth), exactWv(truth, 1u << 20), o);
+  EXPECT_EQ(fe.weighting, gmwm::Weighting::Efficient);
+  EXPECT_GE(fe.weight_passes, 1);
+  EXPECT_LT(fe.objective, 1e-10);
+  for (std::uint64_t seed : {31u, 32u}) {
+    const auto wv = simulatedWv(truth, 1u << 18, seed);
+    const auto f = gmwm::fit(kinds(truth), wv, o);
+    EXPECT_NEAR(f.objective_fast, gmwm::objective(f.model, wv), 1e-12 * f.objective_fast);
+    EXPECT_GT(f.objective, 0.0);
+    EXPECT_LT(f.objective, 4.0 * wv.scales()) << stochastic::formatTerms(f.model.terms);
+    for (std::size_t i = 0; i < f.ci.size(); ++i)
+      for (const auto& pi : f.ci[i]) {
+        EXPECT_LT(pi.low, pi.value);
+        EXPECT_GT(pi.high, pi.value);
+      }
+  }
+  EXPECT_EQ(gmwm::parseWeighting("efficient"), gmwm::Weighting::Efficient);
+  EXPECT_EQ(gmwm::weightingName(gmwm::Weighting::Efficient), "efficient");
+}
+
 TEST(GmwmFit, RejectsBadStructures) {
   Model m;
   m.rate_hz = 100;
@@ -151,103 +222,217 @@ TEST(GmwmFit, RejectsBadStructures) {
   }
 }
 
+namespace {
+/// Table 1 "Ref." models (200 Hz), as in config/models/navchip_table1.yaml.
+const std::pair<const char*, const char*> kTable1Refs[] = {
+    {"acc_ref",
+     "WN(sigma=5.521e-3) + GM(sigma=4.811e-4, T=3.22) + GM(sigma=6.666e-4, T=47.40) + "
+     "GM(sigma=4.003e-4, T=556) + DR(omega=9.302e-10)"},
+    {"gyro_ref",
+     "WN(sigma=9.788e-4) + GM(sigma=4.805e-5, T=59.22) + GM(sigma=2.209e-5, T=1.457) + "
+     "GM(sigma=7.555e-5, T=2008)"}};
+
+/// log parameters (WN/QN/RW/DR amplitude; GM log sigma, log T) of a model, and back.
+Eigen::VectorXd logParams(const Model& m) {
+  std::vector<double> v;
+  for (const auto& t : m.terms) {
+    if (t.kind == ProcessKind::WN) v.push_back(std::log(t.sigma));
+    if (t.kind == ProcessKind::DR) v.push_back(std::log(t.omega));
+    if (t.kind == ProcessKind::GM) {
+      v.push_back(std::log(t.sigma));
+      v.push_back(std::log(t.T));
+    }
+  }
+  return Eigen::Map<Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+Model withLogParams(Model m, const Eigen::VectorXd& p) {
+  int k = 0;
+  for (auto& t : m.terms) {
+    if (t.kind == ProcessKind::WN) t.sigma = std::exp(p[k++]);
+    if (t.kind == ProcessKind::DR) t.omega = std::exp(p[k++]);
+    if (t.kind == ProcessKind::GM) {
+      t.sigma = std::exp(p[k++]);
+      t.T = std::exp(p[k++]);
+    }
+  }
+  return m;
+}
+}  // namespace
+
+// Asymptotic standard errors at the Table 1 Ref models (6 h, 200 Hz) for
+// three weightings, all evaluated with the full WV covariance V
+// (wvCovariance; scales with eta_j < 16 diagonal, 2 nu^2/eta): sandwich
+// (A'WA)^-1 A'WVWA (A'WA)^-1 for R's fast weights and for the eta3 diagonal
+// weights, (A'V^-1 A)^-1 for the efficient GMWM. The efficient one is the
+// smallest for every parameter (GMM efficiency: a theorem, so this fails if
+// the sandwich or V^-1 is formed wrongly). Printed: se of log sigma / log T
+// per GM and the normal-approximation probability that both are within 30 %.
+// Result (printed): efficient se(log T) 0.25 (acc 47.4 s), 0.26 (gyro 1.457 s),
+// 0.21 (gyro 59.2 s), i.e. P(within 30 %) = 0.78 / 0.75 / 0.85 per seed, so
+// ">= 8 of 10 seeds within 30 %" holds with probability ~0.6 / 0.5 / 0.8 even
+// for the efficient estimator: the 6 h record does not carry the information.
+TEST(GmwmFit, EfficientAsymptoticSeAtTable1) {
+  const std::size_t n = 4320000;
+  for (const auto& [name, text] : kTable1Refs) {
+    Model m;
+    m.rate_hz = 200;
+    m.terms = stochastic::parseTerms(text, m.rate_hz);
+    gmwm::WaveletVariance wv = exactWv(m, n);
+    const int J = wv.scales();
+    Eigen::MatrixXd V = gmwm::wvCovariance(m, wv);
+    Eigen::VectorXd chi(J);
+    for (int j = 0; j < J; ++j) {
+      chi[j] = 2 * wv.wv[j] * wv.wv[j] / wv.eta[j];
+      if (wv.eta[j] < 16) {
+        V.row(j).setZero();
+        V.col(j).setZero();
+        V(j, j) = chi[j];
+      }
+    }
+    const Eigen::VectorXd p0 = logParams(m);
+    const Eigen::Index P = p0.size();
+    Eigen::MatrixXd A(J, P);
+    for (Eigen::Index k = 0; k < P; ++k) {
+      Eigen::VectorXd a = p0, b = p0;
+      a[k] += 1e-5;
+      b[k] -= 1e-5;
+      A.col(k) = (stochastic::haarWv(withLogParams(m, a), wv.tau) - stochastic::haarWv(withLogParams(m, b), wv.tau)) / 2e-5;
+    }
+    auto se = [&](const Eigen::MatrixXd& W) {
+      const Eigen::MatrixXd Bi = (A.transpose() * W * A).inverse();
+      const Eigen::MatrixXd Psi = Bi * A.transpose() * W * V * W * A * Bi;
+      return Eigen::VectorXd(Psi.diagonal().cwiseSqrt());
+    };
+    const Eigen::VectorXd fast = se(Eigen::MatrixXd(wv.weights().asDiagonal()));
+    const Eigen::VectorXd diag = se(Eigen::MatrixXd(chi.cwiseInverse().asDiagonal()));
+    const Eigen::VectorXd eff = se(V.inverse());
+    auto within30 = [](double sl, double sT) {  // independent-normal approximation
+      auto p = [](double s) { return 0.5 * (std::erf(std::log(1.3) / (s * std::sqrt(2.0))) - std::erf(std::log(0.7) / (s * std::sqrt(2.0)))); };
+      return p(sl) * p(sT);
+    };
+    int k = 0;
+    for (const auto& t : m.terms) {
+      if (t.kind == ProcessKind::GM) {
+        std::printf("%s GM T=%g: se(log sigma), se(log T): fast %.3f %.3f (P30 %.2f), eta3-diagonal %.3f %.3f (P30 %.2f), "
+                    "efficient %.3f %.3f (P30 %.2f)\n",
+                    name, t.T, fast[k], fast[k + 1], within30(fast[k], fast[k + 1]), diag[k], diag[k + 1],
+                    within30(diag[k], diag[k + 1]), eff[k], eff[k + 1], within30(eff[k], eff[k + 1]));
+        k += 2;
+      } else {
+        ++k;
+      }
+    }
+    for (Eigen::Index q = 0; q < P; ++q) {
+      EXPECT_LE(eff[q], fast[q] * (1 + 1e-6)) << name << " parameter " << q;
+      EXPECT_LE(eff[q], diag[q] * (1 + 1e-6)) << name << " parameter " << q;
+    }
+  }
+}
+
 // Simulate the paper's Table 1 reference models (200 Hz, 6 h) and fit the
-// same structure. Asserted on >= 8 of 10 seeds: WN sigma within 2 %; long-T
-// GMs (T >= record/200) inside the reported 95 % interval (profile method);
-// short-T GMs with T and sigma within a factor 2. The task's stricter "within
-// 30 %" is counted and printed for every short-T GM but asserted (>= 8/10)
-// only for the acc GM with T = 3.22 s: with R's fast weights the sampling
-// spread of the other short-T GMs (47.4 s next to 556 s + DR; 1.457 s and
-// 59.2 s next to 2008 s) gives 6-7 of 10 within 30 % on this seed list,
-// while every fit reaches an objective below the truth's (the optimizer is
-// not the limit; see the report). Model-based weights (FitOptions::weighting
-// = ModelBased) do not change this: 7/10 (47.4 s), 6/10 (1.457 s), 6-7/10
-// (59.2 s) on the same seeds, the misses being mostly T (sigma stays within
-// 30 %), so the spread is the diagonal-weight GMWM's sampling variance, not
-// the fast weights' bias: at the truth, with Omega = V^-1 and the eta3
-// variances V_jj = 2 nu_j^2 / eta_j, the asymptotic se of log T is 0.42
-// (47.4 s), 0.43 (1.457 s) and 0.31 (59.2 s), i.e. about 50-70 % of fits
-// within 30 %. The Wald coverage is printed too.
+// same structure, with R's fast weights and with the efficient GMWM
+// (Weighting::Efficient). Asserted for both on >= 8 of 10 seeds: WN sigma
+// within 2 %; long-T GMs (T >= record/200) inside the reported 95 % interval
+// (profile method); short-T GMs with T and sigma within a factor 2. The
+// task's stricter "within 30 %" is counted and printed for every short-T GM
+// but asserted (>= 8/10) only for the acc GM with T = 3.22 s. Observed on
+// this seed list (fixed before any tuning): within 30 %
+//   fast:      3.22 s 10/10, 47.4 s 7/10, 1.457 s 7/10, 59.2 s 6/10
+//   efficient: 3.22 s  9/10, 47.4 s 6/10, 1.457 s 7/10, 59.2 s 6/10
+// (model-based diagonal weights: 7, 6, 6-7 of 10). Every fast fit reaches
+// an objective below the truth's, so the optimizer is not the limit: the
+// sampling spread is (EfficientAsymptoticSeAtTable1: even the efficient
+// GMWM has only a 0.75-0.85 chance per seed of being within 30 % for those
+// three GMs). The Wald coverage is printed too.
 TEST(GmwmFit, RecoversTable1ReferenceModels) {
   const std::uint64_t seeds[10] = {101, 202, 303, 404, 505, 606, 707, 808, 909, 1010};
   const std::size_t n = 4320000;  // 6 h at 200 Hz
-  // Table 1 "Ref." models (200 Hz), as in config/models/navchip_table1.yaml.
-  const std::pair<const char*, const char*> refs[] = {
-      {"acc_ref",
-       "WN(sigma=5.521e-3) + GM(sigma=4.811e-4, T=3.22) + GM(sigma=6.666e-4, T=47.40) + "
-       "GM(sigma=4.003e-4, T=556) + DR(omega=9.302e-10)"},
-      {"gyro_ref",
-       "WN(sigma=9.788e-4) + GM(sigma=4.805e-5, T=59.22) + GM(sigma=2.209e-5, T=1.457) + "
-       "GM(sigma=7.555e-5, T=2008)"}};
-  for (const auto& [name, text] : refs) {
+  for (const auto& [name, text] : kTable1Refs) {
     Model truth;
     truth.rate_hz = 200.0;
     truth.terms = stochastic::parseTerms(text, truth.rate_hz);
     const auto tg = gms(truth);
     const double record_s = n / truth.rate_hz;
-    int wn_ok = 0;
-    std::vector<int> gm_ok(tg.size(), 0), wald_ok(tg.size(), 0), within30(tg.size(), 0);
+    struct Count {
+      int wn_ok = 0;
+      std::vector<int> gm_ok, wald_ok, within30;
+    };
+    Count cnt[2];  // Fast, Efficient
+    for (auto& c : cnt) c.gm_ok = c.wald_ok = c.within30 = std::vector<int>(tg.size(), 0);
     for (std::uint64_t seed : seeds) {
       const auto wv = simulatedWv(truth, n, seed);
-      gmwm::FitOptions o;
-      o.intervals = gmwm::IntervalMethod::Profile;
-      const auto f = gmwm::fit(kinds(truth), wv, o);
-      ASSERT_EQ(f.ci_method, "profile");
-      const auto fg = gms(f.model);
-      ASSERT_EQ(fg.size(), tg.size());
-      double wn = 0;
-      for (const auto& t : f.model.terms)
-        if (t.kind == ProcessKind::WN) wn = t.sigma;
-      if (std::fabs(wn / truth.terms[0].sigma - 1) < 0.02) ++wn_ok;
-      // Intervals of the GM terms in the estimator's (sorted) order; the Wald
-      // intervals from the sandwich covariance of (log sigma, log T).
-      std::vector<std::vector<gmwm::ParamInterval>> gci, wci;
-      int off = 0;
-      for (std::size_t i = 0; i < f.model.terms.size(); ++i) {
-        const auto& t = f.model.terms[i];
-        if (t.kind == ProcessKind::GM) {
-          gci.push_back(f.ci[i]);
-          auto w = f.ci[i];
-          for (int q = 0; q < 2; ++q) {
-            const double se = std::sqrt(f.cov_transformed(off + q, off + q));
-            w[q].low = w[q].value * std::exp(-1.959964 * se);
-            w[q].high = w[q].value * std::exp(1.959964 * se);
+      for (int wi = 0; wi < 2; ++wi) {
+        auto& [wn_ok, gm_ok, wald_ok, within30] = cnt[wi];
+        gmwm::FitOptions o;
+        o.intervals = gmwm::IntervalMethod::Profile;
+        o.weighting = wi == 0 ? gmwm::Weighting::Fast : gmwm::Weighting::Efficient;
+        const auto f = gmwm::fit(kinds(truth), wv, o);
+        ASSERT_EQ(f.ci_method, "profile");
+        const auto fg = gms(f.model);
+        ASSERT_EQ(fg.size(), tg.size());
+        double wn = 0;
+        for (const auto& t : f.model.terms)
+          if (t.kind == ProcessKind::WN) wn = t.sigma;
+        if (std::fabs(wn / truth.terms[0].sigma - 1) < 0.02) ++wn_ok;
+        // Intervals of the GM terms in the estimator's (sorted) order; the Wald
+        // intervals from the sandwich covariance of (log sigma, log T).
+        std::vector<std::vector<gmwm::ParamInterval>> gci, wci;
+        int off = 0;
+        for (std::size_t i = 0; i < f.model.terms.size(); ++i) {
+          const auto& t = f.model.terms[i];
+          if (t.kind == ProcessKind::GM) {
+            gci.push_back(f.ci[i]);
+            auto w = f.ci[i];
+            for (int q = 0; q < 2; ++q) {
+              const double se = std::sqrt(f.cov_transformed(off + q, off + q));
+              w[q].low = w[q].value * std::exp(-1.959964 * se);
+              w[q].high = w[q].value * std::exp(1.959964 * se);
+            }
+            wci.push_back(w);
           }
-          wci.push_back(w);
+          off += gmwm::parameterCount({t.kind});
         }
-        off += gmwm::parameterCount({t.kind});
+        std::printf("%s seed %llu %s: %s (objective %.3g)\n", name, (unsigned long long)seed,
+                    gmwm::weightingName(o.weighting).c_str(), stochastic::formatTerms(f.model.terms).c_str(), f.objective);
+        auto inside = [&](const std::vector<gmwm::ParamInterval>& ci, const Process& tr) {
+          return ci[1].low <= tr.T && tr.T <= ci[1].high && ci[0].low <= tr.sigma && tr.sigma <= ci[0].high;
+        };
+        for (std::size_t g = 0; g < tg.size(); ++g) {
+          if (tg[g].T < record_s / 200) {
+            const double rT = fg[g].T / tg[g].T, rs = fg[g].sigma / tg[g].sigma;
+            within30[g] += std::fabs(rT - 1) < 0.3 && std::fabs(rs - 1) < 0.3;
+            gm_ok[g] += rT > 0.5 && rT < 2.0 && rs > 0.5 && rs < 2.0;
+          } else {
+            gm_ok[g] += inside(gci[g], tg[g]);
+            wald_ok[g] += inside(wci[g], tg[g]);
+            std::printf("    long GM T=%g: profile T in [%.4g, %.4g], sigma in [%.4g, %.4g]; Wald T in [%.4g, %.4g]\n",
+                        tg[g].T, gci[g][1].low, gci[g][1].high, gci[g][0].low, gci[g][0].high, wci[g][1].low,
+                        wci[g][1].high);
+          }
+        }
       }
-      std::printf("%s seed %llu: %s (objective %.3g)\n", name, (unsigned long long)seed,
-                  stochastic::formatTerms(f.model.terms).c_str(), f.objective);
-      auto inside = [&](const std::vector<gmwm::ParamInterval>& ci, const Process& tr) {
-        return ci[1].low <= tr.T && tr.T <= ci[1].high && ci[0].low <= tr.sigma && tr.sigma <= ci[0].high;
-      };
+    }
+    for (int wi = 0; wi < 2; ++wi) {
+      const auto& c = cnt[wi];
+      std::printf("%s, %s weights: WN within 2 %%: %d/10", name, wi == 0 ? "fast" : "efficient", c.wn_ok);
       for (std::size_t g = 0; g < tg.size(); ++g) {
-        if (tg[g].T < record_s / 200) {
-          const double rT = fg[g].T / tg[g].T, rs = fg[g].sigma / tg[g].sigma;
-          within30[g] += std::fabs(rT - 1) < 0.3 && std::fabs(rs - 1) < 0.3;
-          gm_ok[g] += rT > 0.5 && rT < 2.0 && rs > 0.5 && rs < 2.0;
-        } else {
-          gm_ok[g] += inside(gci[g], tg[g]);
-          wald_ok[g] += inside(wci[g], tg[g]);
-          std::printf("    long GM T=%g: profile T in [%.4g, %.4g], sigma in [%.4g, %.4g]; Wald T in [%.4g, %.4g]\n",
-                      tg[g].T, gci[g][1].low, gci[g][1].high, gci[g][0].low, gci[g][0].high, wci[g][1].low,
-                      wci[g][1].high);
+        if (tg[g].T >= record_s / 200)
+          std::printf("; GM T=%g: in profile CI %d/10 (Wald %d/10)", tg[g].T, c.gm_ok[g], c.wald_ok[g]);
+        else
+          std::printf("; GM T=%g: within 30 %% %d/10, factor 2 %d/10", tg[g].T, c.within30[g], c.gm_ok[g]);
+      }
+      std::printf("\n");
+    }
+    for (int wi = 0; wi < 2; ++wi) {
+      const char* wname = wi == 0 ? "fast" : "efficient";
+      const auto& c = cnt[wi];
+      EXPECT_GE(c.wn_ok, 8) << name << " " << wname;
+      for (std::size_t g = 0; g < tg.size(); ++g) {
+        EXPECT_GE(c.gm_ok[g], 8) << name << " " << wname << " GM with T=" << tg[g].T;
+        if (std::string(name) == "acc_ref" && tg[g].T < 10) {
+          EXPECT_GE(c.within30[g], 8) << name << " " << wname << " T=" << tg[g].T;
         }
       }
-    }
-    std::printf("%s: WN within 2 %%: %d/10", name, wn_ok);
-    for (std::size_t g = 0; g < tg.size(); ++g) {
-      if (tg[g].T >= record_s / 200)
-        std::printf("; GM T=%g: in profile CI %d/10 (Wald %d/10)", tg[g].T, gm_ok[g], wald_ok[g]);
-      else
-        std::printf("; GM T=%g: within 30 %% %d/10, factor 2 %d/10", tg[g].T, within30[g], gm_ok[g]);
-    }
-    std::printf("\n");
-    EXPECT_GE(wn_ok, 8) << name;
-    for (std::size_t g = 0; g < tg.size(); ++g) {
-      EXPECT_GE(gm_ok[g], 8) << name << " GM with T=" << tg[g].T;
-      if (std::string(name) == "acc_ref" && tg[g].T < 10) EXPECT_GE(within30[g], 8) << name << " T=" << tg[g].T;
     }
   }
 }
@@ -263,6 +448,33 @@ bool negligible(const Process& p, double rate, const gmwm::WaveletVariance& wv) 
   return true;
 }
 }  // namespace
+
+// negligibleTerms: a term at 1e-30 of the data's WV is flagged, the true
+// terms are not; a term just above 0.1 x the CI width at one scale is not
+// flagged, just below it at every scale is.
+TEST(GmwmFit, NegligibleTermsAreFlagged) {
+  Model m;
+  m.rate_hz = 100;
+  m.terms = stochastic::parseTerms("WN(sigma=0.01) + GM(sigma=0.003, T=2) + DR(omega=1e-40) + RW(gamma=1e-30)", 100);
+  const auto wv = simulatedWv(m, 1u << 16, 5);
+  const std::vector<bool> neg = gmwm::negligibleTerms(m, wv);
+  ASSERT_EQ(neg.size(), 4u);
+  EXPECT_FALSE(neg[0]);
+  EXPECT_FALSE(neg[1]);
+  EXPECT_TRUE(neg[2]);
+  EXPECT_TRUE(neg[3]);
+  // A WN whose WV equals 0.1 x (CI width) at its most visible scale, scaled by 1 -+ 1e-6.
+  double ratio = 0;
+  for (int j = 0; j < wv.scales(); ++j)
+    ratio = std::max(ratio, (1e-4 / wv.tau[j]) / (wv.ci_high[j] - wv.ci_low[j]));
+  const double s_edge = 0.01 * std::sqrt(0.1 / ratio);
+  Model e = m;
+  e.terms = {Process::wn(s_edge * (1 + 1e-6))};
+  EXPECT_FALSE(gmwm::negligibleTerms(e, wv)[0]);
+  e.terms = {Process::wn(s_edge * (1 - 1e-6))};
+  EXPECT_TRUE(gmwm::negligibleTerms(e, wv)[0]);
+  EXPECT_THROW(gmwm::negligibleTerms(e, wv, 0.0), Error);
+}
 
 // WIC selection: on WN+GM data it picks exactly one GM (other terms beyond WN
 // negligible); on pure WN it picks WN. Larger nested models never end above
@@ -287,8 +499,9 @@ TEST(GmwmFit, SelectionPicksTheSimulatedStructure) {
       EXPECT_EQ(pick.count(ProcessKind::WN), 1);
       EXPECT_EQ(pick.count(ProcessKind::GM), which == 0 ? 1 : 0) << why;
       for (const auto& t : pick.terms)
-        if (t.kind != ProcessKind::WN && t.kind != ProcessKind::GM)
+        if (t.kind != ProcessKind::WN && t.kind != ProcessKind::GM) {
           EXPECT_TRUE(negligible(t, pick.rate_hz, wv)) << stochastic::formatTerms(pick.terms);
+        }
       // Nested models: a structure with one GM more never has a higher objective.
       for (const auto& a : ranked)
         for (const auto& b : ranked) {
@@ -297,9 +510,10 @@ TEST(GmwmFit, SelectionPicksTheSimulatedStructure) {
           bool sub = true;
           for (ProcessKind k : {ProcessKind::WN, ProcessKind::QN, ProcessKind::RW, ProcessKind::DR})
             sub = sub && a.fit.model.count(k) == b.fit.model.count(k);
-          if (sub)
+          if (sub) {
             EXPECT_LE(b.fit.objective, a.fit.objective * (1 + 1e-9) + 1e-12)
                 << stochastic::formatTerms(b.fit.model.terms) << " vs " << stochastic::formatTerms(a.fit.model.terms);
+          }
         }
     }
   }

@@ -108,11 +108,23 @@ using detail::Jet;
 using detail::kMaxParams;
 using detail::Layout;
 
-/// Residuals r_j = w_j (nu_hat_j - nu_j(theta)), Jacobian by forward-mode autodiff.
+/**
+ * Weights of the objective: residuals r = diag(d) (nu_hat - nu) or, when the
+ * matrix m is set (Efficient weighting), r = m (nu_hat - nu) with m'm = Omega.
+ */
+struct Weights {
+  Eigen::VectorXd d;
+  Eigen::MatrixXd m;
+  Weights(const Eigen::VectorXd& diag) : d(diag) {}  // NOLINT: implicit on purpose
+  Weights(const Eigen::VectorXd& diag, const Eigen::MatrixXd& full) : d(diag), m(full) {}
+  bool full() const { return m.size() > 0; }
+  Eigen::VectorXd apply(const Eigen::VectorXd& e) const { return full() ? Eigen::VectorXd(m * e) : Eigen::VectorXd(d.cwiseProduct(e)); }
+};
+
+/// Residuals r = W (nu_hat - nu(theta)), Jacobian by forward-mode autodiff.
 class WvCost final : public ceres::CostFunction {
  public:
-  WvCost(const Layout& L, const Eigen::VectorXd& tau, const Eigen::VectorXd& nu_hat,
-         const Eigen::VectorXd& w)
+  WvCost(const Layout& L, const Eigen::VectorXd& tau, const Eigen::VectorXd& nu_hat, const Weights& w)
       : L_(L), tau_(tau), nu_hat_(nu_hat), w_(w) {
     set_num_residuals(static_cast<int>(tau.size()));
     mutable_parameter_block_sizes()->push_back(L.p);
@@ -120,17 +132,39 @@ class WvCost final : public ceres::CostFunction {
   bool Evaluate(double const* const* params, double* res, double** jac) const override {
     const double* th = params[0];
     const Eigen::Index J = tau_.size();
-    if (jac == nullptr || jac[0] == nullptr) {
+    if (w_.full()) {
+      // r = W e, dr/dtheta = -W dnu/dtheta.
+      Eigen::VectorXd e(J);
+      Eigen::MatrixXd de(J, L_.p);
+      if (jac == nullptr || jac[0] == nullptr) {
+        std::vector<double> nu(J);
+        detail::modelWv(L_, th, tau_, nu.data());
+        for (Eigen::Index j = 0; j < J; ++j) e[j] = nu_hat_[j] - nu[j];
+      } else {
+        std::vector<Jet> x(L_.p), nu(J);
+        for (int k = 0; k < L_.p; ++k) x[k] = Jet(th[k], k);
+        detail::modelWv(L_, x.data(), tau_, nu.data());
+        for (Eigen::Index j = 0; j < J; ++j) {
+          e[j] = nu_hat_[j] - nu[j].a;
+          for (int k = 0; k < L_.p; ++k) de(j, k) = -nu[j].v[k];
+        }
+        const Eigen::MatrixXd dr = w_.m * de;
+        for (Eigen::Index j = 0; j < J; ++j)
+          for (int k = 0; k < L_.p; ++k) jac[0][j * L_.p + k] = dr(j, k);
+      }
+      const Eigen::VectorXd r = w_.m * e;
+      for (Eigen::Index j = 0; j < J; ++j) res[j] = r[j];
+    } else if (jac == nullptr || jac[0] == nullptr) {
       std::vector<double> nu(J);
       detail::modelWv(L_, th, tau_, nu.data());
-      for (Eigen::Index j = 0; j < J; ++j) res[j] = w_[j] * (nu_hat_[j] - nu[j]);
+      for (Eigen::Index j = 0; j < J; ++j) res[j] = w_.d[j] * (nu_hat_[j] - nu[j]);
     } else {
       std::vector<Jet> x(L_.p), nu(J);
       for (int k = 0; k < L_.p; ++k) x[k] = Jet(th[k], k);
       detail::modelWv(L_, x.data(), tau_, nu.data());
       for (Eigen::Index j = 0; j < J; ++j) {
-        res[j] = w_[j] * (nu_hat_[j] - nu[j].a);
-        for (int k = 0; k < L_.p; ++k) jac[0][j * L_.p + k] = -w_[j] * nu[j].v[k];
+        res[j] = w_.d[j] * (nu_hat_[j] - nu[j].a);
+        for (int k = 0; k < L_.p; ++k) jac[0][j * L_.p + k] = -w_.d[j] * nu[j].v[k];
       }
     }
     for (Eigen::Index j = 0; j < J; ++j)
@@ -142,12 +176,14 @@ class WvCost final : public ceres::CostFunction {
   const Layout& L_;
   const Eigen::VectorXd& tau_;
   const Eigen::VectorXd& nu_hat_;
-  const Eigen::VectorXd& w_;
+  const Weights& w_;
 };
 
 /// Everything one fit needs about the data.
 struct Data {
   Eigen::VectorXd tau, nu_hat, w_rel, w_obj, omega, eta;
+  /// Efficient weighting: W with W'W = Omega (empty otherwise: diagonal w_obj).
+  Eigen::MatrixXd w_full;
   double rate = 0;
   double n = 0;
   int J = 0;
@@ -177,13 +213,12 @@ Data makeData(const WaveletVariance& wv) {
   return d;
 }
 
-double criterion(const Layout& L, const Eigen::VectorXd& th, const Data& d, const Eigen::VectorXd& w) {
+/// Weights of the objective (diagonal, or the full efficient matrix when set).
+Weights objW(const Data& d) { return d.w_full.size() ? Weights(d.w_obj, d.w_full) : Weights(d.w_obj); }
+
+double criterion(const Layout& L, const Eigen::VectorXd& th, const Data& d, const Weights& w) {
   const Eigen::VectorXd nu = detail::wvOf(L, th, d.tau);
-  double s = 0;
-  for (int j = 0; j < d.J; ++j) {
-    const double r = w[j] * (d.nu_hat[j] - nu[j]);
-    s += r * r;
-  }
+  const double s = w.apply(d.nu_hat - nu).squaredNorm();
   return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
 }
 
@@ -217,7 +252,7 @@ void clampToBounds(Eigen::VectorXd& th, const Layout& L, const Data& d) {
 }
 
 /// Minimise sum (w_j (nu_hat_j - nu_j))^2 from @p th (in place); returns the criterion.
-double solve(const Layout& L, Eigen::VectorXd& th, const Data& d, const Eigen::VectorXd& w,
+double solve(const Layout& L, Eigen::VectorXd& th, const Data& d, const Weights& w,
              bool* converged = nullptr, int fixed = -1,
              const std::vector<std::pair<double, double>>* bands = nullptr) {
   clampToBounds(th, L, d);
@@ -273,11 +308,11 @@ Eigen::VectorXd unitProfile(const Layout& L, int i, const Eigen::VectorXd& th, c
  * Zero amplitudes become negligible ones (at most 1e-3 of nu_hat at any scale).
  * Writes log amplitudes (0.5 log a) into th; returns the criterion.
  */
-double nnlsAmplitudes(const Layout& L, Eigen::VectorXd& th, const Data& d, const Eigen::VectorXd& w) {
+double nnlsAmplitudes(const Layout& L, Eigen::VectorXd& th, const Data& d, const Weights& w) {
   const int m = static_cast<int>(L.kinds.size());
   Eigen::MatrixXd A(d.J, m);
-  for (int i = 0; i < m; ++i) A.col(i) = unitProfile(L, i, th, d).cwiseProduct(w);
-  const Eigen::VectorXd y = d.nu_hat.cwiseProduct(w);
+  for (int i = 0; i < m; ++i) A.col(i) = w.apply(unitProfile(L, i, th, d));
+  const Eigen::VectorXd y = w.apply(d.nu_hat);
   Eigen::VectorXd scale(m);
   for (int i = 0; i < m; ++i) {
     scale[i] = A.col(i).norm();
@@ -472,8 +507,9 @@ std::vector<Eigen::VectorXd> warmStarts(const Layout& L, const Model& warm, cons
     if (k == fresh.size()) {
       const int m = static_cast<int>(fresh.size());
       Eigen::MatrixXd A(d.J, m);
-      for (int c = 0; c < m; ++c) A.col(c) = unitProfile(L, fresh[c], t, d).cwiseProduct(d.w_obj);
-      const Eigen::VectorXd y = resid.cwiseProduct(d.w_obj);
+      const Weights W = objW(d);
+      for (int c = 0; c < m; ++c) A.col(c) = W.apply(unitProfile(L, fresh[c], t, d));
+      const Eigen::VectorXd y = W.apply(resid);
       Eigen::VectorXd a = A.colPivHouseholderQr().solve(y);
       Eigen::VectorXd tt = t;
       for (int c = 0; c < m; ++c) {
@@ -482,7 +518,7 @@ std::vector<Eigen::VectorXd> warmStarts(const Layout& L, const Model& warm, cons
         else
           negligible(tt, fresh[c]);
       }
-      keepBest(best, {tt, criterion(L, tt, d, d.w_obj)}, 3);
+      keepBest(best, {tt, criterion(L, tt, d, objW(d))}, 3);
       return;
     }
     const int i = fresh[k];
@@ -512,7 +548,7 @@ Eigen::VectorXd fitPoint(const Layout& L, const Data& d, const FitOptions& opt, 
     const double vr = nnlsAmplitudes(L, t, d, d.w_rel);
     keepBest(best_rel, {t, vr}, k);
     t = th0;
-    const double vo = nnlsAmplitudes(L, t, d, d.w_obj);
+    const double vo = nnlsAmplitudes(L, t, d, objW(d));
     keepBest(best_obj, {t, vo}, k);
   });
   std::vector<Eigen::VectorXd> cands;
@@ -529,7 +565,7 @@ Eigen::VectorXd fitPoint(const Layout& L, const Data& d, const FitOptions& opt, 
   bool best_conv = false;
   for (auto& t : cands) {
     bool conv = false;
-    const double v = solve(L, t, d, d.w_obj, &conv);
+    const double v = solve(L, t, d, objW(d), &conv);
     if (v < best_v) {
       best_v = v;
       best_th = t;
@@ -571,12 +607,86 @@ int reweight(const Layout& L, Eigen::VectorXd& th, Data& d, int passes, bool* co
   for (int it = 0; it < std::max(passes, 1); ++it) {
     setModelWeights(L, th, d);
     Eigen::VectorXd t = th;
-    double v = solve(L, t, d, d.w_obj, converged);
+    double v = solve(L, t, d, objW(d), converged);
     sortTerms(L, t);
     if (multi && it == 0) {  // the fast basin need not be the best one under the new weights
       bool c2 = false;
       Eigen::VectorXd t2 = fitPoint(L, d, *multi, nullptr, &c2);
-      const double v2 = criterion(L, t2, d, d.w_obj);
+      const double v2 = criterion(L, t2, d, objW(d));
+      if (v2 < v) {
+        t = t2;
+        v = v2;
+        if (converged) *converged = c2;
+      }
+    }
+    const double change = (t - th).cwiseAbs().maxCoeff();
+    th = t;
+    ++done;
+    if (change < 1e-3) break;
+  }
+  return done;
+}
+
+/**
+ * Efficient weights at theta: Omega = V^-1, V the full asymptotic covariance
+ * of nu_hat under the model theta (wvCovariance). Scales with eta_j < min_eta
+ * get V_jj = 2 nu_j^2 / eta_j (eta3 chi-square variance) and no correlation:
+ * the asymptotic formula assumes M_j >> tau_j and overstates their variance
+ * by up to 1/eta_j. V = D R D (D = sqrt(diag V)); the correlation matrix R is
+ * Cholesky-factored (R = C C', a ridge of 1e-12, 1e-10, ... on its diagonal
+ * if it is not numerically positive definite) and W = C^-1 D^-1, so that
+ * |W e|^2 = e' V^-1 e. Sets d.w_full, d.omega (diag of Omega) and d.w_obj.
+ */
+void setEfficientWeights(const Layout& L, const Eigen::VectorXd& th, Data& d, double min_eta) {
+  const Model m = detail::toModel(L, th, d.rate);
+  WaveletVariance wv;
+  wv.tau = d.tau;
+  wv.n = static_cast<std::size_t>(d.n);
+  wv.rate_hz = d.rate;
+  Eigen::MatrixXd V = wvCovariance(m, wv);
+  const Eigen::VectorXd nu = detail::wvOf(L, th, d.tau);
+  for (int j = 0; j < d.J; ++j) {
+    const double v = std::max(nu[j], 1e-6 * d.nu_hat[j]);
+    const double chi = 2.0 * v * v / d.eta[j];
+    if (d.eta[j] < min_eta || !(V(j, j) > 0.0) || !std::isfinite(V(j, j))) {
+      V.row(j).setZero();
+      V.col(j).setZero();
+      V(j, j) = chi;
+    }
+  }
+  const Eigen::VectorXd D = V.diagonal().cwiseSqrt();
+  const Eigen::VectorXd Di = D.cwiseInverse();
+  Eigen::MatrixXd R = Di.asDiagonal() * V * Di.asDiagonal();
+  R = 0.5 * (R + R.transpose());
+  Eigen::LLT<Eigen::MatrixXd> llt(R);
+  for (double ridge = 1e-12; llt.info() != Eigen::Success && ridge < 1.0; ridge *= 100.0) {
+    Eigen::MatrixXd Rr = R;
+    Rr.diagonal().array() += ridge;
+    llt.compute(Rr);
+  }
+  if (llt.info() != Eigen::Success) throw Error("GMWM efficient weights: WV covariance is not positive definite");
+  const Eigen::MatrixXd Ci =
+      llt.matrixL().solve(Eigen::MatrixXd::Identity(d.J, d.J));
+  d.w_full = Ci * Di.asDiagonal();
+  const Eigen::MatrixXd Om = d.w_full.transpose() * d.w_full;
+  d.omega = Om.diagonal();
+  d.w_obj = d.omega.cwiseSqrt();
+}
+
+/// Efficient GMWM: iterate efficient weights at theta and refit (first pass
+/// also from the multi-start points under the new weights), as reweight().
+int reweightEfficient(const Layout& L, Eigen::VectorXd& th, Data& d, int passes, double min_eta,
+                      bool* converged, const FitOptions* multi = nullptr) {
+  int done = 0;
+  for (int it = 0; it < std::max(passes, 1); ++it) {
+    setEfficientWeights(L, th, d, min_eta);
+    Eigen::VectorXd t = th;
+    double v = solve(L, t, d, objW(d), converged);
+    sortTerms(L, t);
+    if (multi && it == 0) {
+      bool c2 = false;
+      Eigen::VectorXd t2 = fitPoint(L, d, *multi, nullptr, &c2);
+      const double v2 = criterion(L, t2, d, objW(d));
       if (v2 < v) {
         t = t2;
         v = v2;
@@ -670,8 +780,8 @@ void profileInterval(const Layout& L, const Data& d, const Eigen::VectorXd& th, 
         x = t[k];
         edge = x;
       }
-      solve(L, t, d, d.w_obj, nullptr, k, &bands);
-      const double delta = criterion(L, t, d, d.w_obj) - obj;
+      solve(L, t, d, objW(d), nullptr, k, &bands);
+      const double delta = criterion(L, t, d, objW(d)) - obj;
       if (delta > c) {
         const double f = (c - prev_d) / (delta - prev_d);
         x = prev_x + std::clamp(f, 0.0, 1.0) * (x - prev_x);
@@ -711,12 +821,20 @@ Eigen::VectorXd modelWeights(const Model& m, const WaveletVariance& wv) {
   return w;
 }
 
-std::string weightingName(Weighting w) { return w == Weighting::ModelBased ? "model" : "fast"; }
+std::string weightingName(Weighting w) {
+  switch (w) {
+    case Weighting::ModelBased: return "model";
+    case Weighting::Efficient: return "efficient";
+    case Weighting::Fast: break;
+  }
+  return "fast";
+}
 
 Weighting parseWeighting(const std::string& s) {
   if (s == "fast") return Weighting::Fast;
   if (s == "model") return Weighting::ModelBased;
-  throw Error("GMWM weights: '" + s + "' is not one of fast, model");
+  if (s == "efficient") return Weighting::Efficient;
+  throw Error("GMWM weights: '" + s + "' is not one of fast, model, efficient");
 }
 
 namespace detail {
@@ -756,10 +874,18 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
   r.weighting = opt.weighting;
   if (opt.weighting == Weighting::ModelBased)
     r.weight_passes = reweight(L, th, d, opt.weight_iterations, &r.converged, &opt);
+  if (opt.weighting == Weighting::Efficient)
+    r.weight_passes = reweightEfficient(L, th, d, opt.weight_iterations, opt.efficient_min_eta, &r.converged, &opt);
   r.model = detail::toModel(L, th, d.rate);
   r.objective_fast = objective(r.model, wv);
-  r.objective = opt.weighting == Weighting::Fast ? r.objective_fast : criterion(L, th, d, d.w_obj);
-  r.cov_transformed = detail::sandwich(L, th, wv, d.omega);
+  r.objective = opt.weighting == Weighting::Fast ? r.objective_fast : criterion(L, th, d, objW(d));
+  if (opt.weighting == Weighting::Efficient) {
+    // Omega = V^-1: the sandwich reduces to (A' Omega A)^-1 (Guerrier et al. 2013).
+    const Eigen::MatrixXd WA = d.w_full * detail::jacobian(L, th, wv.tau);
+    r.cov_transformed = pinvSym(WA.transpose() * WA);
+  } else {
+    r.cov_transformed = detail::sandwich(L, th, wv, d.omega);
+  }
   Eigen::VectorXd lo(p), hi(p);
   if (opt.bootstrap > 0) {
     // Parametric bootstrap: simulate the fitted model at the data length,
@@ -773,9 +899,11 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
       const WaveletVariance wb = waveletVariance(x.data(), n, wv.rate_hz, 0.05, wv.scales());
       Data db = makeData(wb);
       Eigen::VectorXd t = th;
-      solve(L, t, db, db.w_obj);
+      solve(L, t, db, objW(db));
       sortTerms(L, t);
       if (opt.weighting == Weighting::ModelBased) reweight(L, t, db, opt.weight_iterations, nullptr);
+      if (opt.weighting == Weighting::Efficient)
+        reweightEfficient(L, t, db, opt.weight_iterations, opt.efficient_min_eta, nullptr);
       reps.push_back(t);
     }
     for (int k = 0; k < p; ++k) {
@@ -796,9 +924,14 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
     Eigen::MatrixXd Binv;
     if (opt.intervals == IntervalMethod::Profile) {
       const Eigen::MatrixXd A = detail::jacobian(L, th, wv.tau);
-      Binv = pinvSym(A.transpose() * d.omega.asDiagonal() * A);
+      if (d.w_full.size()) {
+        const Eigen::MatrixXd WA = d.w_full * A;
+        Binv = pinvSym(WA.transpose() * WA);
+      } else {
+        Binv = pinvSym(A.transpose() * d.omega.asDiagonal() * A);
+      }
     }
-    const double obj = criterion(L, th, d, d.w_obj);
+    const double obj = criterion(L, th, d, objW(d));
     // Identity bands of the GM log T (th is sorted by T): between the neighbours.
     std::vector<std::pair<double, double>> bands(p, {-HUGE_VAL, HUGE_VAL});
     std::vector<int> gmT;

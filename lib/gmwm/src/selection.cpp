@@ -12,6 +12,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 #include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/theoretical_wv.hpp"
 
 namespace navimpact::gmwm {
 
@@ -104,6 +105,17 @@ double optimism(const FitResult& f, const WaveletVariance& wv) {
   return 2.0 * tr;
 }
 
+std::vector<bool> negligibleTerms(const Model& m, const WaveletVariance& wv, double fraction) {
+  if (!(fraction > 0.0 && fraction <= 1.0))
+    throw Error("negligibleTerms: fraction " + fmt(fraction) + " outside (0, 1]");
+  std::vector<bool> out(m.terms.size(), true);
+  for (std::size_t i = 0; i < m.terms.size(); ++i)
+    for (int j = 0; j < wv.scales() && out[i]; ++j)
+      if (!(stochastic::haarWv(m.terms[i], m.rate_hz, wv.tau[j]) < fraction * (wv.ci_high[j] - wv.ci_low[j])))
+        out[i] = false;
+  return out;
+}
+
 std::vector<std::vector<ProcessKind>> defaultCandidates(int max_gm) {
   std::vector<std::vector<ProcessKind>> out;
   for (int g = 0; g <= max_gm; ++g)
@@ -163,6 +175,32 @@ std::vector<RankedModel> selectModel(const std::vector<std::vector<ProcessKind>>
     if (ka != kb) return ka < kb;
     return parameterCount(kindsOf(a.fit.model)) < parameterCount(kindsOf(b.fit.model));
   });
+  // A pick with a term the data cannot see yields to the structure without it.
+  std::string dropped;
+  for (int pass = 0; pass < 8; ++pass) {
+    const Model& bm = out.front().fit.model;
+    const std::vector<bool> neg = negligibleTerms(bm, wv);
+    const auto bk = kindsOf(bm);
+    std::size_t swap_to = 0;
+    ProcessKind gone{};
+    for (std::size_t q = 1; q < out.size() && swap_to == 0; ++q) {
+      ProcessKind extra{};
+      if (!oneLess(kindsOf(out[q].fit.model), bk, &extra)) continue;
+      for (std::size_t i = 0; i < bm.terms.size(); ++i)
+        if (neg[i] && bm.terms[i].kind == extra) {
+          swap_to = q;
+          gone = extra;
+          break;
+        }
+    }
+    if (swap_to == 0) break;
+    dropped += std::string(dropped.empty() ? "" : ", ") + stochastic::formatStructure(bk) + " -> " +
+               stochastic::formatStructure(kindsOf(out[swap_to].fit.model)) + " (its " +
+               stochastic::kindName(gone) + " is negligible)";
+    RankedModel r = out[swap_to];
+    out.erase(out.begin() + static_cast<std::ptrdiff_t>(swap_to));
+    out.insert(out.begin(), r);
+  }
   if (opt.bootstrap > 0) {
     // Bootstrap intervals for the selected model only.
     FitOptions o = opt;
@@ -178,6 +216,9 @@ std::vector<RankedModel> selectModel(const std::vector<std::vector<ProcessKind>>
     std::ostringstream os;
     os << "picked " << stochastic::formatStructure(bk) << ": criterion " << fmt(b.criterion)
        << " (objective " << fmt(b.fit.objective) << " + optimism " << fmt(b.optimism) << ")";
+    if (!dropped.empty())
+      os << " [preferred over a lower criterion with a term below " << fmt(kNegligibleFraction)
+         << " of the WV's 95 % CI width at every scale: " << dropped << "]";
     // Best simpler neighbour (one term less) and best richer one (one term more).
     for (const auto& r : out) {
       ProcessKind extra{};

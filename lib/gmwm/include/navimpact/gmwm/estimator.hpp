@@ -43,11 +43,23 @@ enum class Weighting {
   /// short-T GMs than Fast (test_fit_sim.cpp). selectModel's optimism is
   /// derived for Fast weights: rank structures with Fast.
   ModelBased,
+  /// Efficient GMWM (Guerrier et al. 2013, Omega = V^-1 is optimal): fit with
+  /// Fast, then Omega = the inverse of the FULL asymptotic covariance of the
+  /// WV vector under the fitted model (wvCovariance; neighbouring scales are
+  /// strongly correlated), refit from theta_hat, repeated until theta is
+  /// stable (at most FitOptions::weight_iterations passes). Scales whose
+  /// equivalent degrees of freedom eta_j fall below FitOptions::efficient_min_eta
+  /// (the coarsest, where the asymptotic formula does not hold) keep a
+  /// diagonal weight eta_j / (2 nu_j^2) and no correlation with the others.
+  Efficient,
 };
 
 struct FitOptions {
   Weighting weighting = Weighting::Fast;  ///< see Weighting
-  int weight_iterations = 3;     ///< ModelBased: most reweighting passes (>= 1)
+  int weight_iterations = 3;     ///< ModelBased / Efficient: most reweighting passes (>= 1)
+  /// Efficient: scales with eta_j = M_j / tau_j below this keep a diagonal
+  /// weight (the asymptotic covariance needs M_j >> tau_j, the correlation length of W_j).
+  double efficient_min_eta = 16.0;
   int bootstrap = 0;             ///< parametric bootstrap replicates for CIs (0 = asymptotic/profile)
   IntervalMethod intervals = IntervalMethod::Asymptotic;  ///< used when bootstrap == 0
   std::uint64_t seed = 20190101; ///< seed of the bootstrap / random starts
@@ -91,10 +103,27 @@ double objective(const stochastic::Model& m, const WaveletVariance& wv);
 /// Model-based weights eta_j / (2 nu_j(m)^2) of @p m at the scales of @p wv [1/unit^4].
 Eigen::VectorXd modelWeights(const stochastic::Model& m, const WaveletVariance& wv);
 
-/// "fast" or "model".
+/// "fast", "model" or "efficient".
 std::string weightingName(Weighting w);
-/// Parse "fast" / "model". @throws navimpact::Error naming the expected values.
+/// Parse "fast" / "model" / "efficient". @throws navimpact::Error naming the expected values.
 Weighting parseWeighting(const std::string& s);
+
+/**
+ * Asymptotic covariance of the empirical Haar WV vector of @p wv's scales
+ * under the Gaussian model @p m (Percival 1995; Percival & Walden 2000 §8.3):
+ * Cov(nu_hat_j, nu_hat_k) = 2 / max(M_j, M_k) int |H_j(f)|^2 |H_k(f)|^2 S(f)^2 df,
+ * H_j the Haar MODWT wavelet filter of level j, S the spectral density per
+ * sample of the random terms (WN, QN, RW pseudo-spectrum, GM). DR and SIN are
+ * deterministic and add no variance (their cross terms with the noise are neglected).
+ * Valid for M_j >> tau_j (eta_j >> 1); it overstates the variance of the coarsest scales.
+ * @param[in] m   model (per-sample parameters at m.rate_hz, which must equal the data rate).
+ * @param[in] wv  scales tau_j [samples] and coefficient counts M_j (n_coef, or n - tau_j + 1).
+ * @return J x J covariance [unit^4].
+ */
+Eigen::MatrixXd wvCovariance(const stochastic::Model& m, const WaveletVariance& wv);
+
+/// Haar WV of @p m at scale @p tau [samples] by integrating |H(f)|^2 S(f) (check of wvCovariance's quadrature) [unit^2].
+double spectralWv(const stochastic::Model& m, double tau);
 
 /**
  * Fit a structure (e.g. WN+GM+GM+DR) to @p wv.
@@ -118,6 +147,23 @@ double optimism(const FitResult& f, const WaveletVariance& wv);
  */
 std::vector<std::vector<stochastic::ProcessKind>> defaultCandidates(int max_gm = 3);
 
+/// Default fraction of the empirical WV's 95 % CI width below which a term is negligible.
+constexpr double kNegligibleFraction = 0.1;
+
+/**
+ * Flags the terms of @p m that the data cannot see: a term is negligible when
+ * its Haar WV is below @p fraction times the width of the empirical WV's 95 %
+ * CI (ci_high_j - ci_low_j) at EVERY scale of @p wv, i.e. removing it moves
+ * the model WV by less than a tenth of the data's own uncertainty anywhere
+ * (typically a term pushed to its lower bound, e.g. WN(sigma=7e-66)).
+ * @param[in] m         fitted model (per-sample parameters at m.rate_hz).
+ * @param[in] wv        the empirical WV the model was fitted to.
+ * @param[in] fraction  in (0, 1], default kNegligibleFraction.
+ * @return one flag per term of @p m.
+ */
+std::vector<bool> negligibleTerms(const stochastic::Model& m, const WaveletVariance& wv,
+                                  double fraction = kNegligibleFraction);
+
 /// One candidate of an automatic model selection.
 struct RankedModel {
   FitResult fit;
@@ -127,7 +173,10 @@ struct RankedModel {
 
 /**
  * Rank candidate structures by the wavelet information criterion (objective +
- * estimated optimism); best first. @p why receives a plain-language reason.
+ * estimated optimism); best first. If the best candidate has a negligible term
+ * (negligibleTerms) and the candidate without that term was fitted, the
+ * latter is moved to the front (the data cannot tell the two apart; the
+ * simpler one is preferred), repeatedly. @p why receives a plain-language reason.
  */
 std::vector<RankedModel> selectModel(const std::vector<std::vector<stochastic::ProcessKind>>& candidates,
                                      const WaveletVariance& wv, const FitOptions& opt,
