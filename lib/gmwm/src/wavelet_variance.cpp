@@ -7,6 +7,11 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <atomic>
+#include <cstdlib>
+#include <new>
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 #include <exception>
 #include <functional>
 #include <memory>
@@ -97,12 +102,13 @@ void haarModwtLevels(const double* x, std::size_t n, int J,
 
 namespace {
 
-/// Sum of squares of (0.5 (a[i] - b[i])) and v[i] = 0.5 (a[i] + b[i]), i < m.
+/// Sum of squares of (a[i] - b[i]) and v[i] = a[i] + b[i], i < m (unscaled pyramid, see
+/// haarModwtSumSquares).
 /// Eight independent partial sums per chunk keep it vectorised; chunk totals
 /// go to long double.
 inline long double levelStep(const double* __restrict a, const double* __restrict b,
                              double* __restrict v, std::size_t m, std::size_t acc_from) {
-  for (std::size_t i = 0; i < std::min(acc_from, m); ++i) v[i] = 0.5 * (a[i] + b[i]);
+  for (std::size_t i = 0; i < std::min(acc_from, m); ++i) v[i] = a[i] + b[i];
   long double total = 0.0L;
   constexpr std::size_t kChunk = 4096;
   for (std::size_t c = acc_from; c < m; c += kChunk) {
@@ -111,26 +117,89 @@ inline long double levelStep(const double* __restrict a, const double* __restric
     std::size_t i = c;
     for (; i + 8 <= e; i += 8) {
       for (int k = 0; k < 8; ++k) {
-        const double w = 0.5 * (a[i + k] - b[i + k]);
+        const double w = a[i + k] - b[i + k];
         acc[k] += w * w;
-        v[i + k] = 0.5 * (a[i + k] + b[i + k]);
+        v[i + k] = a[i + k] + b[i + k];
       }
     }
     double sum = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
     for (; i < e; ++i) {
-      const double w = 0.5 * (a[i] - b[i]);
+      const double w = a[i] - b[i];
       sum += w * w;
-      v[i] = 0.5 * (a[i] + b[i]);
+      v[i] = a[i] + b[i];
     }
     total += sum;
   }
   return total;
 }
 
+/// Same as levelStep with v == b allowed (in place: v[i] = b[i + s] + b[i]
+/// with a = b + s). Each chunk of 8 is loaded before it is stored, and a write
+/// at i never reaches an element a later step reads (i < i + s), so forward
+/// iteration gives the out-of-place result.
+inline long double levelStepInPlace(const double* a, const double* b, double* v, std::size_t m) {
+  long double total = 0.0L;
+  constexpr std::size_t kChunk = 4096;
+  for (std::size_t c = 0; c < m; c += kChunk) {
+    const std::size_t e = std::min(m, c + kChunk);
+    double acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    std::size_t i = c;
+    for (; i + 8 <= e; i += 8) {
+      double ta[8], tb[8];
+      for (int k = 0; k < 8; ++k) {
+        ta[k] = a[i + k];
+        tb[k] = b[i + k];
+      }
+      for (int k = 0; k < 8; ++k) {
+        const double w = ta[k] - tb[k];
+        acc[k] += w * w;
+        v[i + k] = ta[k] + tb[k];
+      }
+    }
+    double sum = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+    for (; i < e; ++i) {
+      const double ta = a[i], tb = b[i];
+      const double w = ta - tb;
+      sum += w * w;
+      v[i] = ta + tb;
+    }
+    total += sum;
+  }
+  return total;
+}
+
+/// Scratch array of n doubles, not zero-filled, backed by transparent huge
+/// pages where the kernel offers them (first touch of 8 MB in 4 KiB pages
+/// costs ~2000 page faults, a sizeable part of the WV time).
+struct Scratch {
+  double* p = nullptr;
+  explicit Scratch(std::size_t n) {
+    constexpr std::size_t kAlign = std::size_t{2} << 20;  // one huge page
+    const std::size_t need = std::max<std::size_t>(n, 1) * sizeof(double);
+    if (need < 2 * kAlign) {
+      p = static_cast<double*>(std::malloc(need));
+    } else {
+      const std::size_t bytes = ((need + kAlign - 1) / kAlign) * kAlign;
+      p = static_cast<double*>(std::aligned_alloc(kAlign, bytes));
+#ifdef MADV_HUGEPAGE
+      if (p) madvise(p, bytes, MADV_HUGEPAGE);
+#endif
+    }
+    if (!p) throw std::bad_alloc();
+  }
+  ~Scratch() { std::free(p); }
+  Scratch(const Scratch&) = delete;
+  Scratch& operator=(const Scratch&) = delete;
+};
+
 /**
  * Levels jfrom..jto of the Haar MODWT pyramid, cache-blocked over time.
  * @param in   V_{jfrom-1,t} for t = 2^{jfrom-1} - 1 .. n-1.
- * @param out  receives V_{jto,t} for t = 2^{jto} - 1 .. n-1.
+ * @param out  receives V_{jto,t} for t = 2^{jto} - 1 .. n-1; may be @p in when
+ *             jto > jfrom (block b's output overwrites only input that no later
+ *             block reads: both start at index t0 - t_out0, and the next block
+ *             reads from t0 + block - t_out0 on; the first level of a block reads
+ *             all of its input before the last level writes).
  * @param ss   ss[j-1] += sum over kept t of W_{j,t}^2.
  * @param block output samples per block (the lookback 2^jto - 2^{jfrom-1} is recomputed per block).
  */
@@ -168,32 +237,30 @@ std::vector<long double> haarModwtSumSquares(const double* x, std::size_t n, int
   // Same pyramid as haarModwtLevels, fused (no W array) and blocked so that the
   // small levels run in cache: levels 1..10 in blocks of 16 Ki samples, 11..14
   // in blocks of 64 Ki, the rest unblocked over the whole series.
+  // Unscaled pyramid: U_j = 2^j V_j (sums instead of means) and D_j = 2^j W_j,
+  // so each step is one add and one subtract; sum W_j^2 = 4^-j sum D_j^2.
+  // Scaling by powers of two is exact: the result is bit-identical to the
+  // scaled pyramid (no overflow for |x| < 1e290).
+  // One scratch array: the first stage reads x, everything after works in place.
   std::vector<long double> ss(J, 0.0L);
   std::vector<double> b1, b2;
-  std::unique_ptr<double[]> va(new double[n]), vb(new double[n]);  // no zero fill
-  const double* in = x;
+  Scratch va(n);
   int j = 1;
-  bool useA = true;
   const std::pair<int, std::size_t> stages[] = {{10, 16384}, {14, 65536}};
   for (const auto& st : stages) {
     const int jto = std::min(st.first, J);
-    if (jto < j) continue;
-    double* out = useA ? va.get() : vb.get();
-    pyramidStage(in, out, n, j, jto, st.second, b1, b2, ss);
-    in = out;
-    useA = !useA;
+    if (jto < j || (j > 1 && jto == j)) continue;  // a single in-place level goes to the streaming loop
+    pyramidStage(j == 1 ? x : va.p, va.p, n, j, jto, st.second, b1, b2, ss);
     j = jto + 1;
   }
-  // Remaining large levels: one streaming pass each, ping-pong between va and vb;
-  // in[i] = V_{j-1, 2^{j-1} - 1 + i}.
+  // Remaining large levels: one streaming pass each, in place;
+  // va[i] = V_{j-1, 2^{j-1} - 1 + i}.
   for (; j <= J; ++j) {
     const std::size_t s = std::size_t{1} << (j - 1);
     const std::size_t m = n - 2 * s + 1;
-    double* out = useA ? va.get() : vb.get();
-    ss[j - 1] += levelStep(in + s, in, out, m, 0);
-    in = out;
-    useA = !useA;
+    ss[j - 1] += j == 1 ? levelStep(x + s, x, va.p, m, 0) : levelStepInPlace(va.p + s, va.p, va.p, m);
   }
+  for (int q = 1; q <= J; ++q) ss[q - 1] = std::ldexp(ss[q - 1], -2 * q);
   return ss;
 }
 
