@@ -327,7 +327,7 @@ int run(const Opts& o) {
         std::cout << "    negligible: term " << i + 1 << " " << st::formatTerms({c.fit.model.terms[i]})
                   << " (its WV is below " << gm::kNegligibleFraction
                   << " of the WV's 95 % CI width at every scale: the data cannot tell it from its absence;"
-                     " kept because the structure asks for it)\n";
+                  << (autoSel ? " kept: no ranked candidate lacks it)\n" : " kept: the requested structure has it)\n");
     if (autoSel) std::cout << "    " << c.why << "\n";
     std::istringstream lines(st::formatDatasheet(st::datasheetFigures(c.fit.model), c.ch->quantity));
     std::string l;

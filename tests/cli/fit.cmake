@@ -156,3 +156,24 @@ add_test(NAME cli_fit_bad_weights
           "-DARGS=fit|--input|${_fdata}|--rate|100|--gyro-unit|deg/s|--acc-unit|g|--structure|WN|--weights|optimal|--out|${_fdir}/badw"
           "-DREGEX=navimpact: error: --weights: expected 'r', 'model' or 'efficient', got 'optimal'"
           -DNOFILE=${_fdir}/badw/fit.json -P ${_fdir}/expect_fail.cmake)
+
+# A term pushed to its lower bound is reported, not hidden: on gyro_x of the
+# excerpt, WN+GM+RW+DR puts the white noise into a GM with T < 1 sample and
+# leaves WN at ~1e-66; the console says so and fit.json flags it.
+add_test(NAME cli_fit_negligible_term
+  COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GM+RW+DR
+          --channels gyro_x --out ${_fdir}/neg)
+set_tests_properties(cli_fit_negligible_term PROPERTIES
+  PASS_REGULAR_EXPRESSION "negligible: term 1 WN\\(sigma=[0-9.e-]+\\) \\(its WV is below 0.1 of the WV's 95 % CI width at every scale[^\n]*kept: the requested structure has it\\)"
+  FIXTURES_SETUP fit_neg)
+file(WRITE ${_fdir}/check_negligible.cmake [=[
+file(READ ${DIR}/fit.json j)
+string(JSON neg GET "${j}" channels 0 terms 0 negligible)
+string(JSON gm GET "${j}" channels 0 terms 1 negligible)
+if(NOT neg OR gm)
+  message(FATAL_ERROR "expected WN flagged negligible (${neg}) and the GM not (${gm})")
+endif()
+]=])
+add_test(NAME cli_fit_negligible_json
+  COMMAND ${CMAKE_COMMAND} -DDIR=${_fdir}/neg -P ${_fdir}/check_negligible.cmake)
+set_tests_properties(cli_fit_negligible_json PROPERTIES FIXTURES_REQUIRED fit_neg)
