@@ -2,6 +2,7 @@
 // closed-loop feedback. Equation numbers: Groves 2013 ch. 3 and 14.
 #include "navimpact/filter/ekf.hpp"
 
+#include <Eigen/Cholesky>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -48,6 +49,9 @@ struct ErrorStateEkf::Cache {
   Transition tmp;                   // scratch
   MatrixXd Fni, FniFii, FniQii, FniQiiFii, FniFiiQii, Qni;  // scratch of the series form
   MatrixXd Mni;                     // scratch of the propagation
+  MatrixXd PHt, K, KS, Pc;          // scratch of the update
+  VectorXd inv;
+  Eigen::LLT<MatrixXd> llt;
 };
 
 /// The cached exact IMU-error blocks for @p dt (relative tolerance 1e-9, far
@@ -491,10 +495,17 @@ void ErrorStateEkf::predict(const ins::ImuSample& raw) {
   iv_dt_ += raw.dt;
   iv_fN_ += C * (f_B_ * raw.dt);
   iv_C_ += C * raw.dt;
-  Eigen::Matrix3d Cs = C * Vector3d(psd[3], psd[4], psd[5]).asDiagonal();
-  iv_Qv_.noalias() += (Cs * raw.dt) * C.transpose();
-  Cs = C * Vector3d(psd[0], psd[1], psd[2]).asDiagonal();
-  iv_Qa_.noalias() += (Cs * raw.dt) * C.transpose();
+  // C diag(psd) C' dt; = psd I dt when the three axes share the PSD (C orthonormal)
+  auto addPsd = [&](Eigen::Matrix3d& acc, double p0, double p1, double p2) {
+    if (p0 == p1 && p1 == p2) {
+      acc.diagonal().array() += p0 * raw.dt;
+    } else {
+      const Eigen::Matrix3d Cs = C * Vector3d(p0 * raw.dt, p1 * raw.dt, p2 * raw.dt).asDiagonal();
+      acc.noalias() += Cs * C.transpose();
+    }
+  };
+  addPsd(iv_Qv_, psd[3], psd[4], psd[5]);
+  addPsd(iv_Qa_, psd[0], psd[1], psd[2]);
   if (++iv_n_ >= cfg_.propagate_every) applyInterval();
 }
 
@@ -554,10 +565,13 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
                                    bool feedback) {
   flushPropagation();
   const int mz = static_cast<int>(dz.size());
+  Cache& c = *cache_;
   UpdateResult res;
   res.t = state().t;
-  const MatrixXd PHt = P_ * H.transpose();
-  res.S = H * PHt + R;
+  MatrixXd& PHt = c.PHt;
+  PHt.noalias() = P_ * H.transpose();
+  res.S = R;
+  res.S.noalias() += H * PHt;
   res.innovation = dz;
   Eigen::LLT<MatrixXd> llt(res.S);
   if (llt.info() != Eigen::Success || !res.S.allFinite())
@@ -572,30 +586,36 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
       return res;
     }
   }
-  const MatrixXd K = llt.solve(PHt.transpose()).transpose();  // K = P H' S^-1 (Groves 3.21)
+  MatrixXd& K = c.K;
+  K = llt.solve(PHt.transpose()).transpose();  // K = P H' S^-1 (Groves 3.21)
   // Joseph form (I-KH) P (I-KH)' + K R K' (Groves 3.58), expanded:
   // P - K (PH')' - (PH') K' + K S K'
-  const MatrixXd KS = K * res.S;
+  MatrixXd& KS = c.KS;
+  KS.noalias() = K * res.S;
   P_.noalias() -= K * PHt.transpose();
   P_.noalias() -= PHt * K.transpose();
   P_.noalias() += KS * K.transpose();
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  const int N = size();
+  for (int j = 0; j < N; ++j)  // symmetrise in place
+    for (int i = j + 1; i < N; ++i) P_(i, j) = P_(j, i) = 0.5 * (P_(i, j) + P_(j, i));
   if (feedback) {
     const VectorXd dx = K * dz;  // estimated error (estimate minus truth)
     mech_.setState(correctNav(state(), dx.head<9>()));
     x_imu_ -= dx.tail(layout_.imuSize());
-    cache_->nominal_valid = false;
+    c.nominal_valid = false;
   }
   checkP("update");
   // Positive (semi-)definiteness on the correlation scale, so that states with
-  // tiny variances (1e-14) are judged as strictly as the metre-level ones.
-  const VectorXd d = P_.diagonal();
-  VectorXd inv = VectorXd::Ones(d.size());
-  for (int i = 0; i < d.size(); ++i)
-    if (d(i) > 0.0) inv(i) = 1.0 / std::sqrt(d(i));
-  const MatrixXd Pc = inv.asDiagonal() * P_ * inv.asDiagonal();
-  Eigen::LDLT<MatrixXd> ldlt(Pc);
-  if ((ldlt.vectorD().array() < -1e-9).any() || !ldlt.vectorD().allFinite())
+  // tiny variances (1e-14) are judged as strictly as the metre-level ones:
+  // Cholesky of the correlation matrix + 1e-9 I must succeed (eigenvalues > -1e-9).
+  VectorXd& inv = c.inv;
+  inv.resize(N);
+  for (int i = 0; i < N; ++i) inv(i) = P_(i, i) > 0.0 ? 1.0 / std::sqrt(P_(i, i)) : 1.0;
+  MatrixXd& Pc = c.Pc;
+  Pc = inv.asDiagonal() * P_ * inv.asDiagonal();
+  Pc.diagonal().array() += 1e-9;
+  c.llt.compute(Pc);
+  if (c.llt.info() != Eigen::Success || !Pc.allFinite())
     throw Error("filter covariance is not positive definite at t = " + tstr(res.t) +
                 " s after update");
   last_ = res;
