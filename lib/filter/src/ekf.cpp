@@ -49,7 +49,7 @@ struct ErrorStateEkf::Cache {
   Transition tmp;                   // scratch
   MatrixXd Fni, FniFii, FniQii, FniQiiFii, FniFiiQii, Qni;  // scratch of the series form
   MatrixXd Mni;                     // scratch of the propagation
-  MatrixXd PHt, K, KS, Pc;          // scratch of the update
+  MatrixXd PHt, K, KS, Pc;          // scratch of the update (KS holds K L)
   VectorXd inv;
   Eigen::LLT<MatrixXd> llt;
 };
@@ -589,15 +589,15 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
   MatrixXd& K = c.K;
   K = llt.solve(PHt.transpose()).transpose();  // K = P H' S^-1 (Groves 3.21)
   // Joseph form (I-KH) P (I-KH)' + K R K' (Groves 3.58), expanded:
-  // P - K (PH')' - (PH') K' + K S K'
-  MatrixXd& KS = c.KS;
-  KS.noalias() = K * res.S;
-  P_.noalias() -= K * PHt.transpose();
-  P_.noalias() -= PHt * K.transpose();
-  P_.noalias() += KS * K.transpose();
+  // P - K (PH')' - (PH') K' + K S K', with K S K' = (K L)(K L)' for S = L L';
+  // as symmetric rank updates of the lower triangle, then mirrored.
+  MatrixXd& KL = c.KS;
+  KL.noalias() = K * llt.matrixL();
+  auto Pl = P_.selfadjointView<Eigen::Lower>();
+  for (int j = 0; j < mz; ++j) Pl.rankUpdate(K.col(j), PHt.col(j), -1.0);
+  Pl.rankUpdate(KL, 1.0);
   const int N = size();
-  for (int j = 0; j < N; ++j)  // symmetrise in place
-    for (int i = j + 1; i < N; ++i) P_(i, j) = P_(j, i) = 0.5 * (P_(i, j) + P_(j, i));
+  P_.triangularView<Eigen::StrictlyUpper>() = P_.transpose();
   if (feedback) {
     const VectorXd dx = K * dz;  // estimated error (estimate minus truth)
     mech_.setState(correctNav(state(), dx.head<9>()));
