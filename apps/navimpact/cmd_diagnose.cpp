@@ -1,7 +1,9 @@
 // navimpact diagnose: what a simulation with today's IMU error model gets wrong
 // on a measured static recording, the cause, the extended model and its gain.
-//   navimpact diagnose --input STATIC.csv[.gz] [--rate HZ] [--gyro-unit U] [--acc-unit U]
+//   navimpact diagnose --input STATIC.csv[.gz]|STATIC.rawlog [--rate HZ] [--gyro-unit U]
+//                      [--acc-unit U] [--axes SPEC] [--label IMU]
 //                      --model FILE[:NAME] | fit:SPEC  --out DIR
+//                      [--trajectory FILE --outage START:DURATION ... [--nav-runs R]]
 //                      [--simulations N] [--seed S] [--alpha A] [--threads N]
 #include <cmath>
 #include <filesystem>
@@ -12,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "input.hpp"
 #include "navimpact/analysis/diagnosis.hpp"
 #include "navimpact/core/csv_reader.hpp"
 #include "navimpact/core/error.hpp"
@@ -27,12 +30,12 @@ namespace na = navimpact::analysis;
 namespace st = navimpact::stochastic;
 
 struct Opts {
-  std::string input;
-  double rate_hz = 0;
-  std::string gyro_unit, acc_unit, axes;
+  navimpact::cli::InputOpts in;
   std::string model;
   std::string trajectory;
   std::vector<std::string> outages;
+  std::string traj_system = "geodetic";
+  int nav_runs = 10;
   std::string out;
   int simulations = 16;
   std::uint64_t seed = 20261121;
@@ -56,9 +59,12 @@ st::ImuModel fitModel(const std::string& spec, const navimpact::ImuSeries& s) {
   return m;
 }
 
-void checkOutages(const Opts& o) {
+std::vector<na::OutageWindow> checkOutages(const Opts& o) {
+  std::vector<na::OutageWindow> w;
   if (!o.outages.empty() && o.trajectory.empty())
     throw navimpact::Error("--outage needs --trajectory (the navigation part runs along it)");
+  if (!o.trajectory.empty() && o.outages.empty())
+    throw navimpact::Error("--trajectory needs at least one --outage START:DURATION");
   for (const auto& spec : o.outages) {
     const auto c = spec.find(':');
     double a = NAN, b = NAN;
@@ -73,33 +79,39 @@ void checkOutages(const Opts& o) {
     }
     if (!(a >= 0) || !(b > 0))
       throw navimpact::Error("--outage '" + spec + "': START must be >= 0 and DURATION > 0");
+    w.push_back({a, a + b});
   }
-  if (!o.trajectory.empty()) {
-    if (!std::filesystem::exists(o.trajectory))
-      throw navimpact::Error("--trajectory " + o.trajectory + ": no such file");
-    throw navimpact::Error(
-        "--trajectory: the navigation gain of diagnose is not available in this build yet "
-        "(the WV gain is); run without --trajectory");
-  }
+  if (!o.trajectory.empty() && !std::filesystem::exists(o.trajectory))
+    throw navimpact::Error("--trajectory " + o.trajectory + ": no such file");
+  if (o.nav_runs < 2) throw navimpact::Error("--nav-runs must be >= 2");
+  return w;
 }
 
 int run(const Opts& o) {
   if (o.simulations < 0 || o.simulations == 1)
     throw navimpact::Error("--simulations must be 0 or >= 2");
   if (!(o.alpha > 0 && o.alpha < 0.5)) throw navimpact::Error("--alpha must be in (0, 0.5)");
-  checkOutages(o);
+  const auto windows = checkOutages(o);
   // Model file problems are reported before the (long) data read.
   const bool fit = o.model.rfind("fit:", 0) == 0;
   st::ImuModel model;
   if (fit) st::parseStructure(o.model.substr(4));
   else model = st::loadImuModel(o.model);
 
-  navimpact::CsvImuOptions copt;
-  if (o.rate_hz > 0) copt.rate_hz = o.rate_hz;
-  copt.gyro_unit = o.gyro_unit;
-  copt.acc_unit = o.acc_unit;
-  copt.axes = o.axes;
-  const navimpact::ImuSeries data = navimpact::readImuCsv(o.input, copt);
+  navimpact::cli::InputFormat fmt = navimpact::cli::InputFormat::Csv;
+  const navimpact::ImuSeries data = navimpact::cli::loadInput(o.in, &fmt);
+  // Navigation plan (trajectory, outages, recording length) before the long work.
+  std::shared_ptr<const na::NavGainPlan> plan;
+  if (!o.trajectory.empty()) {
+    na::NavGainOptions nopt;
+    nopt.trajectory.file = o.trajectory;
+    nopt.trajectory.system = o.traj_system;
+    nopt.outages = windows;
+    nopt.runs = o.nav_runs;
+    nopt.seed = o.seed;
+    nopt.threads = o.threads;
+    plan = na::prepareNavGain(nopt, data.rate_hz, data.size());
+  }
   if (fit) model = fitModel(o.model.substr(4), data);
 
   navimpact::cli::Progress bar("diagnose", 1000);
@@ -111,23 +123,38 @@ int run(const Opts& o) {
   dopt.progress = [&bar](double f, const std::string&) {
     bar.update(static_cast<std::size_t>(f * 1000));
   };
-  const na::Diagnosis d = na::diagnose(data, model, dopt);
+  na::Diagnosis d = na::diagnose(data, model, dopt);
   bar.finish();
+  if (plan) {
+    navimpact::cli::Progress nbar("navigation", 1000);
+    na::addNavigationGain(d, data, *plan, [&nbar](double f) {
+      nbar.update(static_cast<std::size_t>(f * 1000));
+    });
+    nbar.finish();
+  }
 
   navimpact::OutputSet out(o.out);
-  nlohmann::json in = {{"file", o.input},
+  nlohmann::json in = {{"file", o.in.input},
+                       {"format", fmt == navimpact::cli::InputFormat::Rawlog ? "rawlog" : "csv"},
+                       {"units", navimpact::cli::inputUnitsNote(o.in, fmt)},
                        {"model", o.model},
                        {"model_rate_hz", model.rate_hz},
-                       {"gyro_unit", o.gyro_unit},
-                       {"acc_unit", o.acc_unit},
+                       {"gyro_unit", o.in.gyro_unit},
+                       {"acc_unit", o.in.acc_unit},
                        {"seed", o.seed},
                        {"simulations", o.simulations},
                        {"alpha", o.alpha}};
+  if (fmt == navimpact::cli::InputFormat::Rawlog) in["label"] = o.in.label;
+  if (!o.trajectory.empty()) {
+    in["trajectory"] = o.trajectory;
+    in["outages"] = o.outages;
+    in["nav_runs"] = o.nav_runs;
+  }
   const auto figs =
       na::diagnosisFigures(d, [&out](const std::string& n) { return out.stage(n).string(); });
   out.writeText("diagnosis.json", na::diagnosisJson(d, in.dump()));
   out.writeText("report.md", na::diagnosisReport(d, figs));
-  std::string comment = "extended by navimpact diagnose from " + o.input + " (model " + o.model +
+  std::string comment = "extended by navimpact diagnose from " + o.in.input + " (model " + o.model +
                         ", seed " + std::to_string(o.seed) + ")";
   out.writeText("model_extended.yaml", st::toYaml(d.model_after, comment));
   out.commit();
@@ -143,6 +170,13 @@ int run(const Opts& o) {
                 << (c.gain.significant ? "significant" : "not significant") << ")";
     std::cout << "\n";
   }
+  if (d.navigation)
+    for (const auto& g : d.navigation->outages)
+      std::cout << "  navigation, outage " << g.start_s << " s + " << g.duration_s
+                << " s: horizontal error at end " << g.mean_h_before << " -> " << g.mean_h_after
+                << " m (mean of " << d.navigation->runs << " runs; after better in " << g.wins
+                << "; " << (g.significant ? "significant" : "not significant") << ", sign test p = "
+                << g.sign_p << ")\n";
   std::cout << "wrote " << (std::filesystem::path(o.out) / "diagnosis.json").string()
             << ", report.md, model_extended.yaml and " << figs.size() << " figure(s)\n";
   return 0;
@@ -154,17 +188,23 @@ navimpact::cli::Registrar reg(
      "the extended model and its held-out gain",
      [](CLI::App& app) {
        auto o = std::make_shared<Opts>();
-       app.add_option("--input", o->input, "static recording (CSV, optionally gzip)")->required();
-       app.add_option("--rate", o->rate_hz, "sampling rate [Hz] (files without a time column)");
-       app.add_option("--gyro-unit", o->gyro_unit, "gyroscope unit in the file (rad/s, deg/s, ...)");
-       app.add_option("--acc-unit", o->acc_unit, "accelerometer unit in the file (m/s2, g, ...)");
-       app.add_option("--axes", o->axes, "axis remapping to body FRD, e.g. x,-y,-z");
+       navimpact::cli::addInputOptions(app, o->in);
        app.add_option("--model", o->model,
                       "model simulated today: FILE[:NAME], or fit:SPEC (e.g. fit:WN+GM) to fit "
                       "that structure to the data first")
            ->required();
-       app.add_option("--trajectory", o->trajectory, "trajectory for the navigation gain");
-       app.add_option("--outage", o->outages, "GNSS outage START:DURATION [s] (repeatable)");
+       app.add_option("--trajectory", o->trajectory,
+                      "trajectory CSV for the navigation gain (columns time_s, lat_rad, lon_rad, "
+                      "alt_m, roll_rad, pitch_rad, yaw_rad as datasets/uav_flight_260s.csv.gz)");
+       app.add_option("--trajectory-system", o->traj_system,
+                      "trajectory coordinates: geodetic (lat/lon/height columns)")
+           ->check(CLI::IsMember({"geodetic"}))
+           ->capture_default_str();
+       app.add_option("--outage", o->outages,
+                      "GNSS outage START:DURATION [s from the trajectory start] (repeatable)");
+       app.add_option("--nav-runs", o->nav_runs,
+                      "paired navigation runs (recording windows x GNSS/baro noise), >= 2")
+           ->capture_default_str();
        app.add_option("--out", o->out, "output directory")->required();
        app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel")
            ->capture_default_str();

@@ -16,53 +16,84 @@ namespace navimpact::analysis {
 namespace {
 
 constexpr double kTwoPi = 2.0 * units::kPi;
-
-/// |sum_k (x_k - mean) e^{-i 2 pi f k / fs}|^2 on the whole record (rotation recurrence,
-/// renormalised every 1024 steps to keep the phasor on the unit circle).
-double dftPower(const std::vector<double>& x, double mean, double f, double fs) {
-  const double w = kTwoPi * f / fs;
-  const std::complex<double> rot(std::cos(w), -std::sin(w));
-  std::complex<double> ph(1.0, 0.0), acc(0.0, 0.0);
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    acc += (x[k] - mean) * ph;
-    ph *= rot;
-    if ((k & 1023) == 1023) {
-      const double kk = static_cast<double>(k + 1) * w;
-      ph = std::complex<double>(std::cos(kk), -std::sin(kk));
-    }
-  }
-  return std::norm(acc);
-}
+constexpr double kPi() { return units::kPi; }
 
 /// Least-squares a + b sin + c cos at f; returns amplitude, subtracts b sin + c cos if asked.
+/// sin/cos by a rotation recurrence, re-seeded exactly every 1024 samples.
 double fitSinusoid(std::vector<double>& x, double f, double fs, bool subtract) {
   const std::size_t n = x.size();
   // Normal equations of [1, sin, cos] (3x3), accumulated in long double.
   long double S[3][3] = {{0}}, r[3] = {0};
   const double w = kTwoPi * f / fs;
-  for (std::size_t k = 0; k < n; ++k) {
+  const std::complex<double> rot(std::cos(w), std::sin(w));
+  auto phasor = [&](std::size_t k) {
     const double a = w * static_cast<double>(k);
-    const double s = std::sin(a), c = std::cos(a);
-    const double v[3] = {1.0, s, c};
+    return std::complex<double>(std::cos(a), std::sin(a));
+  };
+  std::complex<double> ph(1.0, 0.0);
+  for (std::size_t k = 0; k < n; ++k) {
+    if ((k & 1023) == 0) ph = phasor(k);
+    const double v[3] = {1.0, ph.imag(), ph.real()};
     for (int i = 0; i < 3; ++i) {
       r[i] += v[i] * x[k];
-      for (int j = 0; j < 3; ++j) S[i][j] += v[i] * v[j];
+      for (int j = i; j < 3; ++j) S[i][j] += v[i] * v[j];
     }
+    ph *= rot;
   }
   Eigen::Matrix3d A;
   Eigen::Vector3d b;
   for (int i = 0; i < 3; ++i) {
     b(i) = static_cast<double>(r[i]);
-    for (int j = 0; j < 3; ++j) A(i, j) = static_cast<double>(S[i][j]);
+    for (int j = i; j < 3; ++j) A(i, j) = A(j, i) = static_cast<double>(S[i][j]);
   }
   const Eigen::Vector3d c = A.ldlt().solve(b);
   if (subtract) {
+    ph = std::complex<double>(1.0, 0.0);
     for (std::size_t k = 0; k < n; ++k) {
-      const double a = w * static_cast<double>(k);
-      x[k] -= c(1) * std::sin(a) + c(2) * std::cos(a);
+      if ((k & 1023) == 0) ph = phasor(k);
+      x[k] -= c(1) * ph.imag() + c(2) * ph.real();
+      ph *= rot;
     }
   }
   return std::hypot(c(1), c(2));
+}
+
+/// Zoomed DFT around f0: the record demodulated at f0 once and summed in
+/// blocks of B samples (z_k, block centre c_k), so that the power at
+/// f0 + delta is |sum_k z_k e^{-i 2 pi delta c_k / fs}|^2 up to a phase error
+/// of at most pi |delta| B / fs inside a block (kept below 0.01 rad by the caller).
+struct Demodulated {
+  std::vector<std::complex<double>> z;
+  std::vector<double> centre;  ///< sample index of each block centre
+};
+
+Demodulated demodulate(const std::vector<double>& x, double mean, double f0, double fs, std::size_t B) {
+  Demodulated d;
+  const std::size_t n = x.size();
+  const double w = kTwoPi * f0 / fs;
+  const std::complex<double> rot(std::cos(w), -std::sin(w));
+  for (std::size_t k0 = 0; k0 < n; k0 += B) {
+    const std::size_t k1 = std::min(n, k0 + B);
+    const double a = w * static_cast<double>(k0);
+    std::complex<double> ph(std::cos(a), -std::sin(a)), acc(0.0, 0.0);
+    for (std::size_t k = k0; k < k1; ++k) {
+      acc += (x[k] - mean) * ph;
+      ph *= rot;
+    }
+    d.z.push_back(acc);
+    d.centre.push_back(0.5 * static_cast<double>(k0 + k1 - 1));
+  }
+  return d;
+}
+
+double zoomPower(const Demodulated& d, double delta, double fs) {
+  const double w = kTwoPi * delta / fs;
+  std::complex<double> acc(0.0, 0.0);
+  for (std::size_t k = 0; k < d.z.size(); ++k) {
+    const double a = w * d.centre[k];
+    acc += d.z[k] * std::complex<double>(std::cos(a), -std::sin(a));
+  }
+  return std::norm(acc);
 }
 
 /// Equivalent dof of a Welch estimate with K Hann segments at 50 % overlap
@@ -199,13 +230,19 @@ LineResult refineAndRemoveLine(std::vector<double>& x, double rate_hz, int segme
   const int D = std::max(2, static_cast<int>(std::ceil(0.15 * bin / fine)));
   double best_f = coarse.freq_hz, best_p = -1;
   std::vector<double> pw(2 * D + 1);
+  // Block length: the phase error pi |delta| B / fs over the zoom range
+  // |delta| <= D fine stays below 0.01 rad.
+  const double dmax = (D + 1) * fine;
+  std::size_t B = 1;
+  while (B * 2 <= n / 64 && kPi() * dmax * static_cast<double>(B * 2) / rate_hz < 0.01) B *= 2;
+  const Demodulated dm = demodulate(x, mean, coarse.freq_hz, rate_hz, B);
   for (int d = -D; d <= D; ++d) {
     const double f = coarse.freq_hz + d * fine;
     if (f <= 0 || f >= rate_hz / 2) {
       pw[d + D] = 0;
       continue;
     }
-    pw[d + D] = dftPower(x, mean, f, rate_hz);
+    pw[d + D] = zoomPower(dm, d * fine, rate_hz);
     if (pw[d + D] > best_p) {
       best_p = pw[d + D];
       best_f = f;

@@ -1,4 +1,5 @@
-# Run navimpact with ARGS (or on a generated short record when SHORT is set),
+# Run navimpact with ARGS (or on a generated short record when SHORT is set,
+# with the further arguments EXTRA),
 # require exit code 1, the EXPECT regex on stderr, and no output directory OUT.
 file(REMOVE_RECURSE ${OUT})
 if(SHORT)
@@ -12,7 +13,7 @@ if(SHORT)
   file(WRITE ${_tmp}/short.csv "${_csv}")
   file(WRITE ${_tmp}/model.yaml "rate_hz: 100\naccelerometer: \"WN(sigma=1e-2)\"\ngyroscope: \"WN(sigma=1e-3)\"\n")
   set(ARGS diagnose --input ${_tmp}/short.csv --rate 100 --gyro-unit deg/s --acc-unit g
-           --model ${_tmp}/model.yaml --out ${OUT})
+           --model ${_tmp}/model.yaml --out ${OUT} ${EXTRA})
 endif()
 execute_process(COMMAND ${NI} ${ARGS} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 1)

@@ -41,12 +41,16 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "navimpact/analysis/nav_run.hpp"
 #include "navimpact/core/imu_series.hpp"
+#include "navimpact/emulation/sensors.hpp"
+#include "navimpact/emulation/trajectory.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/process.hpp"
 
@@ -142,6 +146,9 @@ struct ChannelDiagnosis {
   std::vector<double> line_freqs_hz;    ///< lines found (for plots)
   GainCheck gain;
   double wv_threshold_p = 0;            ///< per-scale p-value threshold used
+  /// How the extended structure was refitted by GMWM (whole record / first half):
+  /// "gmwm (...)" or "start kept (...)"; empty when nothing was added.
+  std::string refit_full, refit_half;
 };
 
 /// Options of diagnose().
@@ -155,6 +162,96 @@ struct DiagnoseOptions {
   std::function<void(double, const std::string&)> progress;
 };
 
+// ---------------------------------------------------------------------------
+// Navigation gain (optional, with a trajectory)
+
+/// Options of the navigation part: emulate navigation along a trajectory with
+/// the MEASURED static errors as the truth (Khaghani et al. 2019), and run the
+/// filter with the model before and after the extension over the same data.
+struct NavGainOptions {
+  emulation::TrajectorySpec trajectory;     ///< reference trajectory (smoothed = truth)
+  emulation::SmoothingOptions smoothing;
+  /// GNSS outages relative to the first trajectory time, (start, end] [s].
+  std::vector<OutageWindow> outages;
+  int runs = 10;                  ///< paired realisations (>= 2): recording window + GNSS/baro noise
+  std::uint64_t seed = 20261121;  ///< run r: deriveSeed(seed, r), streams 1 GNSS, 2 baro, 3 initial error
+  emulation::GnssOptions gnss;    ///< defaults: Table 2 (seed ignored)
+  emulation::BaroOptions baro;    ///< defaults: Table 2 (seed ignored)
+  bool baro_in_outage = true;
+  /// Covariance propagation every k IMU samples (0 = rate / 20 Hz, as the ADIS study).
+  int propagate_every = 0;
+  /// Initial navigation error sigmas [m x3, m/s x3, rad x3]; drawn per run, P0 of both filters.
+  filter::Vector9d initial_sigma = (filter::Vector9d() << 1.0, 1.0, 1.0, 0.1, 0.1, 0.1,
+                                    0.2 * 0.017453292519943295, 0.2 * 0.017453292519943295,
+                                    1.0 * 0.017453292519943295).finished();
+  int threads = 0;                ///< worker threads over runs (0 = hardware)
+  double record_rate_hz = 1.0;          ///< error epochs outside outages [Hz]
+  double outage_record_rate_hz = 5.0;   ///< error epochs inside outages [Hz]
+};
+
+/// Trajectory, perfect IMU and truth prepared once (prepareNavGain()).
+struct NavGainPlan;
+struct Diagnosis;
+
+/// One outage, before (user's model) and after (extension), over the runs.
+struct NavOutageGain {
+  double start_s = 0, duration_s = 0;            ///< relative to the trajectory start
+  /// Per run: horizontal / vertical error at the outage end, max horizontal drift [m].
+  std::vector<double> h_before, h_after, v_before, v_after, drift_before, drift_after;
+  /// Per run: position NEES (3 dof) at the outage end.
+  std::vector<double> nees_before, nees_after;
+  double mean_h_before = 0, mean_h_after = 0;    ///< mean over runs [m]
+  double mean_v_before = 0, mean_v_after = 0;
+  double mean_drift_before = 0, mean_drift_after = 0;
+  double anees_before = 0, anees_after = 0;      ///< mean position NEES at the end
+  std::pair<double, double> nees_band{0, 0};     ///< two-sided 95 % band of that mean (chi2(3R)/R)
+  int wins = 0;                                  ///< runs where the extension's horizontal error is smaller
+  double sign_p = 1;                             ///< exact two-sided sign-test p-value on wins
+  double t_p = 1;                                ///< paired t-test p-value on h_before - h_after
+  bool significant = false;                      ///< sign_p < 0.05
+};
+
+/// Navigation gain of the extension.
+struct NavGain {
+  std::string trajectory;                 ///< file and duration used
+  std::string truth;                      ///< how the measured errors were taken
+  std::string filter_after;               ///< which extended model the filter used and why
+  std::string settings;                   ///< GNSS, baro, EKF settings (one paragraph)
+  double imu_rate_hz = 0, duration_s = 0;
+  int runs = 0;
+  std::uint64_t seed = 0;
+  std::vector<double> window_offsets_s;   ///< start of each run's window in the recording [s]
+  std::vector<NavOutageGain> outages;
+  /// Time series for the figure: epochs [s from start], RMS over runs of the
+  /// horizontal and vertical error, RMS predicted 1-sigma, before and after.
+  std::vector<double> t_s, rms_h_before, rms_h_after, rms_v_before, rms_v_after,
+      sig_h_before, sig_h_after;
+  double wall_s = 0;
+};
+
+/**
+ * Read and smooth the trajectory, check the outages and that the recording
+ * (@p samples at @p rate_hz) is long enough, and precompute the perfect IMU and
+ * the truth. Call before the (long) diagnosis so bad input fails first.
+ * @throws navimpact::Error for an unreadable trajectory, outages outside it,
+ *         or a recording too short for the emulation (names both durations).
+ */
+std::shared_ptr<const NavGainPlan> prepareNavGain(const NavGainOptions& opt, double rate_hz,
+                                                  std::size_t samples);
+
+/**
+ * Navigation gain: R paired runs; run r takes a window of the measured
+ * recording (evenly spaced offsets over the HELD-OUT second half when it is
+ * long enough, else over the whole record, with a notice), its mean removed per
+ * axis, as the true IMU errors, and seeded GNSS/baro noise and initial error;
+ * the filter runs with d.model_before and with the first-half extension
+ * (d.channels[i].model_after_half; the whole-record extension when the second
+ * half is too short). Stores the result in d.navigation.
+ * @param[in] progress  called (serialised) with the fraction done 0..1; may be empty.
+ */
+void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& plan,
+                       const std::function<void(double)>& progress = {});
+
 /// Whole diagnosis.
 struct Diagnosis {
   std::string source;                 ///< input file
@@ -166,6 +263,7 @@ struct Diagnosis {
   stochastic::ImuModel model_after;
   std::vector<std::string> notices;   ///< e.g. rate conversion
   DiagnoseOptions options;
+  std::optional<NavGain> navigation;  ///< with a trajectory (addNavigationGain)
 };
 
 /**

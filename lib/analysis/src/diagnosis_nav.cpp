@@ -1,0 +1,350 @@
+// Navigation gain of navimpact diagnose: measured static errors as the truth
+// along a trajectory (Khaghani et al. 2019), the filter run with the user's
+// model and with the extension over the same realisations (paired), through
+// analysis::runNav. Built from the same library pieces as the study
+// (emulation::perfectImu / staticImuErrors / simulateGnss / simulateBaro).
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <boost/math/distributions/binomial.hpp>
+#include <boost/math/distributions/students_t.hpp>
+
+#include "diagnosis_internal.hpp"
+#include "navimpact/analysis/diagnosis.hpp"
+#include "navimpact/analysis/study.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/units.hpp"
+#include "navimpact/emulation/perfect_imu.hpp"
+#include "navimpact/filter/error_model.hpp"
+#include "navimpact/stochastic/simulate.hpp"
+
+namespace navimpact::analysis {
+
+struct NavGainPlan {
+  NavGainOptions opt;
+  std::optional<emulation::SmoothTrajectory> traj;
+  std::vector<ins::ImuSample> perfect;
+  TruthSeries truth;
+  ins::NavState truth0;
+  double rate = 0, t0 = 0, t1 = 0;
+  std::vector<OutageWindow> outages;   ///< absolute filter times
+  std::vector<std::size_t> end_epoch;  ///< truth index of each outage end
+  NavRunOptions nav;
+  std::size_t samples = 0;             ///< recording samples
+};
+
+std::shared_ptr<const NavGainPlan> prepareNavGain(const NavGainOptions& opt, double rate,
+                                                  std::size_t samples) {
+  if (opt.runs < 2) throw Error("navigation gain: runs must be >= 2, got " + std::to_string(opt.runs));
+  if (opt.outages.empty()) throw Error("navigation gain: give at least one --outage START:DURATION");
+  if (!(rate > 0)) throw Error("navigation gain: recording rate must be > 0");
+  auto plan = std::make_shared<NavGainPlan>();
+  plan->opt = opt;
+  plan->rate = rate;
+  plan->samples = samples;
+  const emulation::SampledTrajectory smp = emulation::readTrajectoryCsv(opt.trajectory);
+  plan->traj.emplace(smp, opt.smoothing);
+  const auto& tr = *plan->traj;
+  plan->t0 = tr.tBegin();
+  const std::size_t n = static_cast<std::size_t>(std::floor((tr.tEnd() - tr.tBegin()) * rate + 1e-9));
+  plan->t1 = plan->t0 + double(n) / rate;
+  const double duration = plan->t1 - plan->t0;
+  for (const auto& o : opt.outages) {
+    if (!(o.start >= 0.0 && o.end > o.start))
+      throw Error("--outage " + fmtNum(o.start, 6) + ":" + fmtNum(o.end - o.start, 6) + " is invalid");
+    if (o.end > duration + 1e-9)
+      throw Error("--outage " + fmtNum(o.start, 6) + ":" + fmtNum(o.end - o.start, 6) + " ends at " +
+                  fmtNum(o.end, 6) + " s, after the end of the trajectory " + opt.trajectory.file + " (" +
+                  fmtNum(duration, 6) + " s)");
+    plan->outages.push_back({plan->t0 + o.start, plan->t0 + o.end});
+  }
+  if (n > samples)
+    throw Error("static recording too short for the navigation gain: " + fmtNum(samples / rate, 6) +
+                " s available, " + fmtNum(duration, 6) + " s needed for the trajectory " +
+                opt.trajectory.file);
+  plan->perfect = emulation::perfectImu(tr, rate, plan->t0, plan->t1);
+  if (plan->perfect.size() != n)
+    throw Error("navigation gain: perfect IMU has " + std::to_string(plan->perfect.size()) +
+                " samples, expected " + std::to_string(n));
+  // Record epochs (IMU sample indices): record_rate outside, outage rate inside.
+  std::vector<std::size_t> ks;
+  const auto step_out = std::max<std::size_t>(1, std::size_t(std::llround(rate / opt.record_rate_hz)));
+  const auto step_in = std::max<std::size_t>(1, std::size_t(std::llround(rate / opt.outage_record_rate_hz)));
+  for (std::size_t k = 0; k <= n; k += step_out) ks.push_back(k);
+  std::vector<std::size_t> ends;
+  for (const auto& o : opt.outages) {
+    const auto ka = std::size_t(std::llround(o.start * rate)), ke = std::min(n, std::size_t(std::llround(o.end * rate)));
+    for (std::size_t k = ka; k < ke; k += step_in) ks.push_back(k);
+    ks.push_back(ke);
+    ends.push_back(ke);
+  }
+  std::sort(ks.begin(), ks.end());
+  ks.erase(std::unique(ks.begin(), ks.end()), ks.end());
+  for (std::size_t k : ks) {
+    const double t = plan->t0 + double(k) / rate;
+    plan->truth.t.push_back(t);
+    plan->truth.x.push_back(emulation::truthNavState(tr, t));
+  }
+  for (std::size_t ke : ends)
+    plan->end_epoch.push_back(static_cast<std::size_t>(std::lower_bound(ks.begin(), ks.end(), ke) - ks.begin()));
+  plan->truth0 = emulation::truthNavState(tr, plan->t0);
+  NavRunOptions& nav = plan->nav;
+  nav.ekf.propagate_every =
+      opt.propagate_every > 0 ? opt.propagate_every : std::max(1, static_cast<int>(std::lround(rate / 20.0)));
+  nav.P0_nav = opt.initial_sigma.cwiseAbs2().asDiagonal();
+  nav.outages = plan->outages;
+  nav.lever_arm_B = opt.gnss.lever_arm_B;
+  nav.baro_in_outage = opt.baro_in_outage;
+  return plan;
+}
+
+namespace {
+
+struct RunOut {
+  // per model (0 before, 1 after): per outage h, v, drift, nees; per epoch h, v, sigma_h
+  std::array<std::vector<double>, 2> h, v, drift, nees;
+  std::array<std::vector<double>, 2> eh, ev, sh;
+};
+
+double exactSignP(int wins, int n) {
+  if (n <= 0) return 1.0;
+  boost::math::binomial bin(n, 0.5);
+  const int k = std::min(wins, n - wins);
+  return std::min(1.0, 2.0 * boost::math::cdf(bin, static_cast<double>(k)));
+}
+
+double pairedTP(const std::vector<double>& a, const std::vector<double>& b) {
+  const std::size_t n = a.size();
+  if (n < 2) return 1.0;
+  double m = 0;
+  for (std::size_t i = 0; i < n; ++i) m += a[i] - b[i];
+  m /= double(n);
+  double v = 0;
+  for (std::size_t i = 0; i < n; ++i) v += (a[i] - b[i] - m) * (a[i] - b[i] - m);
+  v /= double(n - 1);
+  if (!(v > 0)) return m == 0 ? 1.0 : 0.0;
+  const double t = m / std::sqrt(v / double(n));
+  boost::math::students_t st(static_cast<double>(n - 1));
+  return std::min(1.0, 2.0 * boost::math::cdf(boost::math::complement(st, std::abs(t))));
+}
+
+double mean(const std::vector<double>& x) {
+  double s = 0;
+  for (double v : x) s += v;
+  return x.empty() ? 0.0 : s / double(x.size());
+}
+
+}  // namespace
+
+void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p,
+                       const std::function<void(double)>& progress) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const NavGainOptions& opt = p.opt;
+  if (std::abs(data.rate_hz - p.rate) > 1e-9 * p.rate || data.size() != p.samples)
+    throw Error("navigation gain: the plan was prepared for another recording");
+  const std::size_t n = p.perfect.size();
+  NavGain g;
+  g.imu_rate_hz = p.rate;
+  g.duration_s = p.t1 - p.t0;
+  g.runs = opt.runs;
+  g.seed = opt.seed;
+  g.trajectory = opt.trajectory.file + " (" + fmtNum(g.duration_s, 6) + " s used)";
+
+  // Held-out windows: the second half of the recording, which the extension
+  // (first-half fit) has not seen, when it holds the emulation.
+  const std::size_t N = data.size(), nh = N / 2;
+  const bool held_out = (N - nh) >= n;
+  ImuSeries rec;
+  rec.source = data.source;
+  rec.rate_hz = data.rate_hz;
+  rec.channels = data.channels;
+  std::size_t first = 0;
+  if (held_out) {
+    first = nh;
+    for (auto& c : rec.channels) c.x.erase(c.x.begin(), c.x.begin() + static_cast<std::ptrdiff_t>(nh));
+  }
+  stochastic::ImuModel after = d.model_after;
+  stochastic::ImuModel before = d.model_before;
+  for (const auto& c : d.channels) {
+    before.forChannel(c.name) = c.model_before;
+    after.forChannel(c.name) = held_out ? c.model_after_half : c.model_after;
+  }
+  g.filter_after = held_out
+                       ? "the extension fitted on the first half of the record (model_after_first_half); "
+                         "the truth windows come from the second half, which that fit has not seen"
+                       : "the whole-record extension (model_after): the second half of the record is "
+                         "shorter than the emulation, so truth windows and fit share data (in-sample)";
+  if (!held_out)
+    d.notices.push_back("navigation gain is in-sample: the held-out half (" + fmtNum((N - nh) / p.rate, 6) +
+                        " s) is shorter than the trajectory (" + fmtNum(g.duration_s, 6) + " s)");
+  // Evenly spaced window offsets over the available span.
+  const std::size_t avail = rec.size() - n;
+  std::vector<std::size_t> offs;
+  for (int r = 0; r < opt.runs; ++r) {
+    const double frac = opt.runs > 1 ? double(r) / double(opt.runs - 1) : 0.0;
+    const std::size_t off = static_cast<std::size_t>(std::floor(frac * double(avail)));
+    offs.push_back(off);
+    g.window_offsets_s.push_back(double(first + off) / p.rate);
+  }
+  g.truth = "measured static recording " + data.source + ": run r takes the " + fmtNum(g.duration_s, 6) +
+            " s window starting at offset r/(R-1) of the " + (held_out ? "second half" : "whole record") +
+            " (R = " + std::to_string(opt.runs) + "), window mean removed per axis";
+  {
+    std::ostringstream st;
+    st << "IMU " << fmtNum(p.rate, 6) << " Hz; GNSS " << fmtNum(opt.gnss.rate_hz, 4)
+       << " Hz, position sigma " << fmtNum(opt.gnss.sigma_pos_h_m, 4) << " m horizontal / "
+       << fmtNum(opt.gnss.sigma_pos_v_m, 4) << " m vertical, velocity sigma "
+       << fmtNum(opt.gnss.sigma_vel_h_mps, 4) << " / " << fmtNum(opt.gnss.sigma_vel_v_mps, 4)
+       << " m/s; barometer " << fmtNum(opt.baro.rate_hz, 4) << " Hz, sigma " << fmtNum(opt.baro.sigma_m, 4)
+       << " m, " << (opt.baro_in_outage ? "kept" : "off") << " during outages; EKF covariance every "
+       << p.nav.ekf.propagate_every << " IMU samples; initial error sigmas " << fmtNum(opt.initial_sigma(0), 3)
+       << " m, " << fmtNum(opt.initial_sigma(3), 3) << " m/s, roll/pitch "
+       << fmtNum(opt.initial_sigma(6) / units::kDeg, 3) << " deg, yaw "
+       << fmtNum(opt.initial_sigma(8) / units::kDeg, 3) << " deg (drawn per run, same for both models)";
+    g.settings = st.str();
+  }
+
+  const std::size_t O = p.outages.size(), E = p.truth.t.size();
+  std::vector<RunOut> outs(opt.runs);
+  std::atomic<int> next{0}, done{0};
+  std::mutex mu;
+  std::string first_error;
+  auto work = [&]() {
+    for (;;) {
+      const int r = next++;
+      if (r >= opt.runs) return;
+      try {
+        const std::uint64_t seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(r));
+        emulation::StaticRecordingSpec spec;
+        spec.file = data.source;
+        spec.offset_s = double(offs[r]) / p.rate;
+        const auto err = emulation::staticImuErrors(rec, spec, p.rate, n).axis;
+        std::vector<ins::ImuSample> imu = p.perfect;
+        for (std::size_t k = 0; k < n; ++k) {
+          ins::ImuSample& s = imu[k];
+          for (int a = 0; a < 3; ++a) {
+            s.dtheta_B(a) += err[a][k] * s.dt;
+            s.dv_B(a) += err[3 + a][k] * s.dt;
+          }
+        }
+        emulation::GnssOptions go = opt.gnss;
+        go.seed = stochastic::deriveSeed(seed, 1);
+        emulation::BaroOptions bo = opt.baro;
+        bo.seed = stochastic::deriveSeed(seed, 2);
+        const auto gnss = emulation::simulateGnss(*p.traj, go, p.t0, p.t1);
+        const auto baro = emulation::simulateBaro(*p.traj, bo, p.t0, p.t1);
+        const auto z = emulation::standardNormal(9, stochastic::deriveSeed(seed, 3));
+        filter::Vector9d dx0;
+        for (int i = 0; i < 9; ++i) dx0(i) = opt.initial_sigma(i) * z[i];
+        NavRunInput in;
+        in.x0 = filter::applyNavError(p.truth0, dx0);
+        in.x0.t = p.t0;
+        in.imu = &imu;
+        in.gnss = &gnss;
+        in.baro = &baro;
+        in.truth = &p.truth;
+        RunOut& o = outs[r];
+        for (int m = 0; m < 2; ++m) {
+          const NavRunResult res = runNav(in, m == 0 ? before : after, p.nav);
+          if (res.epochs.size() != E)
+            throw Error("navigation gain: run " + std::to_string(r) + " recorded " +
+                        std::to_string(res.epochs.size()) + " epochs, expected " + std::to_string(E));
+          for (std::size_t e = 0; e < E; ++e) {
+            const auto& ep = res.epochs[e];
+            o.eh[m].push_back(std::hypot(ep.err(0), ep.err(1)));
+            o.ev[m].push_back(std::abs(ep.err(2)));
+            o.sh[m].push_back(std::hypot(ep.sigma(0), ep.sigma(1)));
+          }
+          for (std::size_t q = 0; q < O; ++q) {
+            const auto& ep = res.epochs[p.end_epoch[q]];
+            o.h[m].push_back(std::hypot(ep.err(0), ep.err(1)));
+            o.v[m].push_back(std::abs(ep.err(2)));
+            o.nees[m].push_back(ep.nees[0]);
+            o.drift[m].push_back(res.outages[q].max_drift_h);
+          }
+          const int dn = ++done;
+          if (progress) {
+            std::lock_guard<std::mutex> lk(mu);
+            progress(static_cast<double>(dn) / (2.0 * opt.runs));
+          }
+        }
+      } catch (const std::exception& e) {
+        std::lock_guard<std::mutex> lk(mu);
+        if (first_error.empty()) first_error = e.what();
+        next = opt.runs;
+      }
+    }
+  };
+  int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::min(threads, opt.runs);
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  if (!first_error.empty()) throw Error(first_error);
+
+  // Per outage, paired over runs.
+  for (std::size_t q = 0; q < O; ++q) {
+    NavOutageGain og;
+    og.start_s = p.outages[q].start - p.t0;
+    og.duration_s = p.outages[q].end - p.outages[q].start;
+    for (const auto& o : outs) {
+      og.h_before.push_back(o.h[0][q]);
+      og.h_after.push_back(o.h[1][q]);
+      og.v_before.push_back(o.v[0][q]);
+      og.v_after.push_back(o.v[1][q]);
+      og.drift_before.push_back(o.drift[0][q]);
+      og.drift_after.push_back(o.drift[1][q]);
+      og.nees_before.push_back(o.nees[0][q]);
+      og.nees_after.push_back(o.nees[1][q]);
+    }
+    og.mean_h_before = mean(og.h_before);
+    og.mean_h_after = mean(og.h_after);
+    og.mean_v_before = mean(og.v_before);
+    og.mean_v_after = mean(og.v_after);
+    og.mean_drift_before = mean(og.drift_before);
+    og.mean_drift_after = mean(og.drift_after);
+    og.anees_before = mean(og.nees_before);
+    og.anees_after = mean(og.nees_after);
+    og.nees_band = aneesBand(static_cast<std::size_t>(opt.runs), 3, 0.95);
+    int ties = 0;
+    for (int r = 0; r < opt.runs; ++r) {
+      if (og.h_after[r] < og.h_before[r]) ++og.wins;
+      else if (og.h_after[r] == og.h_before[r]) ++ties;
+    }
+    og.sign_p = exactSignP(og.wins, opt.runs - ties);
+    og.t_p = pairedTP(og.h_before, og.h_after);
+    og.significant = og.sign_p < 0.05;
+    g.outages.push_back(og);
+  }
+  // RMS time series for the figure.
+  g.t_s.resize(E);
+  for (std::size_t e = 0; e < E; ++e) {
+    g.t_s[e] = p.truth.t[e] - p.t0;
+    double hb = 0, ha = 0, vb = 0, va = 0, sb = 0, sa = 0;
+    for (const auto& o : outs) {
+      hb += o.eh[0][e] * o.eh[0][e];
+      ha += o.eh[1][e] * o.eh[1][e];
+      vb += o.ev[0][e] * o.ev[0][e];
+      va += o.ev[1][e] * o.ev[1][e];
+      sb += o.sh[0][e] * o.sh[0][e];
+      sa += o.sh[1][e] * o.sh[1][e];
+    }
+    const double R = opt.runs;
+    g.rms_h_before.push_back(std::sqrt(hb / R));
+    g.rms_h_after.push_back(std::sqrt(ha / R));
+    g.rms_v_before.push_back(std::sqrt(vb / R));
+    g.rms_v_after.push_back(std::sqrt(va / R));
+    g.sig_h_before.push_back(std::sqrt(sb / R));
+    g.sig_h_after.push_back(std::sqrt(sa / R));
+  }
+  g.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  d.navigation = std::move(g);
+}
+
+}  // namespace navimpact::analysis
