@@ -133,6 +133,40 @@ double pairedTP(const std::vector<double>& a, const std::vector<double>& b) {
   return std::min(1.0, 2.0 * boost::math::cdf(boost::math::complement(st, std::abs(t))));
 }
 
+/// The filter's version of a model: a GM whose correlation time is below one
+/// IMU interval (GMWM puts the short-term noise of quantised sensors there)
+/// enters as the white noise of the same long-run variance,
+/// sigma_wn^2 = sigma^2 (1 + phi) / (1 - phi), phi = exp(-dt / T) (the AR(1)
+/// spectrum at zero frequency); the EKF covariance is not positive definite
+/// with such a state. Applied alike to the models before and after.
+stochastic::ImuModel filterModel(const stochastic::ImuModel& m, double rate, int* replaced) {
+  stochastic::ImuModel f = m;
+  for (auto& a : f.axis) {
+    double add = 0;
+    std::vector<stochastic::Process> keep;
+    for (const auto& p : a.terms) {
+      if (p.kind == stochastic::ProcessKind::GM && p.T < 1.0 / rate) {
+        const double phi = std::exp(-1.0 / (rate * p.T));
+        add += p.sigma * p.sigma * (1.0 + phi) / (1.0 - phi);
+        ++*replaced;
+      } else {
+        keep.push_back(p);
+      }
+    }
+    if (add > 0) {
+      bool merged = false;
+      for (auto& p : keep)
+        if (p.kind == stochastic::ProcessKind::WN && !merged) {
+          p.sigma = std::sqrt(p.sigma * p.sigma + add);
+          merged = true;
+        }
+      if (!merged) keep.push_back(stochastic::Process::wn(std::sqrt(add)));
+    }
+    a.terms = keep;
+  }
+  return f;
+}
+
 double mean(const std::vector<double>& x) {
   double s = 0;
   for (double v : x) s += v;
@@ -173,6 +207,16 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
   for (const auto& c : d.channels) {
     before.forChannel(c.name) = c.model_before;
     after.forChannel(c.name) = held_out ? c.model_after_half : c.model_after;
+  }
+  {
+    int replaced = 0;
+    before = filterModel(before, p.rate, &replaced);
+    after = filterModel(after, p.rate, &replaced);
+    if (replaced > 0)
+      g.filter_note = std::to_string(replaced) +
+                      " Gauss-Markov term(s) with T below one IMU interval entered the filter as "
+                      "white noise of the same long-run variance sigma^2 (1 + phi) / (1 - phi), "
+                      "phi = exp(-dt/T) (the EKF cannot carry them), alike before and after";
   }
   g.filter_after = held_out
                        ? "the extension fitted on the first half of the record (model_after_first_half); "

@@ -120,6 +120,7 @@ std::string diagnosisJson(const Diagnosis& d, const std::string& input_json) {
     nav["truth"] = g.truth;
     nav["filter_after"] = g.filter_after;
     nav["settings"] = g.settings;
+    if (!g.filter_note.empty()) nav["filter_note"] = g.filter_note;
     nav["imu_rate_hz"] = g.imu_rate_hz;
     nav["runs"] = g.runs;
     nav["seed"] = g.seed;
@@ -220,7 +221,8 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
       << "Navigation along `" << g.trajectory << "` emulated with the **measured** errors as the "
       << "truth: " << g.truth << ". The filter ran once with the model before and once with "
       << g.filter_after << ", on the same " << g.runs << " realisations (seed " << g.seed
-      << "). " << g.settings << ".\n\n"
+      << "). " << g.settings << "."
+      << (g.filter_note.empty() ? std::string() : " Note: " + g.filter_note + ".") << "\n\n"
       << "| outage | horizontal error at end [m] | vertical error at end [m] | max horizontal "
          "drift [m] | position NEES at end (95 % band) | runs better after | gain |\n"
          "|---|---|---|---|---|---|---|\n";

@@ -217,6 +217,7 @@ struct NavGain {
   std::string truth;                      ///< how the measured errors were taken
   std::string filter_after;               ///< which extended model the filter used and why
   std::string settings;                   ///< GNSS, baro, EKF settings (one paragraph)
+  std::string filter_note;                ///< how the models were adapted for the filter ("" = as given)
   double imu_rate_hz = 0, duration_s = 0;
   int runs = 0;
   std::uint64_t seed = 0;
