@@ -1,6 +1,7 @@
 // WGS84 earth model: published normal-gravity values, radii, conversions.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "navimpact/core/earth.hpp"
@@ -68,4 +69,33 @@ TEST(Earth, ConversionsRoundTrip) {
   EXPECT_NEAR(r.h, p.h - 7.0, 0.01);
   // Curvilinear difference agrees with the exact local Cartesian within mm at 100 m.
   EXPECT_NEAR((e::curvilinearDiffNed(r, p) - ned).norm(), 0.0, 5e-3);
+}
+
+// The local gravity cache stays within its documented 1e-9 m/s^2 of the
+// GeographicLib field along a wandering path (climbs, descents, latitude drift)
+// that crosses many boxes, and it really caches (far fewer refreshes than queries).
+TEST(Earth, LocalGravityMatchesGeographicLibAlongAPath) {
+  e::LocalGravity g;
+  double worst = 0.0;
+  long queries = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double t = 0.05 * i;  // 1000 s at 20 Hz
+    const double lat = 0.81 + 2e-4 * std::sin(0.01 * t) + 3e-6 * t;  // drifts over ~5 boxes
+    const double h = 430.0 + 150.0 * std::sin(0.02 * t) + 0.5 * std::sin(3.0 * t);
+    const Eigen::Vector3d d = g(lat, h) - e::gravity_N(lat, h);
+    worst = std::max(worst, d.cwiseAbs().maxCoeff());
+    ++queries;
+  }
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(worst, 0.0);  // it is an approximation, not a second call of gravity_N
+  EXPECT_GT(g.refreshes(), 10);
+  EXPECT_LT(g.refreshes(), queries / 20);
+  // A box that is too large is visibly worse: the bound is the box, not luck.
+  e::LocalGravity coarse(2000.0, 0.05);
+  double worst_coarse = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    const double lat = 0.81 + 2.5e-4 * i, h = 10.0 * i;
+    worst_coarse = std::max(worst_coarse, (coarse(lat, h) - e::gravity_N(lat, h)).cwiseAbs().maxCoeff());
+  }
+  EXPECT_GT(worst_coarse, 1e-8);
 }

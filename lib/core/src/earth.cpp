@@ -33,6 +33,24 @@ Eigen::Vector3d gravity_N(double lat, double h) {
   return Eigen::Vector3d(gy, 0.0, -gz);
 }
 
+Eigen::Vector3d LocalGravity::operator()(double lat, double h) {
+  if (!valid_ || std::abs(h - h0_) > max_dh_ || std::abs(lat - lat0_) > max_dlat_) {
+    // Reference point and its derivatives by central differences of the
+    // GeographicLib field (truncation error of order step^2 x third derivative,
+    // below 1e-15 m/s^2 over the box).
+    constexpr double kDlat = 1e-5, kDh = 1.0;
+    lat0_ = lat;
+    h0_ = h;
+    g0_ = gravity_N(lat, h);
+    dg_dlat_ = (gravity_N(lat + kDlat, h) - gravity_N(lat - kDlat, h)) / (2.0 * kDlat);
+    dg_dh_ = (gravity_N(lat, h + kDh) - gravity_N(lat, h - kDh)) / (2.0 * kDh);
+    valid_ = true;
+    ++refreshes_;
+    return g0_;
+  }
+  return g0_ + dg_dlat_ * (lat - lat0_) + dg_dh_ * (h - h0_);
+}
+
 void gravityGradient(double lat, double h, double& dgD_dlat, double& dgD_dh) {
   static const GeographicLib::NormalGravity& ng = GeographicLib::NormalGravity::WGS84();
   // Somigliana: gamma = gamma_e (1 + k s2) / sqrt(1 - e2 s2), k = b gamma_p / (a gamma_e) - 1.

@@ -13,7 +13,8 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
 }
 
 NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
-                   const ImuSample* last2, const MechanizationOptions& opt) {
+                   const ImuSample* last2, const MechanizationOptions& opt,
+                   earth::LocalGravity* gravity) {
   const double tau = cur.dt;
   const Vector3d& a = cur.dtheta_B;  // alpha_IB_B
   const Vector3d& u = cur.dv_B;      // upsilon_IB_B
@@ -70,13 +71,13 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
 
   // Velocity update (Groves 5.54) with gravity and Coriolis evaluated at the
   // interval midpoint (predicted, then corrected once).
-  const Vector3d g0 = earth::gravity_N(prev.lat, prev.h);
+  const Vector3d g0 = gravity ? (*gravity)(prev.lat, prev.h) : earth::gravity_N(prev.lat, prev.h);
   Vector3d v1 = prev.v_N + dv_f_N + (g0 - (2.0 * w_ie0 + w_en0).cross(prev.v_N)) * tau;
   {
     const Vector3d v_mid = 0.5 * (prev.v_N + v1);
     const double h_mid = prev.h - 0.5 * tau * v_mid.z();
     const double lat_mid = prev.lat + 0.5 * tau * v_mid.x() / (r0.R_N + h_mid);
-    const Vector3d g_mid = earth::gravity_N(lat_mid, h_mid);
+    const Vector3d g_mid = gravity ? (*gravity)(lat_mid, h_mid) : earth::gravity_N(lat_mid, h_mid);
     const Vector3d w_ie_mid = earth::w_IE_N(lat_mid);
     const Vector3d w_en_mid = earth::w_EN_N(lat_mid, h_mid, v_mid);
     v1 = prev.v_N + dv_f_N + (g_mid - (2.0 * w_ie_mid + w_en_mid).cross(v_mid)) * tau;
@@ -102,7 +103,7 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
 }
 
 void Mechanization::step(const ImuSample& s) {
-  x_ = mechanize(x_, s, has_last_ ? &last_ : nullptr, has_last2_ ? &last2_ : nullptr, opt_);
+  x_ = mechanize(x_, s, has_last_ ? &last_ : nullptr, has_last2_ ? &last2_ : nullptr, opt_, &gravity_);
   if (has_last_) {
     last2_ = last_;
     has_last2_ = true;

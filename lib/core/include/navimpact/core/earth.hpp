@@ -54,6 +54,47 @@ Radii radii(double lat);
 Eigen::Vector3d gravity_N(double lat, double h);
 
 /**
+ * WGS84 normal gravity for a moving vehicle, at a fraction of the cost of
+ * gravity_N(): the GeographicLib field is evaluated at a reference point
+ * (lat0, h0) together with its latitude and height derivatives (central
+ * differences of gravity_N, steps 1e-5 rad and 1 m), and used to first order
+ * within a box around it; outside the box the reference point moves to the
+ * query point. With the default box (|h - h0| <= 10 m, |lat - lat0| <= 1e-4
+ * rad, about 640 m) the neglected second-order terms are below 1e-9 m/s^2
+ * (d2g/dh2 = 6 g/a^2 = 1.4e-12 s^-2/m, d2g/dlat2 < 0.11 m/s^2/rad^2), i.e.
+ * 1e-10 g, far below any IMU's bias. Longitude does not enter normal gravity.
+ * Not thread-safe (one instance per navigation loop).
+ */
+class LocalGravity {
+ public:
+  /**
+   * @param[in] max_dh_m      half-size of the box in height [m], > 0.
+   * @param[in] max_dlat_rad  half-size of the box in latitude [rad], > 0.
+   */
+  explicit LocalGravity(double max_dh_m = 10.0, double max_dlat_rad = 1e-4)
+      : max_dh_(max_dh_m), max_dlat_(max_dlat_rad) {}
+
+  /**
+   * Normal gravity in NED at (lat, h), as gravity_N() to within the bound above.
+   * @param[in] lat  geodetic latitude [rad], |lat| < pi/2 - 1e-4.
+   * @param[in] h    ellipsoidal height [m], |h| < 1e5.
+   * @return g_N [m/s^2], down component positive.
+   */
+  Eigen::Vector3d operator()(double lat, double h);
+
+  /// Number of times the reference point was (re)computed (5 gravity_N calls each).
+  long refreshes() const { return refreshes_; }
+
+ private:
+  double max_dh_, max_dlat_;
+  bool valid_ = false;
+  double lat0_ = 0.0, h0_ = 0.0;
+  Eigen::Vector3d g0_ = Eigen::Vector3d::Zero(), dg_dlat_ = Eigen::Vector3d::Zero(),
+                  dg_dh_ = Eigen::Vector3d::Zero();
+  long refreshes_ = 0;
+};
+
+/**
  * Partial derivatives of the down component of normal gravity, for error
  * models (Somigliana's formula differentiated, and the free-air gradient of
  * Heiskanen & Moritz 1967 eq. 2-124).

@@ -15,6 +15,7 @@
  */
 #pragma once
 
+#include "navimpact/core/earth.hpp"
 #include "navimpact/ins/nav_state.hpp"
 
 namespace navimpact::ins {
@@ -48,10 +49,14 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
  * @param[in] last2  increments of the interval before @p last (nullptr = none);
  *                   all three intervals of equal length.
  * @param[in] opt    options.
+ * @param[in,out] gravity  local gravity cache (earth::LocalGravity, within
+ *                   1e-9 m/s^2 of GeographicLib); nullptr = evaluate
+ *                   earth::gravity_N() directly (twice per step).
  * @return the state at cur.t.
  */
 NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
-                   const ImuSample* last2, const MechanizationOptions& opt = {});
+                   const ImuSample* last2, const MechanizationOptions& opt = {},
+                   earth::LocalGravity* gravity = nullptr);
 
 /// Stateful wrapper: keeps the current state and the previous increments.
 class Mechanization {
@@ -81,6 +86,7 @@ class Mechanization {
  private:
   NavState x_;
   MechanizationOptions opt_;
+  earth::LocalGravity gravity_;  ///< GeographicLib normal gravity, linearised per 10 m / 640 m box
   ImuSample last_, last2_;
   bool has_last_ = false, has_last2_ = false;
 };
