@@ -133,19 +133,22 @@ double pairedTP(const std::vector<double>& a, const std::vector<double>& b) {
   return std::min(1.0, 2.0 * boost::math::cdf(boost::math::complement(st, std::abs(t))));
 }
 
-/// The filter's version of a model: a GM whose correlation time is below one
-/// IMU interval (GMWM puts the short-term noise of quantised sensors there)
-/// enters as the white noise of the same long-run variance,
-/// sigma_wn^2 = sigma^2 (1 + phi) / (1 - phi), phi = exp(-dt / T) (the AR(1)
-/// spectrum at zero frequency); the EKF covariance is not positive definite
-/// with such a state. Applied alike to the models before and after.
-stochastic::ImuModel filterModel(const stochastic::ImuModel& m, double rate, int* replaced) {
+/// The filter's version of a model: a GM whose correlation time is at most the
+/// covariance propagation interval k dt (GMWM puts the short-term noise of
+/// quantised sensors there) enters as the white noise of the same long-run
+/// variance, sigma_wn^2 = sigma^2 (1 + phi) / (1 - phi), phi = exp(-dt / T)
+/// (the AR(1) spectrum at zero frequency); the EKF covariance propagated over
+/// k dt is not kept positive definite with such a state (measured: T = 3-6 ms
+/// at t = 0.1 s, T = 10 ms during a 60 s outage, k dt = 50 ms). Applied alike
+/// to the models before and after.
+stochastic::ImuModel filterModel(const stochastic::ImuModel& m, double rate, double t_min,
+                                 int* replaced) {
   stochastic::ImuModel f = m;
   for (auto& a : f.axis) {
     double add = 0;
     std::vector<stochastic::Process> keep;
     for (const auto& p : a.terms) {
-      if (p.kind == stochastic::ProcessKind::GM && p.T < 1.0 / rate) {
+      if (p.kind == stochastic::ProcessKind::GM && p.T <= t_min * (1.0 + 1e-9)) {
         const double phi = std::exp(-1.0 / (rate * p.T));
         add += p.sigma * p.sigma * (1.0 + phi) / (1.0 - phi);
         ++*replaced;
@@ -210,12 +213,13 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
   }
   {
     int replaced = 0;
-    before = filterModel(before, p.rate, &replaced);
-    after = filterModel(after, p.rate, &replaced);
+    const double t_min = p.nav.ekf.propagate_every / p.rate;
+    before = filterModel(before, p.rate, t_min, &replaced);
+    after = filterModel(after, p.rate, t_min, &replaced);
     if (replaced > 0)
       g.filter_note = std::to_string(replaced) +
-                      " Gauss-Markov term(s) with T below one IMU interval entered the filter as "
-                      "white noise of the same long-run variance sigma^2 (1 + phi) / (1 - phi), "
+                      " Gauss-Markov term(s) with T at most the covariance propagation interval (" +
+                      fmtNum(t_min, 3) + " s) entered the filter as white noise of the same long-run variance sigma^2 (1 + phi) / (1 - phi), "
                       "phi = exp(-dt/T) (the EKF cannot carry them), alike before and after";
   }
   g.filter_after = held_out
