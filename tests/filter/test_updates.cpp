@@ -164,3 +164,47 @@ TEST(Layout, RefModelStatesAreNamedAndCounted) {
   opt.turn_on_sigma[4] = 0.0;
   EXPECT_THROW(filter::StateLayout::build(m, opt), Error);
 }
+
+// GMWM fits of quantised sensors put the first-scale noise into GMs with T of a
+// few ms (config/models/adis16405_fitted.yaml:model2, T = 3-6 ms at 100 Hz). Over a
+// propagation interval of k = 5 samples (50 ms) such a state is white at the
+// filter's resolution; it must enter as white noise of the same long-run
+// variance, and the filter must keep P positive definite through a long
+// GNSS-free coast (with the GM as a state the truncated-series coupling made P
+// indefinite within 0.1 s).
+TEST(Layout, GaussMarkovShorterThanThePropagationIntervalEntersAsWhiteNoise) {
+  using stochastic::Process;
+  const double rate = 100.0, T = 0.005, sigma = 6e-3;
+  const stochastic::ImuModel m =
+      ftest::model({Process::wn(1e-12), Process::gm(sigma, T), Process::gm(2e-4, 40.0)},
+                   {Process::wn(1e-12), Process::gm(0.035, 0.006)}, rate);
+  filter::EkfConfig cfg;
+  cfg.propagate_every = 5;
+  const filter::StateLayout L = filter::StateLayout::build(m, filter::effectiveImuOptions(m, cfg));
+  EXPECT_EQ(L.imuSize(), 3);              // only the 40 s gyro GMs stay states
+  EXPECT_EQ(L.notes().size(), 6u) << L.describe();
+  const double phi = std::exp(-1.0 / (rate * T));
+  const double wn2 = 1e-24 + sigma * sigma * (1.0 + phi) / (1.0 - phi);
+  EXPECT_NEAR(L.whitePsd()[0], wn2 / rate, 1e-9 * wn2 / rate);
+  // Every sample: k dt = 10 ms still exceeds T = 5-6 ms, so the same conversion.
+  cfg.propagate_every = 1;
+  EXPECT_EQ(filter::StateLayout::build(m, filter::effectiveImuOptions(m, cfg)).imuSize(), 3);
+  // Without the option the GMs are states (the layout itself does not decide).
+  EXPECT_EQ(filter::StateLayout::build(m).imuSize(), 9);
+
+  // 20 s with GNSS and baro, then 60 s with baro only: P stays positive definite.
+  cfg.propagate_every = 5;
+  const ins::NavState x0 = ftest::staticState();
+  filter::ErrorStateEkf ekf(x0, filter::Matrix9d::Identity() * 1e-2, m, cfg);
+  const auto imu = ftest::simulateStatic(x0, m, 8000, 17);
+  for (std::size_t k = 0; k < imu.size(); ++k) {
+    ekf.predict(imu[k]);
+    if ((k + 1) % 100 == 0 && k < 2000)
+      ekf.updateGnssPosition({x0.lat, x0.lon, x0.h}, Eigen::Vector3d(2.0, 2.0, 4.0));
+    if ((k + 1) % 10 == 0) ekf.updateBaro(x0.h, 0.5);
+  }
+  ekf.flushPropagation();
+  const Eigen::MatrixXd P = ekf.P();
+  EXPECT_TRUE(P.allFinite());
+  EXPECT_EQ(Eigen::LLT<Eigen::MatrixXd>(P).info(), Eigen::Success);
+}

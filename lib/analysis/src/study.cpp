@@ -202,8 +202,10 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
   for (const auto& c : cfg.candidates) {
     try {
       plan->filter_models.push_back(buildCandidate(c, rate, meta.notices));
-      const auto layout = filter::StateLayout::build(plan->filter_models.back(), cfg.ekf.imu);
+      const auto layout = filter::StateLayout::build(
+          plan->filter_models.back(), filter::effectiveImuOptions(plan->filter_models.back(), cfg.ekf));
       meta.states.push_back(layout.size());
+      for (const auto& n : layout.notes()) meta.notices.push_back("candidate '" + c.label + "': " + n);
     } catch (const Error& e) {
       throw Error("candidate '" + c.label + "': " + e.what());
     }

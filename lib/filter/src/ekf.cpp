@@ -93,6 +93,13 @@ bool sameState(const ins::NavState& a, const ins::NavState& b) {
 }
 }  // namespace
 
+ImuErrorOptions effectiveImuOptions(const stochastic::ImuModel& model, const EkfConfig& cfg) {
+  ImuErrorOptions o = cfg.imu;
+  if (model.rate_hz > 0.0)
+    o.white_gm_below_s = std::max(o.white_gm_below_s, cfg.propagate_every / model.rate_hz);
+  return o;
+}
+
 ErrorStateEkf::ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
                              const stochastic::ImuModel& model, const EkfConfig& cfg)
     : cfg_(cfg), mech_(x0, cfg.mechanization), cache_(std::make_shared<Cache>()) {
@@ -105,7 +112,7 @@ ErrorStateEkf::ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
                                  1e-12 * (1.0 + P0_nav.cwiseAbs().maxCoeff()) ||
       (P0_nav.diagonal().array() < 0.0).any())
     throw Error("initial navigation covariance must be finite, symmetric, with diagonal >= 0");
-  layout_ = StateLayout::build(model, cfg.imu);
+  layout_ = StateLayout::build(model, effectiveImuOptions(model, cfg));
   const int N = layout_.size(), m = layout_.imuSize();
   P_ = MatrixXd::Zero(N, N);
   P_.topLeftCorner<9, 9>() = P0_nav;

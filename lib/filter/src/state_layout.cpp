@@ -16,6 +16,37 @@ std::string fmt(double v) {
   s << v;
   return s.str();
 }
+
+// A GM with T <= t_max becomes white noise of the same long-run variance
+// (AR(1) spectrum at f = 0: sigma^2 (1 + phi) / (1 - phi) per sample), merged
+// into the axis' WN term (or added as one).
+stochastic::Model whiteShortGms(const stochastic::Model& in, double t_max, const std::string& ch,
+                                std::vector<std::string>& notes) {
+  if (!(t_max > 0.0)) return in;
+  stochastic::Model out = in;
+  out.terms.clear();
+  double add = 0.0;
+  for (const stochastic::Process& p : in.terms) {
+    if (p.kind == stochastic::ProcessKind::GM && p.T <= t_max) {
+      const double phi = std::exp(-1.0 / (in.rate_hz * p.T));
+      add += p.sigma * p.sigma * (1.0 + phi) / (1.0 - phi);
+      notes.push_back(ch + ": GM(sigma=" + fmt(p.sigma) + ", T=" + fmt(p.T) +
+                      ") is shorter than the covariance propagation interval (" + fmt(t_max) +
+                      " s) and enters as white noise of the same long-run variance");
+    } else {
+      out.terms.push_back(p);
+    }
+  }
+  if (add == 0.0) return in;
+  for (stochastic::Process& p : out.terms)
+    if (p.kind == stochastic::ProcessKind::WN) {
+      p.sigma = std::sqrt(p.sigma * p.sigma + add);
+      return out;
+    }
+  out.terms.push_back(stochastic::Process::wn(std::sqrt(add)));
+  return out;
+}
+
 }  // namespace
 
 StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuErrorOptions& opt) {
@@ -40,9 +71,9 @@ StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuError
       L.names_.push_back(ch + ".TOB(sigma=" + fmt(s) + ")");
       L.blocks_.push_back(b);
     }
-    const stochastic::Model& m = model.axis[c];
-    if (m.empty()) continue;
-    stochastic::validate(m);
+    if (model.axis[c].empty()) continue;
+    stochastic::validate(model.axis[c]);
+    const stochastic::Model m = whiteShortGms(model.axis[c], opt.white_gm_below_s, ch, L.notes_);
     std::map<stochastic::ProcessKind, int> count;
     for (const stochastic::Process& p : m.terms) {
       const int k = ++count[p.kind];

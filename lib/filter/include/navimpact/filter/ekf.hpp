@@ -71,6 +71,14 @@ struct EkfConfig {
   ins::MechanizationOptions mechanization;
 };
 
+/**
+ * The IMU-error options the filter really uses for @p model: cfg.imu with
+ * white_gm_below_s raised to the covariance propagation interval
+ * propagate_every / model.rate_hz [s] (the model is expected at the IMU rate).
+ * Use it to build the same StateLayout as the filter (state counts, notes).
+ */
+ImuErrorOptions effectiveImuOptions(const stochastic::ImuModel& model, const EkfConfig& cfg);
+
 /// Result of one measurement update.
 struct UpdateResult {
   bool accepted = true;         ///< false when rejected by the chi-square gate

@@ -46,6 +46,16 @@ struct ImuErrorOptions {
   bool turn_on_bias = false;
   /// Prior sigma of the turn-on bias per channel (gyro_x..acc_z) [rad/s, m/s^2], > 0.
   std::array<double, 6> turn_on_sigma{{0, 0, 0, 0, 0, 0}};
+  /// Gauss-Markov terms with T <= this [s] enter the filter as white noise of
+  /// the same long-run variance, sigma_wn^2 = sigma^2 (1 + phi) / (1 - phi) per
+  /// sample, phi = exp(-dt/T) (the AR(1) spectrum at zero frequency), instead of
+  /// a state: over a covariance propagation interval longer than T such a state
+  /// is white at the filter's resolution, and the truncated-series coupling
+  /// terms (Groves 3.34/3.46, expansions in dt/T) stop being valid and make P
+  /// indefinite (GMWM puts the quantisation noise of sensors like the ADIS16405
+  /// into GMs with T = 3-6 ms). ErrorStateEkf raises it to its propagation
+  /// interval; 0 = keep every GM as a state. Reported by StateLayout::notes().
+  double white_gm_below_s = 0.0;
 };
 
 /// Names and positions of all error states.
@@ -73,6 +83,8 @@ class StateLayout {
   /// One line per state: "index name".
   std::string describe() const;
   const stochastic::ImuModel& model() const { return model_; }
+  /// What build() changed in the model (GMs entered as white noise), one line each.
+  const std::vector<std::string>& notes() const { return notes_; }
 
  private:
   std::vector<std::string> names_;
@@ -80,6 +92,7 @@ class StateLayout {
   std::array<double, 6> white_psd_{{0, 0, 0, 0, 0, 0}};
   std::array<Eigen::RowVectorXd, 6> h_;
   stochastic::ImuModel model_;
+  std::vector<std::string> notes_;
 };
 
 }  // namespace navimpact::filter
