@@ -16,6 +16,7 @@ struct Opts {
   std::string out;
   bool no_gzip = false;
   bool no_gt = false;
+  int gzip_level = 1;
 };
 
 navimpact::cli::Registrar reg({
@@ -27,6 +28,9 @@ navimpact::cli::Registrar reg({
           ->required();
       app.add_option("--out", o->out, "output rawlog (FILE.rawlog; gzip-compressed unless --no-gzip)")->required();
       app.add_flag("--no-gzip", o->no_gzip, "write the rawlog uncompressed");
+      app.add_option("--gzip-level", o->gzip_level,
+                     "zlib level 1 (fast, default: compression is most of the write time) .. 9 (smallest)")
+          ->check(CLI::Range(1, 9));
       app.add_flag("--no-gt", o->no_gt,
                    "leave out the ground-truth records (label GT), like the rawlog of a real flight");
       return [o]() -> int {
@@ -42,6 +46,7 @@ navimpact::cli::Registrar reg({
         const auto staged = outs.stage(outPath.filename().string());
         navimpact::rawlog::RawlogWriteOptions wo;
         wo.gzip = !o->no_gzip;
+        wo.gzip_level = o->gzip_level;
         navimpact::rawlog::writeRawlog(staged.string(), data, wo);
         const auto bytes = fs::file_size(staged);
         outs.commit();

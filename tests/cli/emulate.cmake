@@ -75,3 +75,17 @@ add_test(NAME cli_emulate_static_rate_mismatch
   COMMAND ${CMAKE_COMMAND} -DNI=${NI} "-DARGS=emulate|--config|${_edir}/static_rate.yaml|--out|${_edir}/static.rawlog"
           -DOUTFILE=${_edir}/static.rawlog "-DREGEX=static recording is at 100 Hz, emulation at 200 Hz"
           -P ${_edir}/expect_fail_nofile.cmake)
+
+# --gzip-level: the fast default and the smallest level both round-trip through
+# the reader (replay of the level-9 file runs); an out-of-range level is refused.
+add_test(NAME cli_emulate_gzip9
+  COMMAND ${NI} emulate --config ${_edir}/uav30.yaml --out ${_edir}/uav30_l9.rawlog --gzip-level 9)
+set_tests_properties(cli_emulate_gzip9 PROPERTIES FIXTURES_SETUP emu_rawlog_l9
+  PASS_REGULAR_EXPRESSION "IMU 6000 samples at 200 Hz")
+add_test(NAME cli_emulate_gzip9_replays
+  COMMAND ${NI} replay --rawlog ${_edir}/uav30_l9.rawlog --outage 10:5 --out ${_edir}/replay_l9)
+set_tests_properties(cli_emulate_gzip9_replays PROPERTIES FIXTURES_REQUIRED emu_rawlog_l9
+  PASS_REGULAR_EXPRESSION "wrote .*solution.csv")
+add_test(NAME cli_emulate_bad_gzip_level
+  COMMAND ${NI} emulate --config ${_edir}/uav30.yaml --out ${_edir}/bad_level.rawlog --gzip-level 12)
+set_tests_properties(cli_emulate_bad_gzip_level PROPERTIES WILL_FAIL TRUE)
