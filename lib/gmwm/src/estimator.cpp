@@ -593,41 +593,6 @@ void setModelWeights(const Layout& L, const Eigen::VectorXd& th, Data& d) {
 }
 
 /**
- * Iteratively reweighted GMWM: from the fast-weight estimate th, set the
- * model-based weights at th, refit from th (on the first pass also from the
- * multi-start points of @p multi under the new weights, keeping the lower
- * objective: a fast fit that spent a GM on the white noise, T < 1 sample,
- * is left that way by a local refit), repeat until the largest change
- * of a transformed parameter is below 1e-3 (0.1 %) or after @p passes passes.
- * Leaves d.omega / d.w_obj at the weights of the last refit.
- */
-int reweight(const Layout& L, Eigen::VectorXd& th, Data& d, int passes, bool* converged,
-             const FitOptions* multi = nullptr) {
-  int done = 0;
-  for (int it = 0; it < std::max(passes, 1); ++it) {
-    setModelWeights(L, th, d);
-    Eigen::VectorXd t = th;
-    double v = solve(L, t, d, objW(d), converged);
-    sortTerms(L, t);
-    if (multi && it == 0) {  // the fast basin need not be the best one under the new weights
-      bool c2 = false;
-      Eigen::VectorXd t2 = fitPoint(L, d, *multi, nullptr, &c2);
-      const double v2 = criterion(L, t2, d, objW(d));
-      if (v2 < v) {
-        t = t2;
-        v = v2;
-        if (converged) *converged = c2;
-      }
-    }
-    const double change = (t - th).cwiseAbs().maxCoeff();
-    th = t;
-    ++done;
-    if (change < 1e-3) break;
-  }
-  return done;
-}
-
-/**
  * Efficient weights at theta: Omega = V^-1, V the full asymptotic covariance
  * of nu_hat under the model theta (wvCovariance). Scales with eta_j < min_eta
  * get V_jj = 2 nu_j^2 / eta_j (eta3 chi-square variance) and no correlation:
@@ -673,19 +638,31 @@ void setEfficientWeights(const Layout& L, const Eigen::VectorXd& th, Data& d, do
   d.w_obj = d.omega.cwiseSqrt();
 }
 
-/// Efficient GMWM: iterate efficient weights at theta and refit (first pass
-/// also from the multi-start points under the new weights), as reweight().
-int reweightEfficient(const Layout& L, Eigen::VectorXd& th, Data& d, int passes, double min_eta,
-                      bool* converged, const FitOptions* multi = nullptr) {
+/**
+ * Iteratively reweighted GMWM: from the fast-weight estimate th, set the
+ * weights of opt.weighting at th (model-based: setModelWeights; efficient:
+ * setEfficientWeights with opt.efficient_min_eta), refit from th (on the first
+ * pass, when @p multistart, also from the multi-start points of @p opt under
+ * the new weights, keeping the lower objective: a fast fit that spent a GM on
+ * the white noise, T < 1 sample, is left that way by a local refit), repeat
+ * until the largest change of a transformed parameter is below 1e-3 (0.1 %)
+ * or after opt.weight_iterations passes. Leaves d.omega / d.w_obj (and
+ * d.w_full) at the weights of the last refit. opt.weighting must not be Fast.
+ */
+int reweight(const Layout& L, Eigen::VectorXd& th, Data& d, const FitOptions& opt, bool* converged,
+             bool multistart) {
   int done = 0;
-  for (int it = 0; it < std::max(passes, 1); ++it) {
-    setEfficientWeights(L, th, d, min_eta);
+  for (int it = 0; it < std::max(opt.weight_iterations, 1); ++it) {
+    if (opt.weighting == Weighting::Efficient)
+      setEfficientWeights(L, th, d, opt.efficient_min_eta);
+    else
+      setModelWeights(L, th, d);
     Eigen::VectorXd t = th;
     double v = solve(L, t, d, objW(d), converged);
     sortTerms(L, t);
-    if (multi && it == 0) {
+    if (multistart && it == 0) {  // the fast basin need not be the best one under the new weights
       bool c2 = false;
-      Eigen::VectorXd t2 = fitPoint(L, d, *multi, nullptr, &c2);
+      Eigen::VectorXd t2 = fitPoint(L, d, opt, nullptr, &c2);
       const double v2 = criterion(L, t2, d, objW(d));
       if (v2 < v) {
         t = t2;
@@ -872,10 +849,7 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
   FitResult r;
   Eigen::VectorXd th = fitPoint(L, d, opt, &r.starts, &r.converged);
   r.weighting = opt.weighting;
-  if (opt.weighting == Weighting::ModelBased)
-    r.weight_passes = reweight(L, th, d, opt.weight_iterations, &r.converged, &opt);
-  if (opt.weighting == Weighting::Efficient)
-    r.weight_passes = reweightEfficient(L, th, d, opt.weight_iterations, opt.efficient_min_eta, &r.converged, &opt);
+  if (opt.weighting != Weighting::Fast) r.weight_passes = reweight(L, th, d, opt, &r.converged, true);
   r.model = detail::toModel(L, th, d.rate);
   r.objective_fast = objective(r.model, wv);
   r.objective = opt.weighting == Weighting::Fast ? r.objective_fast : criterion(L, th, d, objW(d));
@@ -901,9 +875,7 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
       Eigen::VectorXd t = th;
       solve(L, t, db, objW(db));
       sortTerms(L, t);
-      if (opt.weighting == Weighting::ModelBased) reweight(L, t, db, opt.weight_iterations, nullptr);
-      if (opt.weighting == Weighting::Efficient)
-        reweightEfficient(L, t, db, opt.weight_iterations, opt.efficient_min_eta, nullptr);
+      if (opt.weighting != Weighting::Fast) reweight(L, t, db, opt, nullptr, false);
       reps.push_back(t);
     }
     for (int k = 0; k < p; ++k) {
