@@ -272,30 +272,9 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
         spec.file = data.source;
         spec.offset_s = double(offs[r]) / p.rate;
         const auto err = emulation::staticImuErrors(rec, spec, p.rate, n).axis;
-        std::vector<ins::ImuSample> imu = p.perfect;
-        for (std::size_t k = 0; k < n; ++k) {
-          ins::ImuSample& s = imu[k];
-          for (int a = 0; a < 3; ++a) {
-            s.dtheta_B(a) += err[a][k] * s.dt;
-            s.dv_B(a) += err[3 + a][k] * s.dt;
-          }
-        }
-        emulation::GnssOptions go = opt.gnss;
-        go.seed = stochastic::deriveSeed(seed, 1);
-        emulation::BaroOptions bo = opt.baro;
-        bo.seed = stochastic::deriveSeed(seed, 2);
-        const auto gnss = emulation::simulateGnss(*p.traj, go, p.t0, p.t1);
-        const auto baro = emulation::simulateBaro(*p.traj, bo, p.t0, p.t1);
-        const auto z = emulation::standardNormal(9, stochastic::deriveSeed(seed, 3));
-        filter::Vector9d dx0;
-        for (int i = 0; i < 9; ++i) dx0(i) = opt.initial_sigma(i) * z[i];
-        NavRunInput in;
-        in.x0 = filter::applyNavError(p.truth0, dx0);
-        in.x0.t = p.t0;
-        in.imu = &imu;
-        in.gnss = &gnss;
-        in.baro = &baro;
-        in.truth = &p.truth;
+        const EmulatedRun run =
+            emulateRun(p.perfect, err, *p.traj, p.t0, p.t1, opt.gnss, opt.baro, p.truth0, opt.initial_sigma, seed);
+        const NavRunInput in = run.input(p.truth);
         RunOut& o = outs[r];
         for (int m = 0; m < 2; ++m) {
           const NavRunResult res = runNav(in, m == 0 ? before : after, p.nav);

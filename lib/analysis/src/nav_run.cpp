@@ -10,6 +10,7 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/filter/error_model.hpp"
+#include "navimpact/stochastic/simulate.hpp"
 
 namespace navimpact::analysis {
 
@@ -158,6 +159,44 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
   }
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return res;
+}
+
+NavRunInput EmulatedRun::input(const TruthSeries& truth) const {
+  NavRunInput in;
+  in.x0 = x0;
+  in.imu = &imu;
+  in.gnss = &gnss;
+  in.baro = &baro;
+  in.truth = &truth;
+  return in;
+}
+
+EmulatedRun emulateRun(const std::vector<ins::ImuSample>& perfect,
+                       const std::array<std::vector<double>, 6>& err,
+                       const emulation::SmoothTrajectory& traj, double t0, double t1,
+                       emulation::GnssOptions gnss, emulation::BaroOptions baro,
+                       const ins::NavState& truth0, const filter::Vector9d& initial_sigma,
+                       std::uint64_t run_seed) {
+  EmulatedRun run;
+  const std::size_t n = perfect.size();
+  run.imu = perfect;
+  for (std::size_t k = 0; k < n; ++k) {
+    ins::ImuSample& s = run.imu[k];
+    for (int a = 0; a < 3; ++a) {
+      s.dtheta_B(a) += err[a][k] * s.dt;
+      s.dv_B(a) += err[3 + a][k] * s.dt;
+    }
+  }
+  gnss.seed = stochastic::deriveSeed(run_seed, 1);
+  baro.seed = stochastic::deriveSeed(run_seed, 2);
+  run.gnss = emulation::simulateGnss(traj, gnss, t0, t1);
+  run.baro = emulation::simulateBaro(traj, baro, t0, t1);
+  const auto z = emulation::standardNormal(9, stochastic::deriveSeed(run_seed, 3));
+  filter::Vector9d dx0;
+  for (int i = 0; i < 9; ++i) dx0(i) = initial_sigma(i) * z[i];
+  run.x0 = filter::applyNavError(truth0, dx0);
+  run.x0.t = t0;
+  return run;
 }
 
 }  // namespace navimpact::analysis

@@ -341,30 +341,9 @@ RunRecord doRun(const StudyPlan& p, std::uint64_t index) {
   } else {
     err = emulation::modelImuErrors(p.truth_model, cfg.imu_rate_hz, n, stochastic::deriveSeed(rec.seed, 0)).axis;
   }
-  std::vector<ins::ImuSample> imu = p.perfect;
-  for (std::size_t k = 0; k < n; ++k) {
-    ins::ImuSample& s = imu[k];
-    for (int a = 0; a < 3; ++a) {
-      s.dtheta_B(a) += err[a][k] * s.dt;
-      s.dv_B(a) += err[3 + a][k] * s.dt;
-    }
-  }
-  emulation::GnssOptions g = cfg.gnss;
-  g.seed = stochastic::deriveSeed(rec.seed, 1);
-  emulation::BaroOptions b = cfg.baro;
-  b.seed = stochastic::deriveSeed(rec.seed, 2);
-  const auto gnss = emulation::simulateGnss(*p.traj, g, p.t0, p.t1);
-  const auto baro = emulation::simulateBaro(*p.traj, b, p.t0, p.t1);
-  const auto z = emulation::standardNormal(9, stochastic::deriveSeed(rec.seed, 3));
-  filter::Vector9d dx0;
-  for (int i = 0; i < 9; ++i) dx0(i) = cfg.initial_sigma(i) * z[i];
-  NavRunInput in;
-  in.x0 = filter::applyNavError(p.truth0, dx0);
-  in.x0.t = p.t0;
-  in.imu = &imu;
-  in.gnss = &gnss;
-  in.baro = &baro;
-  in.truth = &p.truth;
+  const EmulatedRun run = emulateRun(p.perfect, err, *p.traj, p.t0, p.t1, cfg.gnss, cfg.baro, p.truth0,
+                                     cfg.initial_sigma, rec.seed);
+  const NavRunInput in = run.input(p.truth);
 
   const std::size_t E = p.truth.t.size(), O = p.nav.outages.size();
   for (const auto& model : p.filter_models) {

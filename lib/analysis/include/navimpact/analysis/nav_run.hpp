@@ -36,6 +36,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -125,6 +126,40 @@ struct NavRunResult {
  */
 NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
                     const NavRunOptions& opt);
+
+/// The data of one emulated run, owned; input() points a NavRunInput at them.
+struct EmulatedRun {
+  std::vector<ins::ImuSample> imu;           ///< perfect increments + IMU errors
+  std::vector<emulation::GnssFix> gnss;      ///< seeded GNSS fixes
+  std::vector<emulation::BaroSample> baro;   ///< seeded barometer samples
+  ins::NavState x0;                          ///< truth at t0 with the seeded initial error
+  /// Inputs for runNav over this run against @p truth (which must outlive the call).
+  NavRunInput input(const TruthSeries& truth) const;
+};
+
+/**
+ * One emulated run in the paper's manner, shared by the Monte Carlo study and
+ * the diagnosis' navigation gain: the IMU errors added to the perfect
+ * increments (rate errors times dt), GNSS and barometer simulated along the
+ * trajectory over [t0, t1] and an initial navigation error drawn per run.
+ * Streams from @p run_seed: deriveSeed(run_seed, 1) GNSS noise, 2 baro noise,
+ * 3 initial error (the IMU error streams are the caller's).
+ * @param[in] perfect        perfect increments of the trajectory, first ending after t0.
+ * @param[in] err            per axis (gyro_x..acc_z) rate errors [rad/s, m/s^2],
+ *                           at least perfect.size() samples each.
+ * @param[in] traj           the smoothed trajectory (truth).
+ * @param[in] t0, t1         emulated span [s], t0 < t1.
+ * @param[in] gnss, baro     sensor options (their seeds are replaced).
+ * @param[in] truth0         true navigation state at t0.
+ * @param[in] initial_sigma  1-sigma initial error [m, m/s, rad] per nav state.
+ * @param[in] run_seed       the run's seed.
+ */
+EmulatedRun emulateRun(const std::vector<ins::ImuSample>& perfect,
+                       const std::array<std::vector<double>, 6>& err,
+                       const emulation::SmoothTrajectory& traj, double t0, double t1,
+                       emulation::GnssOptions gnss, emulation::BaroOptions baro,
+                       const ins::NavState& truth0, const filter::Vector9d& initial_sigma,
+                       std::uint64_t run_seed);
 
 /**
  * NEES of the four blocks for an error @p err and covariance @p P9 (the 9x9
