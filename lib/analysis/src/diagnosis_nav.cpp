@@ -21,6 +21,7 @@
 #include "navimpact/core/units.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/filter/error_model.hpp"
+#include "navimpact/filter/state_layout.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 
 namespace navimpact::analysis {
@@ -133,43 +134,6 @@ double pairedTP(const std::vector<double>& a, const std::vector<double>& b) {
   return std::min(1.0, 2.0 * boost::math::cdf(boost::math::complement(st, std::abs(t))));
 }
 
-/// The filter's version of a model: a GM whose correlation time is at most the
-/// covariance propagation interval k dt (GMWM puts the short-term noise of
-/// quantised sensors there) enters as the white noise of the same long-run
-/// variance, sigma_wn^2 = sigma^2 (1 + phi) / (1 - phi), phi = exp(-dt / T)
-/// (the AR(1) spectrum at zero frequency); the EKF covariance propagated over
-/// k dt is not kept positive definite with such a state (measured: T = 3-6 ms
-/// at t = 0.1 s, T = 10 ms during a 60 s outage, k dt = 50 ms). Applied alike
-/// to the models before and after.
-stochastic::ImuModel filterModel(const stochastic::ImuModel& m, double rate, double t_min,
-                                 int* replaced) {
-  stochastic::ImuModel f = m;
-  for (auto& a : f.axis) {
-    double add = 0;
-    std::vector<stochastic::Process> keep;
-    for (const auto& p : a.terms) {
-      if (p.kind == stochastic::ProcessKind::GM && p.T <= t_min * (1.0 + 1e-9)) {
-        const double phi = std::exp(-1.0 / (rate * p.T));
-        add += p.sigma * p.sigma * (1.0 + phi) / (1.0 - phi);
-        ++*replaced;
-      } else {
-        keep.push_back(p);
-      }
-    }
-    if (add > 0) {
-      bool merged = false;
-      for (auto& p : keep)
-        if (p.kind == stochastic::ProcessKind::WN && !merged) {
-          p.sigma = std::sqrt(p.sigma * p.sigma + add);
-          merged = true;
-        }
-      if (!merged) keep.push_back(stochastic::Process::wn(std::sqrt(add)));
-    }
-    a.terms = keep;
-  }
-  return f;
-}
-
 double mean(const std::vector<double>& x) {
   double s = 0;
   for (double v : x) s += v;
@@ -212,10 +176,12 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
     after.forChannel(c.name) = held_out ? c.model_after_half : c.model_after;
   }
   {
-    int replaced = 0;
+    // GMs with T at most the covariance propagation interval enter the filter
+    // as white noise (filter::ImuErrorOptions::white_gm_below_s); say so.
+    std::size_t replaced = 0;
+    for (const auto* m : {&before, &after})
+      replaced += filter::StateLayout::build(*m, filter::effectiveImuOptions(*m, p.nav.ekf)).notes().size();
     const double t_min = p.nav.ekf.propagate_every / p.rate;
-    before = filterModel(before, p.rate, t_min, &replaced);
-    after = filterModel(after, p.rate, t_min, &replaced);
     if (replaced > 0)
       g.filter_note = std::to_string(replaced) +
                       " Gauss-Markov term(s) with T at most the covariance propagation interval (" +
