@@ -21,6 +21,7 @@
 #include "navimpact/core/output.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
+#include "navimpact/report/diagnosis_report.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 
@@ -151,9 +152,9 @@ int run(const Opts& o) {
     in["nav_runs"] = o.nav_runs;
   }
   const auto figs =
-      na::diagnosisFigures(d, [&out](const std::string& n) { return out.stage(n).string(); });
-  out.writeText("diagnosis.json", na::diagnosisJson(d, in.dump()));
-  out.writeText("report.md", na::diagnosisReport(d, figs));
+      navimpact::report::diagnosisFigures(d, [&out](const std::string& n) { return out.stage(n).string(); });
+  out.writeText("diagnosis.json", navimpact::report::diagnosisJson(d, in.dump()));
+  out.writeText("report.md", navimpact::report::diagnosisReport(d, figs));
   std::string comment = "extended by navimpact diagnose from " + o.in.input + " (model " + o.model +
                         ", seed " + std::to_string(o.seed) + ")";
   out.writeText("model_extended.yaml", st::toYaml(d.model_after, comment));

@@ -279,22 +279,11 @@ struct Diagnosis {
 Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
                    const DiagnoseOptions& opt = {});
 
-/// diagnosis.json text (see README "diagnose"); @p input_json is copied under "input".
-std::string diagnosisJson(const Diagnosis& d, const std::string& input_json);
+/// Short number formatting for reports ("3.1e-05", "45.2").
+std::string fmtNum(double v, int digits = 3);
 
-/// report.md text; @p figures are the PNG names to link.
-std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& figures);
-
-/**
- * Render the figures (PNG): an overview of the measured WV vs the simulated
- * envelope of every channel with the misfit scales marked; per channel with
- * findings the extended model's fit and, where a line was found, the spectrum.
- * @param[in] path_for  maps a file name ("wv_envelope.png") to the path to write
- *                      (e.g. OutputSet::stage).
- * @return the file names written.
- */
-std::vector<std::string> diagnosisFigures(
-    const Diagnosis& d, const std::function<std::string(const std::string&)>& path_for);
+/// Unit name of a channel's SI unit ("rad/s" or "m/s^2").
+std::string channelUnit(const std::string& channel);
 
 // ---------------------------------------------------------------------------
 // Building blocks (exposed for tests)

@@ -6,13 +6,15 @@
 
 #include <nlohmann/json.hpp>
 
-#include "diagnosis_internal.hpp"
 #include "navimpact/analysis/diagnosis.hpp"
 #include "navimpact/plot/figure.hpp"
+#include "navimpact/report/diagnosis_report.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
-namespace navimpact::analysis {
+namespace navimpact::report {
+
+using namespace analysis;
 
 namespace {
 
@@ -469,4 +471,4 @@ std::vector<std::string> diagnosisFigures(
   return names;
 }
 
-}  // namespace navimpact::analysis
+}  // namespace navimpact::report
