@@ -10,6 +10,7 @@
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
+#include "navimpact/report/study_report.hpp"
 
 namespace {
 
@@ -55,7 +56,7 @@ int runStudyCmd(const StudyOpts& o) {
 
   navimpact::OutputSet out(o.out);
   if (shard.whole()) {
-    an::writeStudyOutputs(res, out);
+    navimpact::report::writeStudyOutputs(res, out);
     out.commit();
     printSummary(res, o.out);
   } else {
@@ -70,7 +71,7 @@ int runStudyCmd(const StudyOpts& o) {
 int runMergeCmd(const MergeOpts& o) {
   const an::StudyResults res = an::mergeShards(o.dirs);
   navimpact::OutputSet out(o.out);
-  an::writeStudyOutputs(res, out);
+  navimpact::report::writeStudyOutputs(res, out);
   out.commit();
   printSummary(res, o.out);
   return 0;

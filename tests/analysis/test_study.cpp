@@ -11,6 +11,7 @@
 
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/report/study_report.hpp"
 #include "test_support.hpp"
 
 namespace an = navimpact::analysis;
@@ -145,7 +146,7 @@ TEST(StudyRuns, IndependentOfThreadsAndShardingAndPaired) {
   const auto plan = an::prepareStudy(cfg, "test");
   const an::StudyResults one = an::runStudy(plan, an::Shard{}, 1);
   const an::StudyResults two = an::runStudy(plan, an::Shard{}, 2);
-  const std::string m1 = an::studyMetricsJson(one), m2 = an::studyMetricsJson(two);
+  const std::string m1 = navimpact::report::studyMetricsJson(one), m2 = navimpact::report::studyMetricsJson(two);
   EXPECT_EQ(m1, m2) << "metrics depend on the thread count";
 
   // Shards 1/2 and 2/2 written to disk and merged: the same metrics, bit for bit.
@@ -160,7 +161,7 @@ TEST(StudyRuns, IndependentOfThreadsAndShardingAndPaired) {
     dirs.push_back(dir.string());
   }
   const an::StudyResults merged = an::mergeShards(dirs);
-  EXPECT_EQ(an::studyMetricsJson(merged), m1) << "merged shards differ from the unsharded study";
+  EXPECT_EQ(navimpact::report::studyMetricsJson(merged), m1) << "merged shards differ from the unsharded study";
 
   // Missing shard: a clear error.
   EXPECT_THROW(an::mergeShards({dirs[0]}), navimpact::Error);
@@ -174,7 +175,7 @@ TEST(StudyRuns, IndependentOfThreadsAndShardingAndPaired) {
 
   // The outputs are written (study.json, CSV, figures, report).
   navimpact::OutputSet out(test::tempDir() / "study");
-  an::writeStudyOutputs(merged, out);
+  navimpact::report::writeStudyOutputs(merged, out);
   out.commit();
   for (const char* f : {"study.json", "timeseries.csv", "report.md", "fig_gyroscope_errors_o1.png",
                         "fig_gyroscope_nees_o1.png", "fig_accelerometer_outage_end.png"})

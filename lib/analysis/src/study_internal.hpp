@@ -1,4 +1,4 @@
-// Internal helpers shared by study.cpp and study_report.cpp.
+// Internal helpers of study.cpp.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -223,15 +223,6 @@ void writeShard(const StudyResults& r, OutputSet& out);
  */
 StudyResults mergeShards(const std::vector<std::string>& dirs);
 
-/**
- * Write study.json, timeseries.csv, figures (fig_<set>_errors_o<k>.png,
- * fig_<set>_nees_o<k>.png, fig_<set>_outage_end.png) and report.md.
- */
-void writeStudyOutputs(const StudyResults& r, OutputSet& out);
-
-/// The metrics part of study.json (no timings): used by tests to compare runs.
-std::string studyMetricsJson(const StudyResults& r);
-
 /// Two-sided 95 % band of the average NEES of @p runs runs with @p dof dof.
 std::pair<double, double> aneesBand(std::size_t runs, int dof, double confidence = 0.95);
 

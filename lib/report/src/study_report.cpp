@@ -5,13 +5,17 @@
 #include <limits>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/plot/figure.hpp"
-#include "study_internal.hpp"
+#include "navimpact/report/study_report.hpp"
 
-namespace navimpact::analysis {
+namespace navimpact::report {
+
+using namespace analysis;
 
 using nlohmann::json;
 
@@ -632,4 +636,4 @@ void writeStudyOutputs(const StudyResults& r, OutputSet& out) {
   out.writeText("report.md", report(v, figs));
 }
 
-}  // namespace navimpact::analysis
+}  // namespace navimpact::report
