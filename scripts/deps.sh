@@ -11,6 +11,7 @@ PKGS=(
   libmrpt-system-dev libmrpt-config-dev
   libopencv-dev libopencv-contrib-dev fonts-dejavu-core
   libgtest-dev libbenchmark-dev
+  slurm-wlm munge
 )
 missing=()
 for p in "${PKGS[@]}"; do
