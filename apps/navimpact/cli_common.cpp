@@ -11,6 +11,11 @@ std::vector<Command>& registry() {
   return r;
 }
 
+void addOverwriteFlag(CLI::App& app, bool& flag) {
+  app.add_flag("--overwrite", flag,
+               "replace an existing, non-empty output whole (default: refuse it before any work)");
+}
+
 bool stderrIsTerminal() { return isatty(fileno(stderr)) != 0; }
 
 Progress::Progress(std::string label, std::size_t total)

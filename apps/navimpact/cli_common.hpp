@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "navimpact/core/output.hpp"
+
 namespace navimpact::cli {
 
 /// A sub-command: setup() declares its options on the CLI11 sub-app and
@@ -22,6 +24,12 @@ std::vector<Command>& registry();
 struct Registrar {
   explicit Registrar(Command c) { registry().push_back(std::move(c)); }
 };
+
+/// Declare --overwrite on a command that writes an output folder or file:
+/// without it a non-empty output is refused before any work; with it the
+/// output is replaced whole when the job succeeds.
+void addOverwriteFlag(CLI::App& app, bool& flag);
+inline Overwrite overwriteMode(bool flag) { return flag ? Overwrite::Replace : Overwrite::Refuse; }
 
 /// True when stderr is a terminal (progress bars are shown only then).
 bool stderrIsTerminal();

@@ -18,6 +18,7 @@ struct Opts {
   std::string out;
   bool print_states = false;
   std::string trajectory;
+  bool overwrite = false;
 };
 
 navimpact::cli::Registrar reg({
@@ -35,8 +36,10 @@ navimpact::cli::Registrar reg({
                      "roll_rad, pitch_rad, yaw_rad) instead of the static state");
       app.add_flag("--print-states", o->print_states,
                    "print the filter state layout of every model before running");
+      navimpact::cli::addOverwriteFlag(app, o->overwrite);
       return [o]() -> int {
         namespace an = navimpact::analysis;
+        navimpact::OutputSet out(o->out, navimpact::cli::overwriteMode(o->overwrite));
         const an::CovarianceStudyConfig cfg = an::loadCovarianceStudyConfig(o->config);
         if (o->print_states) {
           for (const auto& set : cfg.model_sets)
@@ -55,7 +58,6 @@ navimpact::cli::Registrar reg({
             o->trajectory.empty() ? an::runCovarianceStudy(cfg, tick)
                                   : an::runCovarianceStudyAlongTrajectory(cfg, o->trajectory, tick);
         bar.finish();
-        navimpact::OutputSet out(o->out);
         an::writeCovarianceStudy(cfg, res, out);
         out.commit();
         // short report, human units

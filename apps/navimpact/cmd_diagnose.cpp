@@ -42,6 +42,7 @@ struct Opts {
   std::uint64_t seed = 20261121;
   double alpha = 0.01;
   int threads = 0;
+  bool overwrite = false;
 };
 
 /// `fit:SPEC`: fit the structure to each channel of the data first (GMWM).
@@ -98,6 +99,7 @@ int run(const Opts& o) {
   st::ImuModel model;
   if (fit) st::parseStructure(o.model.substr(4));
   else model = st::loadImuModel(o.model);
+  navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
 
   navimpact::cli::InputFormat fmt = navimpact::cli::InputFormat::Csv;
   const navimpact::ImuSeries data = navimpact::cli::loadInput(o.in, &fmt);
@@ -134,7 +136,6 @@ int run(const Opts& o) {
     nbar.finish();
   }
 
-  navimpact::OutputSet out(o.out);
   nlohmann::json in = {{"file", o.in.input},
                        {"format", fmt == navimpact::cli::InputFormat::Rawlog ? "rawlog" : "csv"},
                        {"units", navimpact::cli::inputUnitsNote(o.in, fmt)},
@@ -207,6 +208,7 @@ navimpact::cli::Registrar reg(
                       "paired navigation runs (recording windows x GNSS/baro noise), >= 2")
            ->capture_default_str();
        app.add_option("--out", o->out, "output directory")->required();
+       navimpact::cli::addOverwriteFlag(app, o->overwrite);
        app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel")
            ->capture_default_str();
        app.add_option("--seed", o->seed, "root seed")->capture_default_str();

@@ -17,6 +17,7 @@ struct Opts {
   bool no_gzip = false;
   bool no_gt = false;
   int gzip_level = 1;
+  bool overwrite = false;
 };
 
 navimpact::cli::Registrar reg({
@@ -33,17 +34,17 @@ navimpact::cli::Registrar reg({
           ->check(CLI::Range(1, 9));
       app.add_flag("--no-gt", o->no_gt,
                    "leave out the ground-truth records (label GT), like the rawlog of a real flight");
+      navimpact::cli::addOverwriteFlag(app, o->overwrite);
       return [o]() -> int {
         namespace fs = std::filesystem;
+        auto outs = navimpact::OutputSet::singleFile(o->out, navimpact::cli::overwriteMode(o->overwrite));
         const auto cfg = navimpact::emulation::loadEmulationConfig(o->config);
         auto data = navimpact::emulation::runEmulation(cfg, NAVIMPACT_VERSION);
         if (o->no_gt) {
           data.truth.clear();
           data.notices.push_back("--no-gt: ground-truth records (label GT) left out of the rawlog");
         }
-        const fs::path outPath(o->out);
-        navimpact::OutputSet outs(outPath.has_parent_path() ? outPath.parent_path() : fs::path("."));
-        const auto staged = outs.stage(outPath.filename().string());
+        const auto staged = outs.stagedFile();
         navimpact::rawlog::RawlogWriteOptions wo;
         wo.gzip = !o->no_gzip;
         wo.gzip_level = o->gzip_level;

@@ -47,6 +47,7 @@ struct Opts {
   std::string weights = "r";
   std::uint64_t seed = 20190101;
   std::string out;
+  bool overwrite = false;
 };
 
 struct ChannelFit {
@@ -138,6 +139,7 @@ int run(const Opts& o) {
   const bool autoSel = o.structure == "auto";
   std::vector<st::ProcessKind> structure;
   if (!autoSel) structure = st::parseStructure(o.structure);
+  navimpact::OutputSet outs(o.out, navimpact::cli::overwriteMode(o.overwrite));
   if (o.bootstrap < 0) throw navimpact::Error("--bootstrap must be >= 0, got " + std::to_string(o.bootstrap));
   if (o.max_gm < 0 || o.max_gm > 3) throw navimpact::Error("--max-gm must be in 0..3");
   if (o.weights != "r" && o.weights != "model" && o.weights != "efficient")
@@ -292,7 +294,6 @@ int run(const Opts& o) {
     j["channels"].push_back(cj);
   }
 
-  navimpact::OutputSet outs(o.out);
   std::ostringstream comment;
   comment << "GMWM fit by navimpact " << NAVIMPACT_VERSION << " of " << input << ", structure " << j["structure"].get<std::string>()
           << ", seed " << o.seed;
@@ -359,6 +360,7 @@ navimpact::cli::Registrar reg({
                      "model-based diagonal) or efficient (inverse of the full WV covariance)");
       app.add_option("--seed", o->seed, "seed of the bootstrap");
       app.add_option("--out", o->out, "output directory (model.yaml, fit.json, fit_*.png)")->required();
+      navimpact::cli::addOverwriteFlag(app, o->overwrite);
       return [o]() -> int { return run(*o); };
     }});
 

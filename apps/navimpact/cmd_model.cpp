@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "cli_common.hpp"
@@ -25,6 +27,7 @@ struct Opts {
   std::string file;
   double rate_hz = 0.0;
   std::string out;
+  bool overwrite = false;
 };
 
 std::string fmtRate(double hz) {
@@ -85,6 +88,8 @@ int runList(const Opts& o) {
 }
 
 int runConvert(const Opts& o) {
+  std::optional<navimpact::OutputSet> set;
+  if (!o.out.empty()) set.emplace(navimpact::OutputSet::singleFile(o.out, navimpact::cli::overwriteMode(o.overwrite)));
   const st::ImuModel m = st::loadImuModel(o.spec);
   const st::ImuModel c = st::convertRate(m, o.rate_hz);
   const std::string note = "converted from " + fmtRate(m.rate_hz) + " to " + fmtRate(o.rate_hz);
@@ -94,10 +99,13 @@ int runConvert(const Opts& o) {
     std::cout << yaml;
     return 0;
   }
-  const std::filesystem::path out(o.out);
-  navimpact::OutputSet set(out.has_parent_path() ? out.parent_path() : std::filesystem::path("."));
-  set.writeText(out.filename().string(), yaml);
-  set.commit();
+  {
+    std::ofstream f(set->stagedFile(), std::ios::binary);
+    f << yaml;
+    f.close();
+    if (!f) throw navimpact::Error(o.out + ": cannot write");
+  }
+  set->commit();
   std::cout << m.source << ": " << note << ", wrote " << o.out << "\n";
   return 0;
 }
@@ -115,6 +123,7 @@ navimpact::cli::Registrar reg({"model", "Inspect IMU error model files (show, li
   conv->add_option("--rate", o->rate_hz, "New sampling rate [Hz]")->required()->check(
       CLI::PositiveNumber);
   conv->add_option("--out", o->out, "Write the converted single-model YAML file here");
+  navimpact::cli::addOverwriteFlag(*conv, o->overwrite);
   return [o, show, list, conv]() -> int {
     if (show->parsed()) return runShow(*o);
     if (list->parsed()) return runList(*o);

@@ -14,6 +14,7 @@ struct Opts {
   std::string rawlog, config, model, out;
   std::vector<std::string> outages;
   int propagate_every = 0;
+  bool overwrite = false;
 };
 
 navimpact::cli::Registrar reg({
@@ -32,7 +33,9 @@ navimpact::cli::Registrar reg({
       app.add_option("--propagate-every", o->propagate_every,
                      "propagate the covariance every k IMU samples (default 10)");
       app.add_option("--out", o->out, "output folder")->required();
+      navimpact::cli::addOverwriteFlag(app, o->overwrite);
       return [o]() -> int {
+        navimpact::OutputSet out(o->out, navimpact::cli::overwriteMode(o->overwrite));
         navimpact::analysis::ReplayConfig cfg;
         if (!o->config.empty()) cfg = navimpact::analysis::loadReplayConfig(o->config);
         if (!o->rawlog.empty()) cfg.rawlog = o->rawlog;
@@ -43,7 +46,6 @@ navimpact::cli::Registrar reg({
         }
         if (o->propagate_every > 0) cfg.propagate_every = o->propagate_every;
         const auto r = navimpact::analysis::runReplay(cfg);
-        navimpact::OutputSet out(o->out);
         out.writeText("solution.csv", navimpact::analysis::solutionCsv(r));
         out.writeText("summary.json", navimpact::analysis::summaryJson(r));
         const auto staged = out.stage("errors_full.png").parent_path();

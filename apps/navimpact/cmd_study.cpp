@@ -21,11 +21,13 @@ struct StudyOpts {
   long long runs = -1;
   long long seed = -1;
   int threads = -1;
+  bool overwrite = false;
 };
 
 struct MergeOpts {
   std::vector<std::string> dirs;
   std::string out;
+  bool overwrite = false;
 };
 
 void printSummary(const an::StudyResults& r, const std::string& dir) {
@@ -35,6 +37,7 @@ void printSummary(const an::StudyResults& r, const std::string& dir) {
 }
 
 int runStudyCmd(const StudyOpts& o) {
+  navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
   an::StudyConfig cfg = an::loadStudyConfig(o.config);
   if (o.runs >= 0) {
     if (o.runs < 1) throw navimpact::Error("--runs must be >= 1, got " + std::to_string(o.runs));
@@ -54,7 +57,6 @@ int runStudyCmd(const StudyOpts& o) {
       an::runStudy(plan, shard, threads, [&bar](std::size_t done, std::size_t) { bar.update(done); });
   bar.finish();
 
-  navimpact::OutputSet out(o.out);
   if (shard.whole()) {
     navimpact::report::writeStudyOutputs(res, out);
     out.commit();
@@ -69,8 +71,8 @@ int runStudyCmd(const StudyOpts& o) {
 }
 
 int runMergeCmd(const MergeOpts& o) {
+  navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
   const an::StudyResults res = an::mergeShards(o.dirs);
-  navimpact::OutputSet out(o.out);
   navimpact::report::writeStudyOutputs(res, out);
   out.commit();
   printSummary(res, o.out);
@@ -84,6 +86,7 @@ navimpact::cli::Registrar regStudy({"study",
                                       app.add_option("--config", o->config, "study YAML (e.g. config/paper/study_navchip_uav.yaml)")
                                           ->required();
                                       app.add_option("--out", o->out, "output folder")->required();
+                                      navimpact::cli::addOverwriteFlag(app, o->overwrite);
                                       app.add_option("--runs", o->runs, "Monte Carlo runs (overrides the config)");
                                       app.add_option("--seed", o->seed, "study seed (overrides the config)");
                                       app.add_option("--threads", o->threads,
@@ -99,6 +102,7 @@ navimpact::cli::Registrar regMerge({"study-merge", "Merge study shards (navimpac
                                       auto o = std::make_shared<MergeOpts>();
                                       app.add_option("dirs", o->dirs, "shard folders")->required();
                                       app.add_option("--out", o->out, "output folder")->required();
+                                      navimpact::cli::addOverwriteFlag(app, o->overwrite);
                                       return [o]() -> int { return runMergeCmd(*o); };
                                     }});
 

@@ -28,6 +28,7 @@ struct Opts {
   double eff = 0.6;
   bool allan = false;
   std::string out;
+  bool overwrite = false;
 };
 
 std::string squaredUnit(navimpact::units::Quantity q) {
@@ -43,6 +44,7 @@ std::string g6(double v) {
 }
 
 int run(const Opts& o) {
+  navimpact::OutputSet outs(o.out, navimpact::cli::overwriteMode(o.overwrite));
   navimpact::cli::InputFormat fmt;
   const navimpact::ImuSeries s = navimpact::cli::loadInput(o.in, &fmt);
   gm::WvOptions wo;
@@ -95,7 +97,6 @@ int run(const Opts& o) {
           << w.ci_low[i] << ',' << w.ci_high[i] << '\n';
   }
 
-  navimpact::OutputSet outs(o.out);
   outs.writeText("wv.json", j.dump(2) + "\n");
   outs.writeText("wv.csv", csv.str());
   // One log-log figure per sensor: the axes present, each with its CI band.
@@ -158,6 +159,7 @@ navimpact::cli::Registrar reg({"wv",
                                  app.add_flag("--allan", o->allan,
                                               "also write overlapping Allan deviations");
                                  app.add_option("--out", o->out, "output directory")->required();
+                                 navimpact::cli::addOverwriteFlag(app, o->overwrite);
                                  return [o]() -> int { return run(*o); };
                                }});
 

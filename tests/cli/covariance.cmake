@@ -71,12 +71,14 @@ _cov_bad(wrong_unit "model_file: ${_models}\nduration_s: 2\nstatic_state: {lat_r
          "static_state\\.lat_rad.*unknown key.*lat_deg")
 _cov_bad(wrong_type "model_file: ${_models}\nduration_s: sixty\nstatic_state: {lat_deg: 46.5}\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
          "duration_s.*expected a number in s")
+_cov_bad(duplicate_set_name "model_file: ${_models}\n${_base}model_sets: [{name: a, models: [acc_ref]}, {name: a, models: [gyro_ref]}]\n"
+         "model_sets\\[1\\]\\.name.*'a' is used by an earlier model set")
 _cov_bad(negative_baro_sigma "model_file: ${_models}\n${_base}baro: {rate_hz: 10, sigma_m: -1}\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
          "baro\\.sigma_m.*> 0")
 
 # covariance-only propagation along the committed UAV trajectory (5 s)
 add_test(NAME cli_covariance_trajectory
-         COMMAND ${NI} covariance --config ${_cdir}/short.yaml --out ${_cdir}/out_traj
+         COMMAND ${NI} covariance --config ${_cdir}/short.yaml --out ${_cdir}/out_traj --overwrite
                  --trajectory ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz)
 set_tests_properties(cli_covariance_trajectory PROPERTIES PASS_REGULAR_EXPRESSION "gyro_ref +5\\.0")
 add_test(NAME cli_covariance_bad_trajectory

@@ -22,7 +22,7 @@ imu:
 ")
 
 add_test(NAME cli_emulate_uav30
-  COMMAND ${NI} emulate --config ${_edir}/uav30.yaml --out ${_edir}/uav30.rawlog)
+  COMMAND ${NI} emulate --config ${_edir}/uav30.yaml --out ${_edir}/uav30.rawlog --overwrite)
 set_tests_properties(cli_emulate_uav30 PROPERTIES FIXTURES_SETUP emu_rawlog
   PASS_REGULAR_EXPRESSION "IMU 6000 samples at 200 Hz, GNSS 31 fixes, BARO 301, GT 301")
 
@@ -79,11 +79,11 @@ add_test(NAME cli_emulate_static_rate_mismatch
 # --gzip-level: the fast default and the smallest level both round-trip through
 # the reader (replay of the level-9 file runs); an out-of-range level is refused.
 add_test(NAME cli_emulate_gzip9
-  COMMAND ${NI} emulate --config ${_edir}/uav30.yaml --out ${_edir}/uav30_l9.rawlog --gzip-level 9)
+  COMMAND ${NI} emulate --config ${_edir}/uav30.yaml --out ${_edir}/uav30_l9.rawlog --gzip-level 9 --overwrite)
 set_tests_properties(cli_emulate_gzip9 PROPERTIES FIXTURES_SETUP emu_rawlog_l9
   PASS_REGULAR_EXPRESSION "IMU 6000 samples at 200 Hz")
 add_test(NAME cli_emulate_gzip9_replays
-  COMMAND ${NI} replay --rawlog ${_edir}/uav30_l9.rawlog --outage 10:5 --out ${_edir}/replay_l9)
+  COMMAND ${NI} replay --rawlog ${_edir}/uav30_l9.rawlog --outage 10:5 --out ${_edir}/replay_l9 --overwrite)
 set_tests_properties(cli_emulate_gzip9_replays PROPERTIES FIXTURES_REQUIRED emu_rawlog_l9
   PASS_REGULAR_EXPRESSION "wrote .*solution.csv")
 add_test(NAME cli_emulate_bad_gzip_level

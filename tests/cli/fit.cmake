@@ -58,7 +58,7 @@ endforeach()
 
 add_test(NAME cli_fit_wn_gm
   COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GM
-          --seed 7 --out ${_fdir}/wn_gm)
+          --seed 7 --out ${_fdir}/wn_gm --overwrite)
 set_tests_properties(cli_fit_wn_gm PROPERTIES
   PASS_REGULAR_EXPRESSION "gyro_x: WN\\(sigma=[0-9.e-]+\\) \\+ GM\\(sigma=[0-9.e-]+, T=[0-9.e+-]+\\).*objective.*ARW.*acc_z: WN"
   FIXTURES_SETUP fit_wn_gm)
@@ -76,7 +76,7 @@ set_tests_properties(cli_fit_json PROPERTIES FIXTURES_REQUIRED fit_wn_gm)
 # automatic selection on two channels prints the reason and ranks the candidates
 add_test(NAME cli_fit_auto
   COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure auto
-          --max-gm 2 --channels gyro_x,acc_z --out ${_fdir}/auto)
+          --max-gm 2 --channels gyro_x,acc_z --out ${_fdir}/auto --overwrite)
 set_tests_properties(cli_fit_auto PROPERTIES
   PASS_REGULAR_EXPRESSION "gyro_x: .*picked [A-Z+]+: criterion .*acc_z: .*picked [A-Z+]+: criterion")
 
@@ -142,7 +142,7 @@ set_tests_properties(cli_fit_weights_default_r PROPERTIES FIXTURES_REQUIRED fit_
 
 add_test(NAME cli_fit_weights_efficient
   COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GM+DR
-          --channels gyro_x,acc_z --weights efficient --out ${_fdir}/eff)
+          --channels gyro_x,acc_z --weights efficient --out ${_fdir}/eff --overwrite)
 set_tests_properties(cli_fit_weights_efficient PROPERTIES
   PASS_REGULAR_EXPRESSION "gyro_x: WN.*objective [0-9.e+-]+ \\(efficient weights, R objective [0-9.e+-]+\\).*acc_z: WN"
   FIXTURES_SETUP fit_eff)
@@ -162,7 +162,7 @@ add_test(NAME cli_fit_bad_weights
 # leaves WN at ~1e-66; the console says so and fit.json flags it.
 add_test(NAME cli_fit_negligible_term
   COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GM+RW+DR
-          --channels gyro_x --out ${_fdir}/neg)
+          --channels gyro_x --out ${_fdir}/neg --overwrite)
 set_tests_properties(cli_fit_negligible_term PROPERTIES
   PASS_REGULAR_EXPRESSION "negligible: term 1 WN\\(sigma=[0-9.e-]+\\) \\(its WV is below 0.1 of the WV's 95 % CI width at every scale[^\n]*kept: the requested structure has it\\)"
   FIXTURES_SETUP fit_neg)

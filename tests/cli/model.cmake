@@ -27,7 +27,7 @@ set_tests_properties(cli_model_list PROPERTIES PASS_REGULAR_EXPRESSION
 
 # convert to 100 Hz, then show the written file: WN sigma scales by sqrt(1/2).
 add_test(NAME cli_model_convert
-  COMMAND ${NI} model convert ${_models}:ref --rate 100 --out ${_mdir}/ref_100hz.yaml)
+  COMMAND ${NI} model convert ${_models}:ref --rate 100 --out ${_mdir}/ref_100hz.yaml --overwrite)
 set_tests_properties(cli_model_convert PROPERTIES
   PASS_REGULAR_EXPRESSION "converted from 200 Hz to 100 Hz"
   FIXTURES_SETUP model_100hz)

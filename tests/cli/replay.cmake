@@ -4,7 +4,7 @@ set(_rdir ${CMAKE_CURRENT_BINARY_DIR}/replay_cli)
 file(MAKE_DIRECTORY ${_rdir})
 
 add_test(NAME cli_replay_default
-  COMMAND ${NI} replay --config ${CMAKE_SOURCE_DIR}/config/replay/default.yaml --out ${_rdir}/default)
+  COMMAND ${NI} replay --config ${CMAKE_SOURCE_DIR}/config/replay/default.yaml --out ${_rdir}/default --overwrite)
 set_tests_properties(cli_replay_default PROPERTIES PASS_REGULAR_EXPRESSION
   "52000 IMU steps at 200 Hz, 201 GNSS and 2601 baro updates.*outage 1 \\(60 s from 200 s\\): horizontal error at end")
 file(WRITE ${_rdir}/check_outputs.cmake [=[

@@ -13,12 +13,12 @@ baro: {seed: 13}
 ground_truth: {rate_hz: 10}
 ")
 add_test(NAME cli_emulate_nogt
-  COMMAND ${NI} emulate --config ${_ngdir}/uav60.yaml --no-gt --out ${_ngdir}/uav60_nogt.rawlog)
+  COMMAND ${NI} emulate --config ${_ngdir}/uav60.yaml --no-gt --out ${_ngdir}/uav60_nogt.rawlog --overwrite)
 set_tests_properties(cli_emulate_nogt PROPERTIES FIXTURES_SETUP nogt_rawlog
   PASS_REGULAR_EXPRESSION "IMU 12000 samples at 200 Hz, GNSS 61 fixes, BARO 601, GT 0")
 
 add_test(NAME cli_replay_nogt
-  COMMAND ${NI} replay --rawlog ${_ngdir}/uav60_nogt.rawlog --outage 30:20 --out ${_ngdir}/out)
+  COMMAND ${NI} replay --rawlog ${_ngdir}/uav60_nogt.rawlog --outage 30:20 --out ${_ngdir}/out --overwrite)
 set_tests_properties(cli_replay_nogt PROPERTIES FIXTURES_REQUIRED nogt_rawlog FIXTURES_SETUP nogt_replay
   PASS_REGULAR_EXPRESSION "no ground truth in the rawlog.*12000 IMU steps at 200 Hz, 41 GNSS and 601 baro updates.*outage 1 \\(20 s from 30 s\\): predicted horizontal 1-sigma at end")
 

@@ -47,7 +47,7 @@ endforeach()
 ]=])
 add_test(NAME cli_wv_excerpt
   COMMAND ${NI} wv --input ${_wv_data} --rate 100 --gyro-unit deg/s --acc-unit g --allan
-          --out ${_wv_dir}/excerpt)
+          --out ${_wv_dir}/excerpt --overwrite)
 set_tests_properties(cli_wv_excerpt PROPERTIES
   PASS_REGULAR_EXPRESSION "262144 samples at 100 Hz, 18 scales")
 add_test(NAME cli_wv_excerpt_outputs
@@ -57,7 +57,7 @@ set_tests_properties(cli_wv_excerpt_outputs PROPERTIES DEPENDS cli_wv_excerpt)
 # Rawlog input (committed, 64 samples, label XSENS): reads with the right label.
 add_test(NAME cli_wv_rawlog
   COMMAND ${NI} wv --input ${CMAKE_SOURCE_DIR}/tests/data/imu_label_xsens.rawlog --label XSENS
-          --out ${_wv_dir}/rawlog)
+          --out ${_wv_dir}/rawlog --overwrite)
 set_tests_properties(cli_wv_rawlog PROPERTIES
   PASS_REGULAR_EXPRESSION "64 samples at 100 Hz, 6 scales")
 

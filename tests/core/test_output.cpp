@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -10,6 +12,29 @@
 using namespace navimpact;
 namespace fs = std::filesystem;
 
+namespace {
+
+std::vector<std::string> entries(const fs::path& dir) {
+  std::vector<std::string> v;
+  for (const auto& e : fs::directory_iterator(dir)) v.push_back(e.path().filename().string());
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+int stagingCount(const fs::path& dir) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir))
+    n += e.path().filename().string().rfind(OutputSet::kStagingPrefix, 0) == 0 ? 1 : 0;
+  return n;
+}
+
+void touch(const fs::path& p, const std::string& text = "x\n") {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p) << text;
+}
+
+}  // namespace
+
 TEST(OutputSet, NothingAppearsUntilCommit) {
   const fs::path dir = test::tempDir() / "out";
   {
@@ -18,9 +43,8 @@ TEST(OutputSet, NothingAppearsUntilCommit) {
     EXPECT_FALSE(fs::exists(dir / "a.json"));
     // destroyed without commit: a failed job leaves nothing behind
   }
-  EXPECT_FALSE(fs::exists(dir / "a.json"));
-  for (const auto& e : fs::directory_iterator(dir.parent_path()))
-    EXPECT_EQ(e.path().filename().string().find(".navimpact-staging"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir));
+  EXPECT_EQ(stagingCount(dir.parent_path()), 0);
   {
     OutputSet out(dir);
     out.writeText("a.json", "{}");
@@ -29,4 +53,127 @@ TEST(OutputSet, NothingAppearsUntilCommit) {
   }
   EXPECT_TRUE(fs::exists(dir / "a.json"));
   EXPECT_TRUE(fs::exists(dir / "sub/b.csv"));
+  EXPECT_EQ(stagingCount(dir.parent_path()), 0);
+}
+
+TEST(OutputSet, StagesInOneFolderNextToTheDestination) {
+  const fs::path base = test::tempDir();
+  OutputSet out(base / "out");
+  EXPECT_EQ(out.stagingDir().parent_path(), fs::absolute(base).lexically_normal());
+  EXPECT_EQ(out.stage("x.csv").parent_path(), out.stagingDir());
+  auto file = OutputSet::singleFile(base / "f" / "x.rawlog");
+  EXPECT_EQ(file.stagedFile().parent_path().parent_path(), fs::absolute(base / "f").lexically_normal());
+}
+
+TEST(OutputSet, RefusesANonEmptyDestinationBeforeAnyWork) {
+  const fs::path dir = test::tempDir() / "out";
+  touch(dir / "old.txt");
+  EXPECT_THROW(OutputSet out(dir), Error);
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"old.txt"});
+  EXPECT_EQ(stagingCount(dir.parent_path()), 0);
+  fs::remove(dir / "old.txt");
+  OutputSet ok(dir);  // an empty folder is fine
+  ok.writeText("a", "1");
+  ok.commit();
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"a"});
+  touch(dir.parent_path() / "file.txt");
+  EXPECT_THROW(OutputSet(dir.parent_path() / "file.txt"), Error);  // not a folder
+}
+
+TEST(OutputSet, OverwriteReplacesTheFolderWhole) {
+  const fs::path dir = test::tempDir() / "out";
+  touch(dir / "errors_outage_2.png");
+  touch(dir / "sub" / "old.csv");
+  {
+    OutputSet out(dir, Overwrite::Replace);
+    out.writeText("summary.json", "{}");
+    // failing job: the old output stays as it was
+  }
+  EXPECT_EQ(entries(dir), (std::vector<std::string>{"errors_outage_2.png", "sub"}));
+  OutputSet out(dir, Overwrite::Replace);
+  out.writeText("summary.json", "{}");
+  out.commit();
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"summary.json"});
+  EXPECT_EQ(stagingCount(dir.parent_path()), 0);
+}
+
+TEST(OutputSet, OverwriteRefusesFoldersNoOutputLooksLike) {
+  const fs::path base = test::tempDir();
+  touch(base / "project" / "src" / "lib" / "a.cpp");
+  EXPECT_THROW(OutputSet(base / "project", Overwrite::Replace), Error);
+  EXPECT_TRUE(fs::exists(base / "project" / "src" / "lib" / "a.cpp"));
+  const fs::path cwd = fs::current_path();
+  fs::current_path(base / "project" / "src");
+  EXPECT_THROW(OutputSet(".", Overwrite::Replace), Error);
+  EXPECT_THROW(OutputSet("..", Overwrite::Replace), Error);
+  fs::current_path(cwd);
+  EXPECT_THROW(OutputSet("/", Overwrite::Replace), Error);
+}
+
+TEST(OutputSet, SingleFile) {
+  const fs::path base = test::tempDir();
+  const fs::path f = base / "x.rawlog";
+  {
+    auto out = OutputSet::singleFile(f);
+    std::ofstream(out.stagedFile()) << "new";
+  }
+  EXPECT_FALSE(fs::exists(f));
+  touch(f, "old");
+  EXPECT_THROW(OutputSet::singleFile(f), Error);
+  auto out = OutputSet::singleFile(f, Overwrite::Replace);
+  std::ofstream(out.stagedFile()) << "new";
+  out.commit();
+  std::ifstream in(f);
+  std::string s;
+  in >> s;
+  EXPECT_EQ(s, "new");
+  EXPECT_EQ(entries(base), std::vector<std::string>{"x.rawlog"});
+}
+
+TEST(OutputSet, FailureRemovesTheParentsItCreated) {
+  const fs::path base = test::tempDir();
+  {
+    OutputSet out(base / "a" / "b" / "out");
+    out.writeText("x", "1");
+  }
+  EXPECT_TRUE(entries(base).empty());
+}
+
+TEST(OutputSet, OneNameTwiceIsAnError) {
+  OutputSet out(test::tempDir() / "out");
+  out.writeText("fig.png", "1");
+  EXPECT_THROW(out.writeText("fig.png", "2"), Error);
+  EXPECT_THROW(out.stage("../escape.txt"), Error);
+}
+
+// A run killed without unwinding (here: a child that _exit()s with its OutputSet alive)
+// leaves its staging folder; the next OutputSet in that folder removes it,
+// but not the staging folder of a process that is still alive.
+TEST(OutputSet, StaleStagingOfDeadRunsIsRemoved) {
+  const fs::path base = test::tempDir();
+  int status = 0;
+  const pid_t child = fork();
+  if (child == 0) {
+    auto* leak = new OutputSet(base / "killed2");  // never destroyed
+    leak->writeText("partial.csv", "1\n");
+    _exit(0);
+  }
+  ASSERT_GT(child, 0);
+  waitpid(child, &status, 0);
+  EXPECT_EQ(stagingCount(base), 1);
+  OutputSet alive(base / "alive");  // ours: alive, must survive
+  EXPECT_EQ(stagingCount(base), 1);  // the dead one was removed, ours is there
+  OutputSet other(base / "other");
+  EXPECT_EQ(stagingCount(base), 2);
+  // a folder with our prefix but not our naming scheme is left alone
+  fs::create_directories(base / (std::string(OutputSet::kStagingPrefix) + "not-ours"));
+  EXPECT_EQ(OutputSet::removeStaleStaging(base), 0);
+  // another host's staging folder: removed only when older than a week
+  const fs::path foreign = base / (std::string(OutputSet::kStagingPrefix) + "1234_0123456789abcdef_" +
+                                   "fedcba9876543210_x");
+  fs::create_directories(foreign);
+  EXPECT_EQ(OutputSet::removeStaleStaging(base), 0);
+  fs::last_write_time(foreign, fs::file_time_type::clock::now() - std::chrono::hours(24 * 8));
+  EXPECT_EQ(OutputSet::removeStaleStaging(base), 1);
+  EXPECT_FALSE(fs::exists(foreign));
 }

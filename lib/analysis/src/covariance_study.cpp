@@ -208,6 +208,9 @@ CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
     ms.name = r.str(sets[i], "name", pre, "");
     if (ms.name.empty() || ms.name.find_first_of("/\\ ,\"") != std::string::npos)
       throw keyError(path, pre + ".name", "required: a name without spaces, commas, quotes or slashes");
+    for (const auto& other : c.model_sets)
+      if (other.name == ms.name)
+        throw keyError(path, pre + ".name", "'" + ms.name + "' is used by an earlier model set (names must be unique)");
     ms.title = r.str(sets[i], "title", pre, ms.name);
     const YAML::Node ml = sets[i]["models"];
     if (!ml || !ml.IsSequence() || ml.size() == 0)

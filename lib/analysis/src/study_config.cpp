@@ -213,6 +213,9 @@ StudyConfig loadStudyConfig(const std::string& path) {
       for (char ch : s.name)
         if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-'))
           throw keyError(path, w + ".name", "'" + s.name + "': use letters, digits, _ and - only");
+      for (const auto& other : cfg.sets)
+        if (other.name == s.name)
+          throw keyError(path, w + ".name", "'" + s.name + "' is used by an earlier set (names must be unique)");
       s.title = s.name;
       opt(n, "title", c, w, s.title);
       if (!n["models"]) throw keyError(path, w + ".models", "missing");

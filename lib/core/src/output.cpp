@@ -1,5 +1,14 @@
 #include "navimpact/core/output.hpp"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <random>
 
@@ -8,58 +17,253 @@
 namespace fs = std::filesystem;
 
 namespace navimpact {
+namespace {
 
-OutputSet::OutputSet(fs::path dir) : dir_(std::move(dir)) {
-  std::random_device rd;
-  const fs::path parent = dir_.has_parent_path() ? dir_.parent_path() : fs::path(".");
+std::string hex16(std::uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+/// FNV-1a of the host name: identifies "this machine" in staging names
+/// (separator-free, unlike host names).
+std::string hostTag() {
+  char name[256] = {0};
+  if (gethostname(name, sizeof name - 1) != 0) std::strcpy(name, "unknown");
+  std::uint64_t h = 1469598103934665603ULL;
+  for (const char* p = name; *p; ++p) h = (h ^ static_cast<unsigned char>(*p)) * 1099511628211ULL;
+  return hex16(h);
+}
+
+/// True when @p folder, or one of the folders in it, contains a folder: a
+/// navimpact output is files plus at most one level of folders of files.
+bool deeperThanOneLevel(const fs::path& folder) {
   std::error_code ec;
-  fs::create_directories(parent, ec);
-  staging_ = parent / (".navimpact-staging-" + dir_.filename().string() + "-" + std::to_string(rd()));
-  fs::create_directories(staging_, ec);
-  if (ec) throw Error(staging_.string() + ": cannot create staging directory (" + ec.message() + ")");
+  for (const auto& e : fs::directory_iterator(folder, ec)) {
+    if (!e.is_directory(ec) || e.is_symlink(ec)) continue;
+    for (const auto& f : fs::directory_iterator(e.path(), ec))
+      if (f.is_directory(ec) && !f.is_symlink(ec)) return true;
+  }
+  return static_cast<bool>(ec);
+}
+
+bool isEmptyDir(const fs::path& p) {
+  std::error_code ec;
+  return fs::is_empty(p, ec) && !ec;
+}
+
+/// Why @p dest must not be replaced whole, or "" when it may be.
+std::string refuseReplace(const fs::path& dest) {
+  std::error_code ec;
+  const fs::path d = fs::weakly_canonical(dest, ec);
+  if (d == d.root_path()) return "refusing to replace the file-system root";
+  if (const char* home = std::getenv("HOME"); home && *home && fs::equivalent(d, fs::path(home), ec))
+    return "refusing to replace the home folder";
+  const fs::path cwd = fs::weakly_canonical(fs::current_path(ec), ec);
+  const auto rel = cwd.lexically_relative(d);
+  if (!rel.empty() && *rel.begin() != "..") return "refusing to replace the current folder or a folder containing it";
+  if (deeperThanOneLevel(d))
+    return "it holds folders of folders, which no navimpact output does; remove it yourself if it is meant";
+  return {};
+}
+
+}  // namespace
+
+int OutputSet::removeStaleStaging(const fs::path& folder) {
+  static const std::string self = hostTag();
+  const std::string prefix = kStagingPrefix;
+  int removed = 0;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(folder, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0 || !e.is_directory(ec)) continue;
+    // <prefix><pid>_<16 hex random>_<16 hex host>_<destination name>
+    const std::string rest = name.substr(prefix.size());
+    const auto u1 = rest.find('_');
+    if (u1 == std::string::npos || u1 == 0 || rest.size() < u1 + 35 || rest[u1 + 17] != '_' ||
+        rest[u1 + 34] != '_')
+      continue;
+    if (rest.find_first_not_of("0123456789") < u1) continue;
+    const std::string host = rest.substr(u1 + 18, 16);
+    if (host.find_first_not_of("0123456789abcdef") != std::string::npos) continue;
+    bool dead = false;
+    if (host == self) {
+      const long pid = std::strtol(rest.substr(0, u1).c_str(), nullptr, 10);
+      dead = pid > 0 && kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+    } else {  // another machine sharing this folder: only when clearly abandoned
+      const auto age = fs::file_time_type::clock::now() - fs::last_write_time(e.path(), ec);
+      dead = !ec && age > std::chrono::hours(24 * 7);
+    }
+    if (!dead) continue;
+    std::error_code rec;
+    fs::remove_all(e.path(), rec);
+    if (!rec) ++removed;
+  }
+  return removed;
+}
+
+OutputSet::OutputSet(fs::path dir, Overwrite ow) : OutputSet(std::move(dir), ow, Kind::Directory) {}
+
+OutputSet OutputSet::singleFile(fs::path file, Overwrite ow) { return OutputSet(std::move(file), ow, Kind::File); }
+
+OutputSet::OutputSet(fs::path dest, Overwrite ow, Kind kind) : dest_(std::move(dest)), ow_(ow), kind_(kind) {
+  const std::string shown = dest_.string();
+  if (shown.empty()) throw Error("output path is empty");
+  std::error_code ec;
+  fs::path abs = fs::absolute(dest_, ec).lexically_normal();
+  if (!abs.has_filename()) abs = abs.parent_path();
+  if (abs == abs.root_path()) throw Error(shown + ": refusing to write an output onto the file-system root");
+  const fs::path parent = abs.parent_path();
+
+  // Missing parent folders are created now and removed again if the job fails.
+  std::vector<fs::path> missing;
+  for (fs::path p = parent; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    missing.push_back(p);
+    if (p == p.root_path()) break;
+  }
+  for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+    if (!fs::create_directory(*it, ec) || ec) {
+      removeCreatedParents();
+      throw Error(it->string() + ": cannot create folder for " + shown + " (" + ec.message() + ")");
+    }
+    createdParents_.push_back(*it);
+  }
+  if (!fs::is_directory(parent, ec)) throw Error(parent.string() + ": not a folder (output " + shown + ")");
+
+  removeStaleStaging(parent);
+
+  try {
+    const auto st = fs::symlink_status(abs, ec);
+    if (fs::exists(st)) {
+      if (kind_ == Kind::Directory) {
+        if (!fs::is_directory(st)) throw Error(shown + ": exists and is not a folder (an output folder is expected)");
+        if (!isEmptyDir(abs)) {
+          if (ow_ == Overwrite::Refuse)
+            throw Error(shown + ": output folder exists and is not empty (pass --overwrite to replace it whole)");
+          if (const auto why = refuseReplace(abs); !why.empty()) throw Error(shown + ": --overwrite: " + why);
+        }
+      } else {
+        if (fs::is_directory(st)) throw Error(shown + ": is a folder (an output file is expected)");
+        if (ow_ == Overwrite::Refuse) throw Error(shown + ": output file exists (pass --overwrite to replace it)");
+      }
+    }
+    std::random_device rd;
+    const std::uint64_t r = (static_cast<std::uint64_t>(rd()) << 32) ^ rd();
+    static const std::string host = hostTag();
+    staging_ = parent / (std::string(kStagingPrefix) + std::to_string(getpid()) + "_" + hex16(r) + "_" + host +
+                         "_" + abs.filename().string());
+    if (!fs::create_directory(staging_, ec) || ec)
+      throw Error(parent.string() + ": cannot create the staging folder for " + shown + " (" +
+                  (ec ? ec.message() : std::string("exists")) + ")");
+  } catch (...) {
+    staging_.clear();
+    removeCreatedParents();
+    throw;
+  }
+  target_ = abs;
+}
+
+OutputSet::OutputSet(OutputSet&& o) noexcept
+    : dest_(std::move(o.dest_)),
+      target_(std::move(o.target_)),
+      staging_(std::move(o.staging_)),
+      createdParents_(std::move(o.createdParents_)),
+      names_(std::move(o.names_)),
+      ow_(o.ow_),
+      kind_(o.kind_),
+      committed_(o.committed_) {
+  o.staging_.clear();
+  o.createdParents_.clear();
+  o.committed_ = true;
 }
 
 OutputSet::~OutputSet() {
+  if (committed_ || staging_.empty()) return;
   std::error_code ec;
   fs::remove_all(staging_, ec);
+  removeCreatedParents();
+}
+
+void OutputSet::removeCreatedParents() noexcept {
+  std::error_code ec;
+  for (auto it = createdParents_.rbegin(); it != createdParents_.rend(); ++it) fs::remove(*it, ec);  // only if empty
+  createdParents_.clear();
 }
 
 fs::path OutputSet::stage(const std::string& name) {
-  names_.push_back(name);
-  const fs::path p = staging_ / name;
+  if (kind_ != Kind::Directory) throw Error(dest_.string() + ": stage() on a single-file output");
+  const fs::path rel = fs::path(name).lexically_normal();
+  if (rel.empty() || rel.is_absolute() || *rel.begin() == "..")
+    throw Error(dest_.string() + ": output name '" + name + "' is not inside the output folder");
+  for (const auto& n : names_)
+    if (n == rel.string()) throw Error(dest_.string() + ": output '" + n + "' written twice by one job");
+  names_.push_back(rel.string());
+  const fs::path p = staging_ / rel;
   std::error_code ec;
   fs::create_directories(p.parent_path(), ec);
+  if (ec) throw Error(p.parent_path().string() + ": cannot create (" + ec.message() + ")");
   return p;
+}
+
+fs::path OutputSet::stagedFile() const {
+  if (kind_ != Kind::File) throw Error(dest_.string() + ": stagedFile() on a folder output");
+  return staging_ / target_.filename();
 }
 
 void OutputSet::writeText(const std::string& name, const std::string& content) {
   const fs::path p = stage(name);
   std::ofstream f(p, std::ios::binary);
   f << content;
+  f.close();
   if (!f) throw Error(p.string() + ": cannot write");
 }
 
 void OutputSet::commit() {
-  std::error_code ec;
-  fs::create_directories(dir_, ec);
-  if (ec) throw Error(dir_.string() + ": cannot create output directory (" + ec.message() + ")");
-  for (const auto& n : names_) {
-    const fs::path dst = dir_ / n;
-    fs::create_directories(dst.parent_path(), ec);
-    fs::rename(staging_ / n, dst, ec);
-    if (ec) {
-      // Different file systems: copy then remove.
-      ec.clear();
-      fs::copy_file(staging_ / n, dst, fs::copy_options::overwrite_existing, ec);
-      if (ec) throw Error(dst.string() + ": cannot write (" + ec.message() + ")");
+  if (committed_) throw Error(dest_.string() + ": output committed twice");
+  const std::string shown = dest_.string();
+  if (kind_ == Kind::File) {
+    const fs::path src = stagedFile();
+    std::error_code ec;
+    if (!fs::exists(src, ec)) throw Error(shown + ": nothing was written");
+    if (ow_ == Overwrite::Refuse && fs::exists(fs::symlink_status(target_, ec)))
+      throw Error(shown + ": output file appeared while the job ran (pass --overwrite to replace it)");
+    if (std::rename(src.c_str(), target_.c_str()) != 0)
+      throw Error(shown + ": cannot move the output into place (" + std::strerror(errno) + ")");
+    fs::remove_all(staging_, ec);
+  } else {
+    if (::rename(staging_.c_str(), target_.c_str()) != 0) {
+      const int err = errno;
+      if ((err != ENOTEMPTY && err != EEXIST) || ow_ == Overwrite::Refuse)
+        throw Error(shown + ": cannot move the output into place (" +
+                    (err == ENOTEMPTY || err == EEXIST ? std::string("the folder was filled while the job ran")
+                                                       : std::string(std::strerror(err))) +
+                    ")");
+      if (const auto why = refuseReplace(target_); !why.empty()) throw Error(shown + ": --overwrite: " + why);
+      // Replace whole: swap the two folders atomically, then delete the old one
+      // (now at the staging name, so a crash here leaves only a stale staging folder).
+      if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) != 0) {
+        const fs::path old = staging_.string() + ".old";
+        if (::rename(target_.c_str(), old.c_str()) != 0)
+          throw Error(shown + ": cannot replace the output folder (" + std::strerror(errno) + ")");
+        if (::rename(staging_.c_str(), target_.c_str()) != 0) {
+          const int e2 = errno;
+          ::rename(old.c_str(), target_.c_str());
+          throw Error(shown + ": cannot replace the output folder (" + std::strerror(e2) + ")");
+        }
+        staging_ = old;
+      }
+      std::error_code ec;
+      fs::remove_all(staging_, ec);
     }
   }
   committed_ = true;
+  createdParents_.clear();
 }
 
 std::vector<fs::path> OutputSet::finalPaths() const {
   std::vector<fs::path> out;
-  for (const auto& n : names_) out.push_back(dir_ / n);
+  if (kind_ == Kind::File) return {dest_};
+  for (const auto& n : names_) out.push_back(dest_ / n);
   return out;
 }
 
