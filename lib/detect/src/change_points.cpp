@@ -1,0 +1,171 @@
+// Level shifts under a correlated noise model (see change_points.hpp).
+#include "navimpact/detect/change_points.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <boost/math/distributions/normal.hpp>
+
+#include "navimpact/core/error.hpp"
+#include "robust.hpp"
+
+namespace navimpact::detect {
+
+namespace {
+
+constexpr double kLn2Pi = 1.8378770664093453;
+
+struct Scale {
+  std::size_t m = 0, stride = 1, positions = 0;
+  double sd = 0, threshold = 0;
+};
+
+/// Mean of x over [a, b) from prefix sums.
+inline double meanOf(const std::vector<double>& S, std::size_t a, std::size_t b) {
+  return (S[b] - S[a]) / static_cast<double>(b - a);
+}
+
+std::vector<double> prefix(const std::vector<double>& x) {
+  std::vector<double> S(x.size() + 1, 0.0);
+  double mean = 0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(std::max<std::size_t>(1, x.size()));
+  for (std::size_t k = 0; k < x.size(); ++k) S[k + 1] = S[k] + (x[k] - mean);
+  return S;
+}
+
+/// Fraction of [a, b) at or after c.
+inline double fracAfter(std::size_t a, std::size_t b, std::size_t c) {
+  if (c <= a) return 1.0;
+  if (c >= b) return 0.0;
+  return static_cast<double>(b - c) / static_cast<double>(b - a);
+}
+
+}  // namespace
+
+ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunction& null_wv,
+                                     double alpha, const ChangePointOptions& opt) {
+  if (!(alpha > 0 && alpha < 1)) throw Error("detectChangePoints: alpha must be in (0, 1)");
+  const std::size_t n = x.size();
+  ChangePointResult res;
+  if (n < 4 * std::max<std::size_t>(1, opt.min_half_width)) return res;
+  // Scales and their null sd / thresholds (the robust part from the record
+  // as given; steps affect few windows at the scales where it is used).
+  std::vector<Scale> scales;
+  for (double mf = static_cast<double>(opt.min_half_width); 2.0 * std::floor(mf) <= static_cast<double>(n);
+       mf *= opt.scale_ratio) {
+    const std::size_t m = static_cast<std::size_t>(std::floor(mf));
+    if (!scales.empty() && scales.back().m == m) continue;
+    Scale s;
+    s.m = m;
+    s.stride = std::max<std::size_t>(1, m / 8);
+    s.positions = (n - 2 * m) / s.stride + 1;
+    scales.push_back(s);
+  }
+  const double J = static_cast<double>(scales.size());
+  res.scales_tested = static_cast<int>(scales.size());
+  {
+    const auto S = prefix(x);
+    for (auto& s : scales) {
+      const double v = null_wv(2.0 * static_cast<double>(s.m));
+      s.sd = 2.0 * std::sqrt(std::max(0.0, v));
+      const double indep = static_cast<double>(n) / (2.0 * static_cast<double>(s.m));
+      if (indep >= 64) {
+        const std::size_t step = std::max<std::size_t>(s.stride, (n - 2 * s.m) / 8192 + 1);
+        std::vector<double> d;
+        for (std::size_t k = s.m; k + s.m <= n; k += step)
+          d.push_back(meanOf(S, k, k + s.m) - meanOf(S, k - s.m, k));
+        s.sd = std::max(s.sd, madScale(d));
+      }
+      s.threshold = twoSidedNormalQuantile(alpha / (J * static_cast<double>(s.positions)));
+    }
+  }
+  for (int it = 0; it < opt.max_changes; ++it) {
+    const auto S = prefix(x);
+    ChangePoint best;
+    double best_excess = 1.0;
+    for (const auto& s : scales) {
+      if (!(s.sd > 0)) continue;
+      double dmax = 0;
+      std::size_t kmax = 0;
+      for (std::size_t k = s.m; k + s.m <= n; k += s.stride) {
+        const double d = meanOf(S, k, k + s.m) - meanOf(S, k - s.m, k);
+        if (std::abs(d) > std::abs(dmax)) {
+          dmax = d;
+          kmax = k;
+        }
+      }
+      const double z = std::abs(dmax) / s.sd;
+      if (z / s.threshold > best_excess) {
+        best_excess = z / s.threshold;
+        best.index = kmax;
+        best.contrast = dmax;
+        best.half_width = s.m;
+        best.sd = s.sd;
+        best.z = z;
+        best.threshold = s.threshold;
+        const double p1 = 2.0 * boost::math::cdf(boost::math::complement(boost::math::normal(), z));
+        best.p_value = std::min(1.0, p1 * J * static_cast<double>(s.positions));
+      }
+    }
+    if (best.half_width == 0) break;
+    // Locate the change inside the detecting window [k - m, k + m) by the
+    // likelihood ratio of one change in a mean (CUSUM weighted by
+    // sqrt((j - a)(b - j) / (b - a))): the largest contrast over the grid may
+    // sit at a window edge when the window cannot be centred on the change.
+    {
+      const std::size_t m = best.half_width;
+      const std::size_t a = best.index - m, b = best.index + m;
+      const double tot = S[b] - S[a], len = static_cast<double>(b - a);
+      double tbest = -1;
+      std::size_t jbest = best.index;
+      for (std::size_t j = a + 1; j < b; ++j) {
+        const double l = static_cast<double>(j - a);
+        const double t = std::abs(S[j] - S[a] - l / len * tot) / std::sqrt(l * (len - l) / len);
+        if (t > tbest) {
+          tbest = t;
+          jbest = j;
+        }
+      }
+      best.index = jbest;
+      // The contrast at the located change with the window m clipped to the record.
+      const std::size_t mm = std::min({m, jbest, n - jbest});
+      if (mm >= 1) best.contrast = meanOf(S, jbest, jbest + mm) - meanOf(S, jbest - mm, jbest);
+    }
+    // Size from the adjacent segments, bounded by the changes already found
+    // and by 4 m on each side (a longer window adds noise of a random walk).
+    const std::size_t m = best.half_width;
+    std::size_t a = best.index > 4 * m ? best.index - 4 * m : 0;
+    std::size_t b = std::min(n, best.index + 4 * m);
+    for (const auto& c : res.changes) {
+      if (c.index < best.index) a = std::max(a, c.index);
+      else b = std::min(b, c.index);
+    }
+    best.size = (b > best.index && best.index > a)
+                    ? meanOf(S, best.index, b) - meanOf(S, a, best.index)
+                    : best.contrast;
+    for (std::size_t k = best.index; k < n; ++k) x[k] -= best.size;
+    res.changes.push_back(best);
+  }
+  return res;
+}
+
+double contrastLogLikelihood(const std::vector<double>& x, const HaarWvFunction& wv,
+                             const std::vector<ChangePoint>& changes) {
+  const std::size_t n = x.size();
+  const auto S = prefix(x);
+  double ll = 0;
+  for (std::size_t m = 16; 4 * m <= n; m *= 2) {
+    const double sd = 2.0 * std::sqrt(std::max(1e-300, wv(2.0 * static_cast<double>(m))));
+    for (std::size_t k = m; k + m <= n; k += m) {
+      double d = meanOf(S, k, k + m) - meanOf(S, k - m, k);
+      for (const auto& c : changes)
+        d -= c.size * (fracAfter(k, k + m, c.index) - fracAfter(k - m, k, c.index));
+      ll += -0.5 * (kLn2Pi + 2.0 * std::log(sd) + d * d / (sd * sd));
+    }
+  }
+  return ll;
+}
+
+}  // namespace navimpact::detect
