@@ -38,7 +38,7 @@ struct Opts {
   std::string traj_system = "geodetic";
   int nav_runs = 10;
   std::string out;
-  int simulations = 16;
+  int simulations = 8;
   std::uint64_t seed = 20261121;
   double alpha = 0.01;
   int threads = 0;

@@ -8,9 +8,11 @@
 
 namespace navimpact::analysis {
 
-/// Refine a line's frequency on the whole record (zoomed DFT), fit its
-/// amplitude by least squares and subtract it from @p x (spectrum.cpp).
-LineResult refineAndRemoveLine(std::vector<double>& x, double rate_hz, int segment_length,
-                               const LineResult& coarse);
+/**
+ * Chi-square (gamma) deviance of measured WV @p nu_hat against model WV @p nu
+ * with dof @p eta: sum eta_j (nu_hat/nu - log(nu_hat/nu) - 1).
+ */
+double wvDeviance(const std::vector<double>& nu_hat, const std::vector<double>& nu,
+                  const std::vector<double>& eta);
 
 }  // namespace navimpact::analysis

@@ -148,6 +148,53 @@ ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunctio
     for (std::size_t k = best.index; k < n; ++k) x[k] -= best.size;
     res.changes.push_back(best);
   }
+  // Clusters of changes closer than their detecting windows.
+  std::vector<ChangePoint> byIndex = res.changes;
+  std::sort(byIndex.begin(), byIndex.end(),
+            [](const ChangePoint& a, const ChangePoint& b) { return a.index < b.index; });
+  std::vector<ChangePoint> kept;
+  for (std::size_t i = 0; i < byIndex.size();) {
+    std::size_t j = i;
+    while (j + 1 < byIndex.size() &&
+           byIndex[j + 1].index - byIndex[j].index <= std::min(byIndex[j].half_width, byIndex[j + 1].half_width))
+      ++j;
+    if (j == i) {
+      kept.push_back(byIndex[i]);
+      ++i;
+      continue;
+    }
+    double net = 0, level = 0, peak = 0, maxabs = 0;
+    std::size_t strongest = i;
+    for (std::size_t q = i; q <= j; ++q) {
+      net += byIndex[q].size;
+      level += byIndex[q].size;
+      if (std::abs(level) > std::abs(peak)) peak = level;
+      maxabs = std::max(maxabs, std::abs(byIndex[q].size));
+      if (byIndex[q].z / byIndex[q].threshold > byIndex[strongest].z / byIndex[strongest].threshold) strongest = q;
+    }
+    if (std::abs(net) < 0.5 * maxabs) {
+      Transient t;
+      t.first = byIndex[i].index;
+      t.last = byIndex[j].index;
+      t.peak = peak;
+      t.z = byIndex[strongest].z;
+      t.threshold = byIndex[strongest].threshold;
+      t.p_value = byIndex[strongest].p_value;
+      t.half_width = byIndex[strongest].half_width;
+      res.transients.push_back(t);
+    } else {
+      ChangePoint c = byIndex[strongest];
+      c.size = net;
+      kept.push_back(c);
+    }
+    i = j + 1;
+  }
+  // Back to detection order (strongest first) for the changes kept.
+  std::vector<ChangePoint> ordered;
+  for (const auto& c : res.changes)
+    for (const auto& k : kept)
+      if (k.index == c.index && k.half_width == c.half_width) ordered.push_back(k);
+  res.changes = ordered;
   return res;
 }
 

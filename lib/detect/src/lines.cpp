@@ -243,6 +243,14 @@ LineTestResult detectLines(std::vector<double>& x, double fs, const PsdFunction&
   res.f_max_hz = static_cast<double>(k_hi) * fs / static_cast<double>(nfft);
   // K counts FFT bins (correlated where zero padded): a conservative Bonferroni.
   res.threshold = std::log(std::max(1, K) / alpha);
+  // Against the local level B the threshold is raised for B's own noise: log B
+  // is a mean of about m = 2 (W - G) log-periodogram values (variance
+  // pi^2/6 each, x1.5 for the correlation of Hann-tapered neighbours), and
+  // E exp(-c B/B_true) ~ exp(-c + c^2 s^2 / 2) for log-normal B.
+  const double m_eff = 2.0 * (opt.background_half_width - opt.guard_bins);
+  const double s2 = 1.6449 * 1.5 / std::max(1.0, m_eff);
+  const double threshold_local =
+      res.threshold / std::max(0.5, 1.0 - 0.5 * res.threshold * s2);
 
   // Plot arrays (before subtraction).
   {
@@ -266,7 +274,8 @@ LineTestResult detectLines(std::vector<double>& x, double fs, const PsdFunction&
     double rbest = 0;
     for (std::size_t k = k_lo; k <= k_hi && k < nb; ++k) {
       if (!tested[k]) continue;
-      const double bg = std::max(E[k], B[k]);
+      // Ratio to the threshold-equivalent background: E x 1 or B x c_B / c.
+      const double bg = std::max(E[k], B[k] * threshold_local / res.threshold);
       if (!(bg > 0)) continue;
       const double r = I[k] / bg;
       if (r > rbest) {
@@ -280,7 +289,7 @@ LineTestResult detectLines(std::vector<double>& x, double fs, const PsdFunction&
     L.model_ratio = E[kbest] > 0 ? I[kbest] / E[kbest] : INFINITY;
     L.local_ratio = B[kbest] > 0 ? I[kbest] / B[kbest] : INFINITY;
     L.p_value = std::min(1.0, static_cast<double>(K) * std::exp(-rbest));
-    L.background_psd = std::max(E[kbest], B[kbest]);
+    L.background_psd = std::max(E[kbest], B[kbest] * threshold_local / res.threshold);
     // Refine: zoomed tapered DFT over +-1 natural bin, grid of 41 + parabola.
     const double f0 = static_cast<double>(kbest) * fs / static_cast<double>(nfft);
     const Zoom zm(y, f0, fs, 1.2 * res.bin_hz);

@@ -37,6 +37,15 @@ json findingJson(const Finding& f) {
   j["action"] = f.action;
   j["statistic"] = num(f.statistic);
   j["threshold"] = num(f.threshold);
+  j["p_value"] = num(f.p_value);
+  if (!f.intervals.empty()) {
+    json iv = json::object();
+    for (const auto& kv : f.intervals) iv[kv.first] = {num(kv.second.first), num(kv.second.second)};
+    j["intervals_95"] = iv;
+  }
+  if (!f.evidence.empty()) j["evidence"] = f.evidence;
+  if (!f.harmonics_hz.empty()) j["harmonics_hz"] = f.harmonics_hz;
+  if (f.event >= 0) j["event"] = f.event;
   return j;
 }
 
@@ -101,20 +110,30 @@ std::string diagnosisJson(const Diagnosis& d, const std::string& input_json) {
                   {"deviance", {{"before", num(c.gain.deviance_before)},
                                 {"after", num(c.gain.deviance_after)}}},
                   {"added_params", c.gain.added_params},
+                  {"test", c.gain.test},
+                  {"z", num(c.gain.z)},
                   {"p_value", num(c.gain.p_value)},
+                  {"direction", c.gain.direction},
                   {"significant", c.gain.significant}};
     if (!c.refit_full.empty())
       cj["gmwm_refit"] = {{"whole_record", c.refit_full}, {"first_half", c.refit_half}};
     cj["wv_per_scale_p_threshold"] = c.wv_threshold_p;
     cj["scales"] = scalesJson(c.scales);
-    cj["spectrum"] = {{"segments", c.spectrum.segments},
-                      {"segment_length", c.spectrum.segment_length},
-                      {"dof", c.spectrum.dof},
+    cj["spectrum"] = {{"method", "Hann periodogram of the whole record vs max(model PSD, local level)"},
+                      {"bin_hz", c.spectrum.bin_hz},
+                      {"bins_tested", c.spectrum.bins_tested},
+                      {"band_hz", {c.spectrum.f_min_hz, c.spectrum.f_max_hz}},
                       {"line_threshold_ratio", c.spectrum.threshold_ratio},
                       {"lines_hz", c.line_freqs_hz}};
+    if (!c.notes.empty()) cj["notes"] = c.notes;
     chans.push_back(cj);
   }
   j["channels"] = chans;
+  json evs = json::array();
+  for (const auto& e : d.events)
+    evs.push_back({{"cause", causeName(e.cause)}, {"t_s", e.t_s}, {"duration_s", e.duration_s},
+                   {"channels", e.channels}, {"sizes", e.sizes}});
+  j["events"] = evs;
   if (d.navigation) {
     const NavGain& g = *d.navigation;
     json nav;
@@ -440,21 +459,20 @@ std::vector<std::string> diagnosisFigures(
       plot::Figure fig;
       fig.width = 1200;
       fig.height = 700;
-      fig.title = c.name + ": Welch spectrum, lines beyond the family-wise threshold";
+      fig.title = c.name + ": periodogram, lines beyond the family-wise threshold";
       plot::Axes ax;
       ax.xlabel = "frequency [Hz]";
       ax.ylabel = "PSD [(" + channelUnit(c.name) + ")^2/Hz]";
       ax.logx = ax.logy = true;
       plot::Series psd{"measured PSD", {}, {}, {0, 0, 0}};
       psd.width = 1.0;
-      plot::Series bg{"background (running median)", {}, {}, plot::palette(1)};
+      plot::Series bg{"background max(model, local level)", {}, {}, plot::palette(1)};
       plot::Series th{"line threshold", {}, {}, {213, 94, 0}, plot::LineStyle::Dashed};
       for (std::size_t k = 1; k < c.spectrum.psd.size(); ++k) {
         if (!(c.spectrum.psd[k] > 0)) continue;
         psd.x.push_back(c.spectrum.freq_hz[k]);
         psd.y.push_back(c.spectrum.psd[k]);
-        if (c.spectrum.background.size() == c.spectrum.psd.size() &&
-            static_cast<int>(k) >= c.spectrum.first_tested_bin && c.spectrum.background[k] > 0) {
+        if (c.spectrum.background.size() == c.spectrum.psd.size() && c.spectrum.background[k] > 0) {
           bg.x.push_back(c.spectrum.freq_hz[k]);
           bg.y.push_back(c.spectrum.background[k]);
           th.x.push_back(c.spectrum.freq_hz[k]);

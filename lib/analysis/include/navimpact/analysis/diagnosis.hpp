@@ -4,37 +4,39 @@
  *        model gets wrong on a measured static recording, why, and how much an
  *        extended model gains.
  *
- * Pipeline per channel (all channels in parallel, see diagnose()):
- *  1. time domain, where the wavelet variance (WV) is blind or distorted:
- *     isolated spikes (robust z-score of the second difference, Bonferroni
- *     over samples) and level shifts (multi-scale maximum of the Haar
- *     coefficients against their robust scale, Bonferroni over positions and
- *     scales); both are removed before the next steps;
- *  2. spectrum: Welch periodogram against a running-median background;
- *     narrow-band lines beyond a chi-square threshold (Bonferroni over bins)
- *     are sinusoids; their frequency is refined on the whole record and they
- *     are subtracted;
- *  3. WV: measured Haar WV of the cleaned record against the model's
- *     theoretical WV with its chi-square CI (eta_j = max(M_j / 2^j, 1),
- *     Percival & Walden 2000 §8.4; lowered to the dof seen in the model's own
- *     simulations where those are fewer), family-wise level by Bonferroni over
- *     scales and channels; a Monte-Carlo envelope from seeded simulations;
- *  4. cause: the excess is matched against each process family (add WN, QN,
- *     RW, DR, GM, or retune one term of the model, the other terms kept) by
- *     minimising the chi-square (gamma) deviance of the WV on the FIRST half of
- *     the record, choosing by AIC = deviance + 2 p (a penalised criterion in
- *     the spirit of the WIC, Guerrier et al. 2013); the chosen extension is
- *     refitted on the whole record for the reported parameters and the model
- *     file, repeated while scales remain outside the family-wise CI;
- *  5. gain: the first-half extension and the user's model are both judged on
- *     the SECOND half (held out): GMWM objective, deviance, scales outside the
- *     95 % CI; significance by a chi-square test on the held-out deviance drop.
+ * Pipeline per channel (all channels in parallel, see diagnose()); the
+ * detectors are lib/detect's, each calibrated under the user's model:
+ *  1. outlier events: second-difference exceedances (scale max(model, MAD)),
+ *     clusters of consecutive spikes (a knock) are one event; interpolated out;
+ *  2. spectral lines: Hann periodogram of the whole record against
+ *     max(model PSD, the record's local level), Bonferroni over bins, from 4
+ *     cycles per record to Nyquist; harmonics are one finding; subtracted;
+ *  3. level shifts: equal-window contrasts scaled by the model's Haar WV
+ *     (valid under random walks and Gauss-Markov noise), detect-and-remove;
+ *     accepted only when they explain the record better than the best
+ *     stochastic alternative (RW, DR or GM added to the model, fitted to the
+ *     WV) by a multi-scale Gaussian pseudo-likelihood with an AIC penalty;
+ *  4. WV: measured Haar WV of the cleaned record against the model's WV with
+ *     its chi-square CI (eta_j = max(M_j / 2^j, 1), Percival & Walden 2000
+ *     §8.4; lowered to the dof seen in the model's own simulations where
+ *     those are fewer), Bonferroni over scales; the excess is matched against
+ *     each process family (add WN, QN, RW, DR, GM with T <= record/5, or
+ *     retune one term) by the chi-square (gamma) deviance on the FIRST half,
+ *     chosen by AIC = deviance + 2 p; the runner-up is reported; a term that
+ *     changes the WV by less than the CI width at every scale, or has a
+ *     vanishing parameter, is not a finding;
+ *  5. gain: the first-half extension and the user's model are judged on the
+ *     SECOND half (held out): GMWM objective, deviance, and a one-sided
+ *     paired (Vuong-type) z test of the per-scale deviances; "significant"
+ *     only when both held-out criteria improved and the test rejects.
  *
  * The family-wise level alpha (default 1 % for the whole record) is split over
- * the four test families (WV 40 %, spectrum 20 %, level shifts 20 %, spikes
+ * the four test families (WV 40 %, spectrum 20 %, level shifts 20 %, outliers
  * 20 %), each Bonferroni-corrected over its channels and elements, so that data
  * drawn from the model itself are called adequate with probability >= 1 - alpha
- * (up to the normal/chi-square approximations stated above).
+ * (up to the asymptotic approximations of each detector).
+ * Events at the same time on several channels (a knock, a temperature jump)
+ * are listed once in Diagnosis::events and still as a finding per channel.
  */
 #pragma once
 
@@ -88,6 +90,13 @@ struct Finding {
   std::string action;                                   ///< what to do about it
   double statistic = 0.0;   ///< test statistic that triggered it (z or ratio)
   double threshold = 0.0;   ///< its family-wise threshold
+  double p_value = 1.0;     ///< family-wise adjusted p-value of the detection
+  /// 95 % intervals of parameters, by key (e.g. "freq_hz", "amplitude", "T", "gamma").
+  std::vector<std::pair<std::string, std::pair<double, double>>> intervals;
+  /// Why this cause and not the runner-up explanation (one sentence).
+  std::string evidence;
+  std::vector<double> harmonics_hz;  ///< sinusoid: harmonics of the line found with it [Hz]
+  int event = -1;                    ///< index in Diagnosis::events (cross-channel), -1 if none
   double get(const std::string& key) const;             ///< params lookup (NaN if absent)
 };
 
@@ -108,15 +117,14 @@ struct ScaleCheck {
   bool significant = false;  ///< outside at the family-wise level
 };
 
-/// Welch spectrum of a channel and its line test.
+/// Spectrum of a channel and its line test (decimated for plots).
 struct SpectrumCheck {
-  std::vector<double> freq_hz;     ///< bin frequencies [Hz]
-  std::vector<double> psd;         ///< one-sided PSD [unit^2/Hz]
-  std::vector<double> background;  ///< running-median background [unit^2/Hz]
+  std::vector<double> freq_hz;     ///< frequencies [Hz]
+  std::vector<double> psd;         ///< Hann periodogram, block maxima, two-sided [unit^2/Hz]
+  std::vector<double> background;  ///< max(model PSD, local level) [unit^2/Hz]
   double threshold_ratio = 0;      ///< family-wise line threshold on psd/background
-  double dof = 0;                  ///< equivalent dof of the Welch estimate
-  int segments = 0, segment_length = 0;
-  int first_tested_bin = 0, last_tested_bin = 0;
+  int bins_tested = 0;
+  double bin_hz = 0, f_min_hz = 0, f_max_hz = 0;
 };
 
 /// Held-out comparison of the model before and after extension.
@@ -127,8 +135,11 @@ struct GainCheck {
   int outside_before = 0, outside_after = 0;          ///< scales outside the 95 % CI
   int scales = 0;
   int added_params = 0;
-  double p_value = 1;                ///< chi-square test of the deviance drop
-  bool significant = false;          ///< p_value < 0.05 and the deviance dropped
+  std::string test;                  ///< the test used, in words
+  double z = 0;                      ///< its statistic (positive: after fits better)
+  double p_value = 1;                ///< one-sided p-value (H1: the extension fits better)
+  std::string direction;             ///< "better", "worse" or "mixed" (deviance and objective)
+  bool significant = false;          ///< both criteria better AND p_value < 0.05
 };
 
 /// Diagnosis of one channel.
@@ -149,11 +160,25 @@ struct ChannelDiagnosis {
   /// How the extended structure was refitted by GMWM (whole record / first half):
   /// "gmwm (...)" or "start kept (...)"; empty when nothing was added.
   std::string refit_full, refit_half;
+  std::vector<std::string> notes;       ///< e.g. candidate steps explained by a random walk
+  /// Outlier events of this channel: start [s], length [s], peak deviation [SI].
+  struct OutlierSpan {
+    double t_s = 0, duration_s = 0, size = 0;
+  };
+  std::vector<OutlierSpan> outlier_events;
+};
+
+/// One event seen at the same time on several channels (listed once).
+struct Event {
+  Cause cause = Cause::Outliers;        ///< level_shift or outliers
+  double t_s = 0, duration_s = 0;       ///< start [s] and length [s]
+  std::vector<std::string> channels;
+  std::vector<double> sizes;            ///< per channel: step size or peak deviation [SI]
 };
 
 /// Options of diagnose().
 struct DiagnoseOptions {
-  int simulations = 16;          ///< Monte-Carlo simulations of the model per channel (>= 2)
+  int simulations = 8;           ///< Monte-Carlo simulations of the model per channel (0 or >= 2)
   std::uint64_t seed = 20261121; ///< root seed (simulations: deriveSeed(seed, 1000 c + s))
   double alpha = 0.01;           ///< family-wise level for the whole record, in (0, 0.5)
   int max_terms = 3;             ///< most processes added per channel
@@ -263,6 +288,7 @@ struct Diagnosis {
   stochastic::ImuModel model_before;  ///< at the data rate
   stochastic::ImuModel model_after;
   std::vector<std::string> notices;   ///< e.g. rate conversion
+  std::vector<Event> events;          ///< events on two or more channels at once
   DiagnoseOptions options;
   std::optional<NavGain> navigation;  ///< with a trajectory (addNavigationGain)
 };
@@ -284,68 +310,5 @@ std::string fmtNum(double v, int digits = 3);
 
 /// Unit name of a channel's SI unit ("rad/s" or "m/s^2").
 std::string channelUnit(const std::string& channel);
-
-// ---------------------------------------------------------------------------
-// Building blocks (exposed for tests)
-
-/// Isolated spikes found by detectSpikes().
-struct SpikeResult {
-  std::vector<std::size_t> index;   ///< sample indices
-  std::vector<double> size;         ///< spike heights [unit]
-  double scale = 0;                 ///< robust std of the second difference [unit]
-  double threshold = 0;             ///< z threshold used
-};
-
-/**
- * Spikes: r_k = x_k - (x_{k-1} + x_{k+1}) / 2 beyond @p z_threshold robust
- * standard deviations (1.4826 MAD), with both neighbours of opposite sign and
- * about half the size (what a single-sample spike does, unlike a step).
- */
-SpikeResult detectSpikes(const std::vector<double>& x, double z_threshold);
-
-/// One level shift.
-struct StepResult {
-  std::size_t index = 0;   ///< first sample after the step
-  double size = 0;         ///< [unit]
-  double z = 0;            ///< Haar coefficient / robust scale at the detecting scale
-  double threshold = 0;
-  int level = 0;           ///< detecting Haar level j (scale 2^j samples)
-};
-
-/**
- * Level shifts by the multi-scale Haar maximum test, at most @p max_steps,
- * each removed from @p x (x[k >= index] -= size) before the next search.
- * @param[in] alpha  family-wise level of one search, split (Bonferroni) over
- *                   the levels tested and the positions of each level.
- * @param[out] levels_tested  number of Haar levels tested (optional).
- */
-std::vector<StepResult> detectSteps(std::vector<double>& x, double alpha,
-                                    int max_steps = 5, int* levels_tested = nullptr);
-
-/// Welch PSD (Hann window, 50 % overlap, per-segment linear detrend).
-SpectrumCheck welch(const std::vector<double>& x, double rate_hz, int segment_length);
-
-/// A spectral line.
-struct LineResult {
-  double freq_hz = 0;
-  double amplitude = 0;
-  double ratio = 0;   ///< peak psd / background
-};
-
-/**
- * Lines beyond the Bonferroni threshold for @p alpha over the tested bins;
- * fills spec.background and spec.threshold_ratio. Frequencies are Gaussian-
- * interpolated Welch peaks (diagnose() refines them on the whole record of
- * @p x and fits the amplitudes by least squares).
- */
-std::vector<LineResult> detectLines(const std::vector<double>& x, double rate_hz,
-                                    SpectrumCheck& spec, double alpha);
-
-/**
- * Chi-square (gamma) deviance of measured WV @p nu_hat against model WV @p nu
- * with dof @p eta: sum eta_j (nu_hat/nu - log(nu_hat/nu) - 1).
- */
-double wvDeviance(const std::vector<double>& nu_hat, const std::vector<double>& nu,
-                  const std::vector<double>& eta);
 
 }  // namespace navimpact::analysis

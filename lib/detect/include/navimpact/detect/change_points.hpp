@@ -18,7 +18,9 @@
  * half-width, Bonferroni over its P_m grid positions (two-sided normal).
  * Multiple changes by detect-and-remove (binary segmentation's greedy
  * variant): the most significant change is removed from the rest of the
- * record and the search repeated.
+ * record and the search repeated. Changes closer than their detecting
+ * windows whose sizes cancel are reported as one transient; those whose
+ * sizes do not cancel are merged into one change.
  */
 #pragma once
 
@@ -48,8 +50,18 @@ struct ChangePoint {
   double p_value = 1;          ///< Bonferroni-adjusted p-value
 };
 
+/// Changes closer together than their detecting windows whose sizes cancel
+/// (net below half the largest): a transient (a knock, a bump), not shifts.
+struct Transient {
+  std::size_t first = 0, last = 0;  ///< first and last change index
+  double peak = 0;                  ///< largest level reached relative to before [unit]
+  double z = 0, threshold = 0, p_value = 1;  ///< of its strongest change
+  std::size_t half_width = 0;       ///< detecting window of its strongest change [samples]
+};
+
 struct ChangePointResult {
-  std::vector<ChangePoint> changes;  ///< in order of detection
+  std::vector<ChangePoint> changes;  ///< in order of detection (transients taken out)
+  std::vector<Transient> transients;
   int scales_tested = 0;
 };
 

@@ -9,12 +9,13 @@
  * (Brillinger 1981 §5.2; Percival & Walden 1993 §6.6). The ratio
  * R_k = I_k / max(E_k, B_k) is tested at every bin from a few cycles per
  * record up to Nyquist, B_k being the record's own local level: a
- * least-squares line of log I against log f over +-40 bins (the +-3 bins
+ * least-squares line of log I against log f over +-100 bins (the +-3 bins
  * around k left out) plus Euler's gamma (E log Exp(1) = -gamma), which
  * follows power-law slopes. max(E, B) >= E, so under the null
  * P(R_k > c) <= e^{-c} exactly as for the model alone, and a broadband misfit
  * of the model (a missing Gauss-Markov process, more white noise) raises B
- * instead of making lines. Family-wise level alpha by Bonferroni over the
+ * instead of making lines; where B is the larger, the threshold is raised
+ * for B's own estimation noise (log-normal, variance 1.5 pi^2 / 6 / m). Family-wise level alpha by Bonferroni over the
  * K tested bins: c = ln(K / alpha). Lines are found one at a time
  * (strongest first), refined on the whole record (zoomed DFT), fitted by
  * least squares and subtracted; harmonics of a line are tagged.
@@ -33,7 +34,7 @@ using PsdFunction = std::function<double(double f_hz)>;
 struct LineTestOptions {
   double min_cycles = 4.0;        ///< lowest frequency tested [cycles per record]
   int max_lines = 12;             ///< most lines found per record
-  int background_half_width = 40; ///< local background half width [bins]
+  int background_half_width = 100;///< local background half width [bins]
   int guard_bins = 3;             ///< bins on each side left out of the local background
   std::vector<double> exclude_hz; ///< lines the model already has (+-4 bins not tested)
   int max_harmonic = 12;          ///< highest harmonic number tagged
