@@ -380,12 +380,16 @@ Candidate fitCandidate(bool retune, int term, ProcessKind kind, const Model& mod
         lo = std::min(lo, Ts[i]);
         hi = std::max(hi, Ts[i]);
       }
-    c.T_lo = lo;
-    c.T_hi = hi;
+    // The grid resolves T to one grid step at best: never narrower than that.
+    c.T_lo = std::min(lo, Ts[std::max(0, gi - 1)]);
+    c.T_hi = std::max(hi, Ts[std::min(G, gi + 1)]);
     // A GM whose T the data do not bound below a fifth of the record (best
     // T at the top of the grid, or its 95 % profile interval reaching it) is
-    // a random walk or a drift over this record.
-    c.T_hi_open = gi >= G - 1 || lT >= std::log(Ts[G - 1]) || devs[G] <= best + 3.84;
+    // a random walk or a drift over this record; one at the bottom (one
+    // sample) is white noise. Either is left to those candidates.
+    c.T_hi_open = gi >= G - 1 || lT >= std::log(Ts[G - 1]) || devs[G] <= best + 3.84 ||
+                  // T at the bottom of the grid (one sample): white noise, not a GM
+                  gi <= 1 || lT <= std::log(Ts[1]);
     c.p_lo = c.p_hi = kNaN;
   }
   if (retune) {

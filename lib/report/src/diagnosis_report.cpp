@@ -85,11 +85,11 @@ std::string diagnosisJson(const Diagnosis& d, const std::string& input_json) {
       {"alpha_split", {{"wv", 0.4}, {"spectrum", 0.2}, {"level_shift", 0.2}, {"outliers", 0.2}}},
       {"simulations", d.options.simulations},
       {"seed", d.options.seed},
-      {"cause_selection", "gamma-deviance WV fit of each family on the first half, AIC"},
+      {"cause_selection", "gamma-deviance WV fit of each family on the whole cleaned record, AIC; level shifts against the best stochastic extension by a penalised multi-scale contrast likelihood"},
       {"extension", "GMWM refit of the extended structure warm-started at the user's "
                     "parameters plus the findings (first half for the gain, whole record for "
                     "the model file), kept when it does not raise the deviance"},
-      {"gain", "held-out second half (first-half fit) when a process was fitted"}};
+      {"gain", "held-out second half (first-half fit) when a process was fitted; one-sided paired z test over scales; significant only when deviance and objective improved and p < 0.05"}};
   json chans = json::array();
   for (const auto& c : d.channels) {
     json cj;
@@ -179,121 +179,217 @@ std::string diagnosisJson(const Diagnosis& d, const std::string& input_json) {
   return j.dump(2) + "\n";
 }
 
+namespace {
+
+/// Parameter with its unit and 95 % interval, e.g. "T = 0.0223 s (0.019–0.027)".
+std::string paramText(const Finding& f, const std::string& key, double v) {
+  const std::string unit = channelUnit(f.channel);
+  std::string u;
+  if (key == "T" || key == "t_s") u = " s";
+  else if (key == "freq_hz") u = " Hz";
+  else if (key == "omega") u = " " + unit + "/sample";
+  else if (key != "count") u = " " + unit;
+  std::string name = key == "t_s" ? "t" : key == "freq_hz" ? "f" : key;
+  std::string s = name + " = " + fmtNum(v, key == "t_s" || key == "freq_hz" ? 6 : 3);
+  for (const auto& kv : f.intervals)
+    if (kv.first == key) {
+      const std::string lo = fmtNum(kv.second.first, 2), hi = fmtNum(kv.second.second, 2);
+      if (lo == hi) s += " ± " + fmtNum(0.5 * (kv.second.second - kv.second.first), 1);
+      else s += " (" + lo + "–" + hi + ")";
+    }
+  return s + u;
+}
+
+std::string shortAction(const Finding& f) {
+  switch (f.cause) {
+    case Cause::WhiteNoise:
+    case Cause::QuantizationNoise: return f.direction == "overstated" ? "lower it in the model" : "raise it in the model";
+    case Cause::RandomWalk:
+    case Cause::Drift:
+    case Cause::GaussMarkov: return f.direction == "overstated" ? "retune the term" : "add the term";
+    case Cause::Sinusoid: return "add SIN terms or notch it";
+    case Cause::LevelShift: return "segment the record there";
+    case Cause::Outliers: return "remove before fitting";
+  }
+  return "";
+}
+
+std::string strength(double p) {
+  if (!(p >= 0)) return "—";
+  if (p < 1e-12) return "p < 1e-12";
+  return "p = " + fmtNum(p, 2);
+}
+
+}  // namespace
+
 std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& figures) {
   std::ostringstream r;
   r << "# IMU error model diagnosis\n\n";
-  r << "Input: `" << d.source << "`, " << d.samples << " samples at " << fmtNum(d.rate_hz, 6)
-    << " Hz (" << fmtNum(d.samples / d.rate_hz, 5) << " s). Model: `" << d.model_before.source
-    << "`.\n\n";
-  for (const auto& n : d.notices) r << "> Notice: " << n << "\n\n";
-  r << "**Verdict: " << (d.adequate ? "adequate" : "inadequate") << "** — ";
-  int nf = 0;
-  for (const auto& c : d.channels) nf += static_cast<int>(c.findings.size());
-  if (d.adequate)
-    r << "on every channel the measured data are consistent with simulations of the model "
-         "(wavelet variance, spectrum, level shifts, spikes; family-wise level "
-      << d.options.alpha * 100 << " % for the whole record).\n\n";
-  else
-    r << nf << " finding(s); what the simulation gets wrong and why is listed per channel "
-         "below.\n\n";
-  r << "## Summary\n\n| channel | verdict | findings | model before | model after | "
-       "scales outside CI (before → after) | WV objective (before → after) | gain |\n"
-       "|---|---|---|---|---|---|---|---|\n";
+  r << "`" << d.source << "`: " << d.samples << " samples at " << fmtNum(d.rate_hz, 6) << " Hz ("
+    << fmtNum(d.samples / d.rate_hz, 5) << " s); model `" << d.model_before.source << "`.\n\n";
+  int bad = 0, nf = 0;
   for (const auto& c : d.channels) {
-    std::string causes;
-    for (const auto& f : c.findings) causes += std::string(causes.empty() ? "" : ", ") + causeName(f.cause);
-    r << "| " << c.name << " | " << (c.adequate ? "adequate" : "inadequate") << " | "
-      << (causes.empty() ? "—" : causes) << " | `" << modelText(c.model_before) << "` | `"
-      << modelText(c.model_after) << "` | " << c.gain.outside_before << " → "
-      << c.gain.outside_after << " of " << c.gain.scales << " | "
-      << fmtNum(c.gain.objective_before, 3) << " → " << fmtNum(c.gain.objective_after, 3) << " | "
-      << (c.findings.empty() ? "—"
-                             : (c.gain.significant ? "significant" : "not significant") +
-                                   std::string(" (") + c.gain.basis + ", p = " +
-                                   fmtNum(c.gain.p_value, 2) + ")")
-      << " |\n";
+    bad += c.adequate ? 0 : 1;
+    nf += static_cast<int>(c.findings.size());
   }
-  r << "\n## Findings\n\n";
-  for (const auto& c : d.channels) {
-    if (c.findings.empty()) continue;
-    r << "### " << c.name << "\n\n";
-    for (const auto& f : c.findings) {
-      r << "- **" << causeName(f.cause) << "** (";
-      bool first = true;
-      for (const auto& kv : f.params) {
-        r << (first ? "" : ", ") << kv.first << " = " << fmtNum(kv.second, 4);
-        first = false;
+  r << "**Verdict: " << (d.adequate ? "adequate" : "inadequate") << "**";
+  if (d.adequate)
+    r << " — every channel is consistent with simulations of the model (outliers, spectral lines, level "
+         "shifts, wavelet variance; family-wise false-alarm level "
+      << fmtNum(d.options.alpha * 100, 3) << " % for the whole record).\n\n";
+  else
+    r << " — " << bad << " of " << d.channels.size() << " channels, " << nf
+      << " finding(s) (family-wise level " << fmtNum(d.options.alpha * 100, 3) << " %).\n\n";
+  for (const auto& n : d.notices) r << "> " << n << "\n\n";
+  if (!d.adequate) {
+    // One row per channel and cause (several lines or shifts of a channel share it).
+    r << "| channel | cause | parameters (95 % interval) | evidence | what to do |\n|---|---|---|---|---|\n";
+    for (const auto& c : d.channels) {
+      std::vector<bool> done(c.findings.size(), false);
+      for (std::size_t i = 0; i < c.findings.size(); ++i) {
+        if (done[i]) continue;
+        const Finding& f0 = c.findings[i];
+        std::string ps, cause = causeName(f0.cause);
+        double pmin = f0.p_value;
+        std::vector<int> events;
+        int count = 0;
+        for (std::size_t k = i; k < c.findings.size(); ++k) {
+          const Finding& f = c.findings[k];
+          if (done[k] || f.cause != f0.cause || f.direction != f0.direction) continue;
+          done[k] = true;
+          ++count;
+          pmin = std::min(pmin, f.p_value);
+          if (f.event >= 0) events.push_back(f.event + 1);
+          std::string one;
+          for (const auto& kv : f.params) {
+            if (f.cause == Cause::Outliers && kv.first == "count") {
+              one = fmtNum(kv.second, 4) + " event(s)";
+              if (!f.times_s.empty()) {
+                one += " at t = " + fmtNum(f.times_s[0], 6);
+                for (std::size_t q = 1; q < std::min<std::size_t>(3, f.times_s.size()); ++q) one += ", " + fmtNum(f.times_s[q], 6);
+                one += f.times_s.size() > 3 ? ", … s" : " s";
+              }
+              continue;
+            }
+            one += (one.empty() ? "" : ", ") + paramText(f, kv.first, kv.second);
+          }
+          if (!f.harmonics_hz.empty()) one += ", " + std::to_string(f.harmonics_hz.size()) + " harmonic(s)";
+          ps += (ps.empty() ? "" : "; ") + one;
+        }
+        if (count > 1) cause = std::to_string(count) + " × " + cause;
+        if (f0.direction == "overstated") cause += " (overstated)";
+        if (!events.empty()) {
+          cause += " [event";
+          for (int e : events) cause += " " + std::to_string(e);
+          cause += "]";
+        }
+        r << "| " << c.name << " | " << cause << " | " << ps << " | " << strength(pmin) << " | " << shortAction(f0) << " |\n";
       }
-      r << "): " << f.explanation << " *What to do:* " << f.action << ".\n";
     }
-    r << "\n| tau [s] | measured | model | 95 % CI | ratio | CI widths outside | significant |\n"
-         "|---|---|---|---|---|---|---|\n";
-    for (const auto& s : c.scales)
-      if (s.outside95)
-        r << "| " << fmtNum(s.tau_s, 4) << " | " << fmtNum(s.measured, 3) << " | "
-          << fmtNum(s.model, 3) << " | " << fmtNum(s.ci_low, 3) << " – " << fmtNum(s.ci_high, 3)
-          << " | " << fmtNum(s.ratio, 3) << " | " << fmtNum(s.ci_widths, 3) << " | "
-          << (s.significant ? "yes" : "no") << " |\n";
+    r << "\n";
+  }
+  if (!d.events.empty()) {
+    r << "**Events on several channels** (each is one event, listed above under every channel it touches):\n\n";
+    for (std::size_t i = 0; i < d.events.size(); ++i) {
+      const auto& e = d.events[i];
+      r << i + 1 << ". t = " << fmtNum(e.t_s, 6) << " s";
+      if (e.duration_s > 0) r << " (" << fmtNum(e.duration_s, 2) << " s)";
+      r << ": " << causeName(e.cause) << " on";
+      for (const auto& ch : e.channels) r << " " << ch;
+      r << "\n";
+    }
+    r << "\n";
+  }
+  {
+    r << "**Gain of the extended model** (held-out second half unless stated; significant = both "
+         "criteria better and the paired test rejects at 5 %):\n\n"
+         "| channel | WV objective before → after | deviance before → after | test | result |\n"
+         "|---|---|---|---|---|\n";
+    for (const auto& c : d.channels) {
+      if (c.adequate) continue;
+      const auto& g = c.gain;
+      r << "| " << c.name << " | " << fmtNum(g.objective_before, 4) << " → " << fmtNum(g.objective_after, 4) << " | "
+        << fmtNum(g.deviance_before, 4) << " → " << fmtNum(g.deviance_after, 4) << " | z = " << fmtNum(g.z, 3)
+        << ", p = " << fmtNum(g.p_value, 2) << (g.basis == "second_half" ? "" : " (whole record)") << " | "
+        << (g.significant ? "significant, better" : "not significant, " + g.direction) << " |\n";
+    }
     r << "\n";
   }
   if (d.navigation) {
     const NavGain& g = *d.navigation;
-    r << "## Navigation gain\n\n"
-      << "Navigation along `" << g.trajectory << "` emulated with the **measured** errors as the "
-      << "truth: " << g.truth << ". The filter ran once with the model before and once with "
-      << g.filter_after << ", on the same " << g.runs << " realisations (seed " << g.seed
-      << "). " << g.settings << "."
-      << (g.filter_note.empty() ? std::string() : " Note: " + g.filter_note + ".") << "\n\n"
-      << "| outage | horizontal error at end [m] | vertical error at end [m] | max horizontal "
-         "drift [m] | position NEES at end (95 % band) | runs better after | gain |\n"
-         "|---|---|---|---|---|---|---|\n";
-    for (const auto& o : g.outages) {
-      auto inBand = [&](double v) {
-        return v >= o.nees_band.first && v <= o.nees_band.second ? "" : " (outside)";
-      };
-      r << "| " << fmtNum(o.start_s, 5) << " s + " << fmtNum(o.duration_s, 4) << " s | "
-        << fmtNum(o.mean_h_before, 3) << " → " << fmtNum(o.mean_h_after, 3) << " | "
-        << fmtNum(o.mean_v_before, 3) << " → " << fmtNum(o.mean_v_after, 3) << " | "
-        << fmtNum(o.mean_drift_before, 3) << " → " << fmtNum(o.mean_drift_after, 3) << " | "
-        << fmtNum(o.anees_before, 3) << inBand(o.anees_before) << " → " << fmtNum(o.anees_after, 3)
-        << inBand(o.anees_after) << " (" << fmtNum(o.nees_band.first, 3) << "–"
-        << fmtNum(o.nees_band.second, 3) << ") | " << o.wins << " of " << g.runs << " | "
-        << (o.significant ? "significant" : "not significant") << " (sign test p = "
-        << fmtNum(o.sign_p, 2) << ", paired t p = " << fmtNum(o.t_p, 2) << ") |\n";
+    for (const auto& o : g.outages)
+      r << "**Navigation** (" << g.runs << " paired runs, outage " << fmtNum(o.start_s, 5) << " s + "
+        << fmtNum(o.duration_s, 4) << " s): horizontal error at the end " << fmtNum(o.mean_h_before, 3) << " → "
+        << fmtNum(o.mean_h_after, 3) << " m, position ANEES " << fmtNum(o.anees_before, 3) << " → "
+        << fmtNum(o.anees_after, 3) << " (band " << fmtNum(o.nees_band.first, 3) << "–"
+        << fmtNum(o.nees_band.second, 3) << "); extension better in " << o.wins << " of " << g.runs << " runs: "
+        << (o.significant ? "significant" : "not significant") << " (sign test p = " << fmtNum(o.sign_p, 2)
+        << ").\n\n";
+  }
+  r << "The extended model is in `model_extended.yaml`; the evidence follows below.\n\n";
+  r << "---\n\n# Evidence\n\n";
+  for (const auto& c : d.channels) {
+    if (c.findings.empty() && c.notes.empty()) continue;
+    r << "## " << c.name << "\n\n`" << modelText(c.model_before) << "` → `" << modelText(c.model_after) << "`\n\n";
+    for (const auto& f : c.findings) {
+      r << "- **" << causeName(f.cause) << "**: " << f.explanation;
+      if (!f.evidence.empty()) r << " *Evidence:* " << f.evidence << ".";
+      r << " *What to do:* " << f.action << ".\n";
     }
-    r << "\nErrors are means over the runs; the NEES band is the two-sided 95 % band of the "
-         "mean of " << g.runs << " chi-square(3) values (a consistent filter lies inside it). A "
-         "gain is called significant only when the extension gives the smaller horizontal error "
-         "at the outage end in significantly more runs than chance (exact sign test, p < 0.05); "
-         "the runs share one recording, so they are not fully independent (overlapping windows "
-         "when the record is short).\n\n";
+    for (const auto& n : c.notes) r << "- Note: " << n << ".\n";
+    r << "- Gain: " << c.gain.test << "; " << c.gain.outside_before << " → " << c.gain.outside_after << " of "
+      << c.gain.scales << " scales outside the 95 % CI.\n";
+    if (!c.refit_full.empty()) r << "- GMWM refit: whole record " << c.refit_full << "; first half " << c.refit_half << ".\n";
+    bool any = false;
+    for (const auto& s : c.scales) any = any || s.outside95;
+    if (any) {
+      r << "\n| tau [s] | measured WV | model WV | 95 % CI | ratio | significant |\n|---|---|---|---|---|---|\n";
+      for (const auto& s : c.scales)
+        if (s.outside95)
+          r << "| " << fmtNum(s.tau_s, 4) << " | " << fmtNum(s.measured, 3) << " | " << fmtNum(s.model, 3) << " | "
+            << fmtNum(s.ci_low, 3) << "–" << fmtNum(s.ci_high, 3) << " | " << fmtNum(s.ratio, 3) << " | "
+            << (s.significant ? "yes" : "no") << " |\n";
+    }
+    r << "\n";
+  }
+  if (d.navigation) {
+    const NavGain& g = *d.navigation;
+    r << "## Navigation gain\n\nAlong `" << g.trajectory << "` with the **measured** errors as the truth: " << g.truth
+      << ". The filter ran with the model before and with " << g.filter_after << ", on the same " << g.runs
+      << " realisations (seed " << g.seed << "). " << g.settings << "."
+      << (g.filter_note.empty() ? std::string() : " Note: " + g.filter_note + ".") << "\n\n"
+      << "| outage | horizontal error at end [m] | vertical [m] | max horizontal drift [m] | position ANEES (95 % band) | runs better | sign test p | paired t p |\n"
+         "|---|---|---|---|---|---|---|---|\n";
+    for (const auto& o : g.outages)
+      r << "| " << fmtNum(o.start_s, 5) << " s + " << fmtNum(o.duration_s, 4) << " s | " << fmtNum(o.mean_h_before, 3)
+        << " → " << fmtNum(o.mean_h_after, 3) << " | " << fmtNum(o.mean_v_before, 3) << " → " << fmtNum(o.mean_v_after, 3)
+        << " | " << fmtNum(o.mean_drift_before, 3) << " → " << fmtNum(o.mean_drift_after, 3) << " | "
+        << fmtNum(o.anees_before, 3) << " → " << fmtNum(o.anees_after, 3) << " (" << fmtNum(o.nees_band.first, 3) << "–"
+        << fmtNum(o.nees_band.second, 3) << ") | " << o.wins << " of " << g.runs << " | " << fmtNum(o.sign_p, 2) << " | "
+        << fmtNum(o.t_p, 2) << " |\n";
+    r << "\nA navigation gain is significant only when the extension gives the smaller horizontal error at the outage "
+         "end in significantly more runs than chance (exact sign test, p < 0.05); the runs share one recording.\n\n";
   }
   r << "## Method\n\n"
-       "- **What the simulation gets wrong:** the model is simulated "
-    << d.options.simulations << " times (seed " << d.options.seed
-    << ") at the data's length and rate; the measured Haar WV is compared with the "
-       "simulated envelope (min–max) and with the model's theoretical WV and its chi-square "
-       "CI (dof eta_j = max(M_j/2^j, 1), lowered to the dof seen in the simulations where "
-       "smaller). A scale is significant when its two-sided p-value is below the "
-       "family-wise level (Bonferroni over scales and channels).\n"
-       "- **Where the WV is blind:** isolated spikes (robust z of the second difference, "
-       "Bonferroni over samples), level shifts (maximum Haar coefficient over positions "
-       "against its robust scale, scales 2^3.. samples), and narrow-band lines (Welch "
-       "periodogram against a running-median background, chi-square threshold, Bonferroni "
-       "over bins). These are removed before the WV tests so that they do not pose as "
-       "Gauss-Markov or random-walk terms.\n"
-       "- **Cause:** each family (WN, QN, RW, DR, GM, or a retuned term of the model) is "
-       "fitted to the WV with the other terms kept, on the first half of the record; the "
-       "smallest AIC (chi-square deviance + 2 × parameters) names the cause; it is refitted "
-       "on the whole record for the finding's parameters. The extended structure is then "
-       "refitted by GMWM (warm start: the user's parameters plus the findings' estimates), on "
-       "the first half for the held-out comparison and on the whole record for "
-       "model_extended.yaml; a refit that raises the chi-square deviance on its own fit data "
-       "is not kept (see gmwm_refit in diagnosis.json).\n"
-       "- **Gain:** the user's model and the first-half extension are both evaluated on the "
-       "held-out second half (GMWM objective with the R package's fast weights, deviance, "
-       "scales outside the 95 % CI). Channels whose only findings are spikes, steps or lines "
-       "are evaluated on the whole record (no WV parameter was fitted).\n\n";
+       "- **Outliers:** second difference beyond a Bonferroni threshold (scale: the larger of the model's and the "
+       "robust MAD); exceedances closer than 10 samples, and level changes that undo each other within 1 s, are one "
+       "event (a knock). Interpolated out.\n"
+       "- **Spectral lines:** Hann periodogram of the whole record against max(model PSD, the record's local "
+       "level), Bonferroni over all bins from 4 cycles per record to Nyquist; harmonics and a wandering frequency "
+       "are one finding. Subtracted.\n"
+       "- **Level shifts:** window contrasts scaled by the model's Haar WV (valid under random walks and "
+       "Gauss-Markov noise); kept only when shifts plus the best stochastic extension explain the record better than "
+       "that extension alone (multi-scale contrast likelihood, penalty 1.5 log(contrasts) per parameter).\n"
+       "- **Wavelet variance:** measured Haar WV of the cleaned record against the model's, chi-square CI "
+       "(dof lowered to what "
+    << d.options.simulations << " simulations of the model show, seed " << d.options.seed
+    << "), Bonferroni over scales; each process family (or a retuned term) fitted to the excess by the chi-square "
+       "deviance, chosen by AIC on the whole record (runner-up given as evidence); no term below one CI width, no "
+       "GM with T beyond a fifth of the record.\n"
+       "- **Gain:** the first-half extension against the model on the held-out second half; one-sided paired z "
+       "test over the scales of the per-scale deviance.\n"
+       "- The family-wise level is split WV 40 %, lines 20 %, level shifts 20 %, outliers 20 %, each over the "
+       "channels.\n\n";
   if (!figures.empty()) {
     r << "## Figures\n\n";
     for (const auto& f : figures) r << "![" << f << "](" << f << ")\n\n";
