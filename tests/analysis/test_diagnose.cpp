@@ -198,3 +198,63 @@ TEST(Diagnose, FindingsHaveNoVanishingTermsAndNoOverlongGaussMarkov) {
     }
   }
 }
+
+TEST(Diagnose, IssueCasesLowFrequencyLinesAndFourteenSeLevelShifts) {
+  // The two synthetic cases of the issue, drawn at random: 2 h records at
+  // 100 Hz of white noise; (a) a line of amplitude 0.2 sigma at a frequency
+  // log-uniform from 5 cycles per record to 0.3 Hz must be a sinusoid (not a
+  // Gauss-Markov process); (b) a level shift of 14 standard errors of the
+  // difference of the two segment means, anywhere in the middle 80 %, must be
+  // a level shift (not a random walk).
+  std::mt19937_64 rng(rootSeed() + 1414);
+  std::uniform_real_distribution<double> U(0, 1);
+  const int R = runs(4);
+  const double rate = 100, sigma = 0.01;
+  const std::size_t n = 720000;
+  int lines_ok = 0, steps_ok = 0;
+  for (int r = 0; r < R; ++r) {
+    for (int kind = 0; kind < 2; ++kind) {
+      ns::ImuModel m;
+      m.rate_hz = rate;
+      m.source = "wn";
+      const int ci = static_cast<int>(rng() % 6);
+      m.axis[ci].rate_hz = rate;
+      m.axis[ci].terms = {ns::Process::wn(sigma)};
+      navimpact::ImuSeries s;
+      s.rate_hz = rate;
+      s.source = "issue case";
+      navimpact::ImuChannel ch;
+      ch.name = navimpact::kChannelNames[ci];
+      ch.quantity = navimpact::channelQuantity(ch.name);
+      ch.x = ns::simulate(m.axis[ci], n, rng());
+      ch.x.resize(n);
+      double f = 0, k0 = 0, size = 0;
+      if (kind == 0) {
+        f = 5.0 / (n / rate) * std::pow(0.3 / (5.0 / (n / rate)), U(rng));
+        const double ph = 6.283185307179586 * U(rng);
+        for (std::size_t k = 0; k < n; ++k) ch.x[k] += 0.2 * sigma * std::sin(6.283185307179586 * f * k / rate + ph);
+      } else {
+        k0 = std::floor((0.1 + 0.8 * U(rng)) * n);
+        size = (U(rng) < 0.5 ? -1 : 1) * 14.0 * sigma * std::sqrt(1.0 / k0 + 1.0 / (n - k0));
+        for (std::size_t k = static_cast<std::size_t>(k0); k < n; ++k) ch.x[k] += size;
+      }
+      s.channels.push_back(std::move(ch));
+      na::DiagnoseOptions o;
+      o.threads = 1;
+      o.simulations = 4;
+      const auto d = na::diagnose(s, m, o);
+      bool ok = false, gm = false;
+      for (const auto& fd : d.channels[0].findings) {
+        if (kind == 0 && fd.cause == na::Cause::Sinusoid && std::abs(fd.get("freq_hz") - f) <= 2 * rate / n) ok = true;
+        if (kind == 1 && fd.cause == na::Cause::LevelShift && std::abs(fd.get("t_s") - k0 / rate) <= 0.02 * n / rate) ok = true;
+        if (fd.cause == na::Cause::GaussMarkov || fd.cause == na::Cause::RandomWalk) gm = true;
+      }
+      ok = ok && !gm;
+      (kind == 0 ? lines_ok : steps_ok) += ok;
+      std::cout << "  issue case " << (kind == 0 ? "line f=" + std::to_string(f) : "14-se step at t=" + std::to_string(k0 / rate) + " size=" + std::to_string(size))
+                << ": " << (ok ? "right" : "WRONG") << pw::describe(d) << "\n";
+    }
+  }
+  EXPECT_EQ(lines_ok, R);
+  EXPECT_GE(steps_ok, R - 1);
+}

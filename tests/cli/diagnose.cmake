@@ -67,3 +67,16 @@ add_test(NAME cli_diagnose_recording_shorter_than_trajectory
           "-DEXTRA=--trajectory;${_dg_traj};--outage;100:30"
           "-DEXPECT=error: static recording too short for the navigation gain: 9.99 s available, 2.* s needed"
           -P ${_dg_dir}/expect_error.cmake)
+
+# Detection-power sweep: a tiny run writes its table and records every run;
+# bad flags fail before any work.
+add_test(NAME cli_diagnose_power_small
+  COMMAND ${CMAKE_COMMAND} -DNI=${NI} -DOUT=${_dg_out}/power -P ${_dg_dir}/run_power.cmake)
+add_test(NAME cli_diagnose_power_bad_cause
+  COMMAND ${CMAKE_COMMAND} -DNI=${NI} -DOUT=${_dg_out}/bad10
+          "-DARGS=diagnose-power;--out;${_dg_out}/bad10;--causes;sinusoid,wobble"
+          "-DEXPECT=error: --causes: unknown cause 'wobble'" -P ${_dg_dir}/expect_error.cmake)
+add_test(NAME cli_diagnose_power_bad_snr
+  COMMAND ${CMAKE_COMMAND} -DNI=${NI} -DOUT=${_dg_out}/bad11
+          "-DARGS=diagnose-power;--out;${_dg_out}/bad11;--snr;5"
+          "-DEXPECT=error: --snr '5': expected LO:HI" -P ${_dg_dir}/expect_error.cmake)
