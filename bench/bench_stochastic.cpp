@@ -1,62 +1,56 @@
-// Speed of the stochastic module: theoretical WV of the Table 1 accelerometer
-// reference model (WN + 3 GM + DR) and seeded simulation of it.
+// Stochastic models: simulation, theoretical WV and the PSD (the background of
+// a spectral line test evaluates it at every periodogram bin).
 #include <benchmark/benchmark.h>
 
+#include <vector>
+
+#include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
+#include "navimpact/stochastic/spectrum.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
 namespace {
 
 namespace st = navimpact::stochastic;
 
-st::Model accRef() {
+/// Table 1 gyroscope reference model with QN and RW added, at 100 Hz.
+st::Model model() {
   st::Model m;
-  m.rate_hz = 200.0;
-  m.terms = {st::Process::wn(5.521e-3), st::Process::gm(4.811e-4, 3.22),
-             st::Process::gm(6.666e-4, 47.40), st::Process::gm(4.003e-4, 556),
-             st::Process::dr(9.302e-10)};
+  m.rate_hz = 100;
+  m.terms = st::parseTerms(
+      "WN(sigma=9.788e-4) + QN(Q=1e-5) + RW(gamma=1e-7) + GM(sigma=4.805e-5, T=59.22) + "
+      "GM(sigma=7.555e-5, T=2008) + DR(omega=1e-10) + SIN(amp=1e-4, freq=0.56)",
+      100);
   return m;
 }
 
-void BM_TheoreticalWv_WN3GMDR_20scales(benchmark::State& state) {
-  const st::Model m = accRef();
-  const Eigen::VectorXd tau = st::dyadicScales(20);
+}  // namespace
+
+// PSD of the seven-term model at the 2^19 bins of a 10^6-sample periodogram.
+static void BM_PsdAtPeriodogramBins(benchmark::State& state) {
+  const st::Model m = model();
+  const int bins = 1 << 19;
+  std::vector<double> out(bins);
+  for (auto _ : state) {
+    const st::Spectrum S(m);
+    for (int k = 0; k < bins; ++k) out[k] = S((k + 1) * 0.5 * m.rate_hz / bins);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * bins);
+}
+BENCHMARK(BM_PsdAtPeriodogramBins)->Unit(benchmark::kMillisecond);
+
+// Simulation of 10^6 samples of the same model.
+static void BM_Simulate1e6(benchmark::State& state) {
+  const st::Model m = model();
+  for (auto _ : state) benchmark::DoNotOptimize(st::simulate(m, 1000000, 7));
+}
+BENCHMARK(BM_Simulate1e6)->Unit(benchmark::kMillisecond);
+
+// Theoretical Haar WV at 20 dyadic scales.
+static void BM_TheoreticalWv20Scales(benchmark::State& state) {
+  const st::Model m = model();
+  const auto tau = st::dyadicScales(20);
   for (auto _ : state) benchmark::DoNotOptimize(st::haarWv(m, tau));
 }
-BENCHMARK(BM_TheoreticalWv_WN3GMDR_20scales);
-
-void BM_Simulate_WN3GMDR(benchmark::State& state) {
-  const st::Model m = accRef();
-  const auto n = static_cast<std::size_t>(state.range(0));
-  std::vector<double> x(n);
-  std::uint64_t seed = 1;
-  for (auto _ : state) {
-    std::fill(x.begin(), x.end(), 0.0);
-    st::simulateAdd(m, seed++, x.data(), n);
-    benchmark::DoNotOptimize(x.data());
-  }
-  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n));
-}
-BENCHMARK(BM_Simulate_WN3GMDR)->Arg(1000000)->Unit(benchmark::kMillisecond);
-
-void BM_Simulate_OneProcess(benchmark::State& state) {
-  st::Model m;
-  m.rate_hz = 200.0;
-  switch (state.range(0)) {
-    case 0: m.terms = {st::Process::wn(1.0)}; state.SetLabel("WN"); break;
-    case 1: m.terms = {st::Process::gm(1.0, 3.0)}; state.SetLabel("GM"); break;
-    case 2: m.terms = {st::Process::rw(1.0)}; state.SetLabel("RW"); break;
-    case 3: m.terms = {st::Process::qn(1.0)}; state.SetLabel("QN"); break;
-    default: m.terms = {st::Process::sin(1.0, 3.0)}; state.SetLabel("SIN"); break;
-  }
-  const std::size_t n = 1000000;
-  std::vector<double> x(n);
-  for (auto _ : state) {
-    st::simulateAdd(m, 7, x.data(), n);
-    benchmark::DoNotOptimize(x.data());
-  }
-  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n));
-}
-BENCHMARK(BM_Simulate_OneProcess)->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
-
-}  // namespace
+BENCHMARK(BM_TheoreticalWv20Scales)->Unit(benchmark::kMicrosecond);

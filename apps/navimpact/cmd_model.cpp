@@ -78,11 +78,9 @@ int runList(const Opts& o) {
   }
   for (const auto& n : names) {
     const st::ImuModel m = st::loadImuModel(o.file + ":" + n);
-    std::vector<st::ProcessKind> g, a;
-    for (const auto& p : m.axis[0].terms) g.push_back(p.kind);
-    for (const auto& p : m.axis[3].terms) a.push_back(p.kind);
-    std::printf("%-16s gyro: %-14s acc: %-14s (%g Hz)\n", n.c_str(), st::formatStructure(g).c_str(),
-                st::formatStructure(a).c_str(), m.rate_hz);
+    std::printf("%-16s gyro: %-14s acc: %-14s (%g Hz)\n", n.c_str(),
+                st::formatStructure(m.axis[0]).c_str(), st::formatStructure(m.axis[3]).c_str(),
+                m.rate_hz);
   }
   return 0;
 }

@@ -84,25 +84,9 @@ StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuError
       b.channel = c;
       b.offset = static_cast<int>(L.names_.size());
       b.ss = ss;
-      std::string base = ch + "." + stochastic::kindName(p.kind) + std::to_string(k);
-      switch (p.kind) {
-        case stochastic::ProcessKind::GM:
-          L.names_.push_back(base + "(T=" + fmt(p.T) + "s)");
-          break;
-        case stochastic::ProcessKind::RW:
-          L.names_.push_back(base);
-          break;
-        case stochastic::ProcessKind::DR:
-          L.names_.push_back(base + ".bias");
-          L.names_.push_back(base + ".rate");
-          break;
-        case stochastic::ProcessKind::SIN:
-          L.names_.push_back(base + "(f=" + fmt(p.freq_hz) + "Hz).a");
-          L.names_.push_back(base + "(f=" + fmt(p.freq_hz) + "Hz).b");
-          break;
-        default:
-          for (int i = 0; i < ss.n; ++i) L.names_.push_back(base + "." + std::to_string(i));
-      }
+      // "<channel>.<KIND><k>" plus the kind's label of each state (state_space.hpp).
+      const std::string base = ch + "." + stochastic::kindName(p.kind) + std::to_string(k);
+      for (const std::string& label : ss.names) L.names_.push_back(base + label);
       if (static_cast<int>(L.names_.size()) != b.offset + ss.n)
         throw Error("internal: state-space block of " + base + " has " + std::to_string(ss.n) +
                     " states, expected a different number");

@@ -25,11 +25,11 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/gmwm/estimator.hpp"
+#include "navimpact/stochastic/spectrum.hpp"
 
 namespace navimpact::gmwm {
 
 using stochastic::Model;
-using stochastic::ProcessKind;
 
 namespace {
 
@@ -37,37 +37,13 @@ constexpr double kA = 16.0;     // periods integrated exactly before averaging
 constexpr double kP = 16.0;     // grid points per period in the exact part
 constexpr double kRel = 0.02;   // largest geometric step (fraction of f)
 
-/// Two-sided spectral density of the random terms of a model at f [cycles/sample], unit^2 per (cycle/sample).
+/// Two-sided spectral density per sample of the random terms of a model
+/// (stochastic::Spectrum: WN, QN, RW pseudo-spectrum, GM; DR and SIN are
+/// deterministic and have no density), as a function of s1sq = sin^2(pi f).
 struct Spectrum {
-  double white = 0.0, qn = 0.0, rw = 0.0;
-  std::vector<std::array<double, 3>> gm;  // s2 (1 - phi^2), (1 - phi)^2, 4 phi
-  explicit Spectrum(const Model& m) {
-    for (const auto& p : m.terms) {
-      switch (p.kind) {
-        case ProcessKind::WN: white += p.sigma * p.sigma; break;
-        // X_t = sqrt(12) Q (Y_t - Y_{t-1}), Var Y = 1/12: |1 - e^{-i 2 pi f}|^2 Q^2.
-        case ProcessKind::QN: qn += 4.0 * p.Q * p.Q; break;
-        // Pseudo-spectrum of the random walk (integrated WN), regular after the Haar filter.
-        case ProcessKind::RW: rw += p.gamma * p.gamma / 4.0; break;
-        case ProcessKind::GM: {
-          // AR(1), phi = exp(-L): S = s2 (1 - phi^2) / ((1 - phi)^2 + 4 phi sin^2(pi f)), stable for phi -> 1.
-          const double L = 1.0 / (p.T * m.rate_hz);
-          const double om = -std::expm1(-L);
-          gm.push_back({p.sigma * p.sigma * (-std::expm1(-2.0 * L)), om * om, 4.0 * std::exp(-L)});
-          break;
-        }
-        case ProcessKind::DR:   // deterministic: no spectral density
-        case ProcessKind::SIN:  // deterministic line: no spectral density
-          break;
-      }
-    }
-  }
-  /// S at f given s1sq = sin^2(pi f).
-  double operator()(double s1sq) const {
-    double S = white + qn * s1sq + (rw > 0 ? rw / s1sq : 0.0);
-    for (const auto& g : gm) S += g[0] / (g[1] + g[2] * s1sq);
-    return S;
-  }
+  stochastic::Spectrum s;
+  explicit Spectrum(const Model& m) : s(m) {}
+  double operator()(double s1sq) const { return s.perSample(s1sq); }
 };
 
 /// Mean over a period of sin^4(x) sin^4(2^d x).

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "kind.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
 namespace navimpact::stochastic {
@@ -32,22 +33,11 @@ DatasheetFigures datasheetFigures(const Model& m) {
   DatasheetFigures f;
   if (m.terms.empty() || !(m.rate_hz > 0.0)) return f;
   const double dt = 1.0 / m.rate_hz;
-  double s2_wn = 0.0, g2_rw = 0.0, q2 = 0.0, omega = 0.0;
-  bool has_wn = false, has_rw = false, has_qn = false, has_dr = false;
-  for (const auto& p : m.terms) {
-    switch (p.kind) {
-      case ProcessKind::WN: s2_wn += p.sigma * p.sigma; has_wn = true; break;
-      case ProcessKind::RW: g2_rw += p.gamma * p.gamma; has_rw = true; break;
-      case ProcessKind::QN: q2 += p.Q * p.Q; has_qn = true; break;
-      case ProcessKind::DR: omega += p.omega; has_dr = true; break;
-      default: break;
-    }
-  }
-  // Independent terms of one kind add in variance (WN, RW, QN), drifts add.
-  if (has_wn) f.noise_density = std::sqrt(s2_wn * dt);  // N = sigma sqrt(dt)
-  if (has_rw) f.random_walk = std::sqrt(g2_rw / dt);    // K = gamma / sqrt(dt)
-  if (has_qn) f.quantization = std::sqrt(q2) * dt;      // Q_c = Q dt
-  if (has_dr) f.drift_rate = omega / dt;                // omega / dt
+  // Each kind adds its own figure (processes/<name>.cpp): WN the noise
+  // density N = sigma sqrt(dt), RW the rate random walk K = gamma / sqrt(dt),
+  // QN the quantization Q dt, DR the drift rate omega / dt; independent terms
+  // of one kind add in variance, drifts add.
+  for (const auto& p : m.terms) detail::kindDef(p.kind).addDatasheet(p, m.rate_hz, f);
 
   // Bias instability: first local minimum of the model ADEV on a log grid of
   // averaging times from 1 sample to 1e6 s (50 points per decade), divided by

@@ -10,24 +10,39 @@
 #include <cstdlib>
 #include <optional>
 
+#include "kind.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/stochastic/process_kind.hpp"
 
 namespace navimpact::stochastic {
 
 namespace {
 
-/// Parameter keys of each process name, in their canonical (print) order.
+/// One accepted process name: a kind's own name or one of its aliases,
+/// with its keys in the canonical (print) order.
 struct TermSpec {
+  const detail::KindDef* def;
+  int alias;  ///< -1: the kind's own name and parameters; else the alias index
   const char* name;
-  std::array<const char*, 2> keys;
-  int nkeys;
+  std::vector<const char*> keys;
 };
-constexpr TermSpec kSpecs[] = {
-    {"WN", {"sigma", nullptr}, 1},  {"QN", {"Q", nullptr}, 1},
-    {"RW", {"gamma", nullptr}, 1},  {"DR", {"omega", nullptr}, 1},
-    {"GM", {"sigma", "T"}, 2},      {"AR1", {"phi", "sigma2"}, 2},
-    {"SIN", {"amp", "freq"}, 2},
-};
+
+/// Every accepted name: each kind (process_kinds.def order) followed by its aliases.
+const std::vector<TermSpec>& specs() {
+  static const std::vector<TermSpec> all = [] {
+    std::vector<TermSpec> v;
+    for (ProcessKind k : allKinds()) {
+      const detail::KindDef& d = detail::kindDef(k);
+      std::vector<const char*> keys;
+      for (const ParamInfo& p : d.info().params) keys.push_back(p.key);
+      v.push_back({&d, -1, d.info().name, keys});
+      for (std::size_t a = 0; a < d.info().aliases.size(); ++a)
+        v.push_back({&d, static_cast<int>(a), d.info().aliases[a].name, d.info().aliases[a].keys});
+    }
+    return v;
+  }();
+  return all;
+}
 
 bool iequals(const std::string& a, const char* b) {
   std::size_t i = 0;
@@ -40,7 +55,7 @@ bool iequals(const std::string& a, const char* b) {
 
 std::string namesList() {
   std::string s;
-  for (const auto& sp : kSpecs) {
+  for (const auto& sp : specs()) {
     if (!s.empty()) s += ", ";
     s += sp.name;
   }
@@ -148,16 +163,17 @@ Process parseTerm(Parser& P, double rate_hz) {
   const std::string name = P.identifier();
   if (name.empty()) P.failHere("a process name (" + namesList() + ")");
   const TermSpec* spec = nullptr;
-  for (const auto& sp : kSpecs)
+  for (const auto& sp : specs())
     if (iequals(name, sp.name)) spec = &sp;
   if (!spec) P.fail(name_pos, "a process name (" + namesList() + ")", "'" + name + "'");
+  const int nkeys = static_cast<int>(spec->keys.size());
 
   std::string keylist;
-  for (int k = 0; k < spec->nkeys; ++k) keylist += std::string(k ? ", " : "") + spec->keys[k];
+  for (int k = 0; k < nkeys; ++k) keylist += std::string(k ? ", " : "") + spec->keys[k];
 
   P.expect('(', "'(' after " + std::string(spec->name));
-  std::array<std::optional<double>, 2> values;
-  std::array<std::size_t, 2> value_pos{0, 0};
+  std::vector<std::optional<double>> values(spec->keys.size());
+  std::vector<std::size_t> value_pos(spec->keys.size(), 0);
   bool first = true;
   while (true) {
     if (P.peek() == ')') {
@@ -169,7 +185,7 @@ Process parseTerm(Parser& P, double rate_hz) {
     const std::string key = P.identifier();
     if (key.empty()) P.failHere("a key (" + keylist + ") of " + spec->name);
     int idx = -1;
-    for (int k = 0; k < spec->nkeys; ++k)
+    for (int k = 0; k < nkeys; ++k)
       if (iequals(key, spec->keys[k])) idx = k;
     if (idx < 0)
       P.fail(key_pos, "a key of " + std::string(spec->name) + " (" + keylist + ")",
@@ -192,28 +208,26 @@ Process parseTerm(Parser& P, double rate_hz) {
   }
   const std::size_t close_pos = P.pos();
   P.expect(')', "')'");
-  for (int k = 0; k < spec->nkeys; ++k)
+  for (int k = 0; k < nkeys; ++k)
     if (!values[k])
       P.fail(close_pos, "key '" + std::string(spec->keys[k]) + "' of " + spec->name + "(" +
                             keylist + ")",
              "')'");
 
-  const std::string n = spec->name;
-  if (n == "WN") return Process::wn(*values[0]);
-  if (n == "QN") return Process::qn(*values[0]);
-  if (n == "RW") return Process::rw(*values[0]);
-  if (n == "DR") return Process::dr(*values[0]);
-  if (n == "GM") return Process::gm(*values[0], *values[1]);
-  if (n == "SIN") return Process::sin(*values[0], *values[1]);
-  // AR1(phi, sigma2) in the R package's form, stored as GM.
-  const double phi = *values[0], s2 = *values[1];
-  if (!(phi > 0.0 && phi < 1.0))
-    P.fail(value_pos[0], "phi in (0, 1) (an AR1 stored as Gauss-Markov)",
-           "phi=" + std::to_string(phi));
-  if (!(s2 > 0.0)) P.fail(value_pos[1], "sigma2 > 0", "sigma2=" + std::to_string(s2));
-  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
-    P.fail(name_pos, "a model rate (rate_hz > 0) to convert AR1 to GM", "no rate");
-  return Process::ar1(phi, s2, rate_hz);
+  std::vector<double> v(values.size());
+  for (std::size_t k = 0; k < v.size(); ++k) v[k] = *values[k];
+  if (spec->alias >= 0) {
+    // Another input form of the kind (AR1 for GM), converted by the kind.
+    try {
+      return spec->def->fromAlias(static_cast<std::size_t>(spec->alias), v.data(), rate_hz);
+    } catch (const detail::AliasValueError& e) {
+      P.fail(e.key >= 0 ? value_pos[static_cast<std::size_t>(e.key)] : name_pos, e.expected, e.found);
+    }
+  }
+  Process p;
+  p.kind = spec->def->info().kind;
+  for (std::size_t k = 0; k < v.size(); ++k) p.*(spec->def->info().params[k].field) = v[k];
+  return p;
 }
 
 /// %g with @p digits significant digits; digits >= 17 means "exact": the
@@ -259,18 +273,11 @@ std::string formatTerms(const std::vector<Process>& terms, int digits) {
   std::string s;
   for (const auto& p : terms) {
     if (!s.empty()) s += " + ";
-    s += kindName(p.kind);
+    const KindInfo& info = kindInfo(p.kind);
+    s += info.name;
     s += "(";
-    switch (p.kind) {
-      case ProcessKind::WN: s += "sigma=" + fmt(p.sigma, digits); break;
-      case ProcessKind::QN: s += "Q=" + fmt(p.Q, digits); break;
-      case ProcessKind::RW: s += "gamma=" + fmt(p.gamma, digits); break;
-      case ProcessKind::DR: s += "omega=" + fmt(p.omega, digits); break;
-      case ProcessKind::GM: s += "sigma=" + fmt(p.sigma, digits) + ", T=" + fmt(p.T, digits); break;
-      case ProcessKind::SIN:
-        s += "amp=" + fmt(p.amp, digits) + ", freq=" + fmt(p.freq_hz, digits);
-        break;
-    }
+    for (std::size_t k = 0; k < info.params.size(); ++k)
+      s += std::string(k ? ", " : "") + info.params[k].key + "=" + fmt(p.*info.params[k].field, digits);
     s += ")";
   }
   return s;
@@ -279,7 +286,7 @@ std::string formatTerms(const std::vector<Process>& terms, int digits) {
 std::vector<ProcessKind> parseStructure(const std::string& spec) {
   Parser P(spec, "structure");
   std::vector<ProcessKind> kinds;
-  if (P.atEnd()) P.failHere("a process name (WN, QN, RW, DR, GM, AR1, SIN)");
+  if (P.atEnd()) P.failHere("a process name (" + namesList() + ")");
   while (true) {
     // Optional repetition count: "3GM" or "3*GM".
     int count = 1;
@@ -298,15 +305,10 @@ std::vector<ProcessKind> parseStructure(const std::string& spec) {
     P.skipWs();
     const std::size_t at = P.pos();
     const std::string name = P.identifier();
-    ProcessKind k;
-    if (iequals(name, "WN")) k = ProcessKind::WN;
-    else if (iequals(name, "QN")) k = ProcessKind::QN;
-    else if (iequals(name, "RW")) k = ProcessKind::RW;
-    else if (iequals(name, "DR")) k = ProcessKind::DR;
-    else if (iequals(name, "GM") || iequals(name, "AR1")) k = ProcessKind::GM;
-    else if (iequals(name, "SIN")) k = ProcessKind::SIN;
-    else if (name.empty()) P.failHere("a process name (WN, QN, RW, DR, GM, AR1, SIN)");
-    else P.fail(at, "a process name (WN, QN, RW, DR, GM, AR1, SIN)", "'" + name + "'");
+    if (name.empty()) P.failHere("a process name (" + namesList() + ")");
+    const std::optional<ProcessKind> kind = kindFromName(name);  // aliases too: AR1 is a GM
+    if (!kind) P.fail(at, "a process name (" + namesList() + ")", "'" + name + "'");
+    const ProcessKind k = *kind;
     // Tolerate the R-style empty call "GM()".
     if (P.peek() == '(') {
       P.expect('(', "'('");
@@ -318,6 +320,8 @@ std::vector<ProcessKind> parseStructure(const std::string& spec) {
   }
   return kinds;
 }
+
+std::string formatStructure(const Model& m) { return formatStructure(m.structure()); }
 
 std::string formatStructure(const std::vector<ProcessKind>& kinds) {
   if (kinds.empty()) return "none";

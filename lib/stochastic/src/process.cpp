@@ -1,25 +1,15 @@
-// Latent processes, composite models, exact rate conversion and validation.
+// Latent processes, composite models, exact rate conversion and validation;
+// what is specific to a kind is in processes/<name>.cpp.
 #include "navimpact/stochastic/process.hpp"
 
 #include <cmath>
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "kind.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 
 namespace navimpact::stochastic {
-
-const char* kindName(ProcessKind k) {
-  switch (k) {
-    case ProcessKind::WN: return "WN";
-    case ProcessKind::QN: return "QN";
-    case ProcessKind::RW: return "RW";
-    case ProcessKind::DR: return "DR";
-    case ProcessKind::GM: return "GM";
-    case ProcessKind::SIN: return "SIN";
-  }
-  return "?";
-}
 
 Process Process::wn(double sigma) {
   Process p;
@@ -65,23 +55,6 @@ Process Process::sin(double amp, double freq_hz) {
   return p;
 }
 
-Process Process::ar1(double phi, double sigma2_innov, double rate_hz) {
-  if (!(phi > 0.0 && phi < 1.0))
-    throw Error("AR1(phi=" + std::to_string(phi) +
-                "): phi must be in (0, 1) to be a Gauss-Markov process");
-  if (!(sigma2_innov > 0.0) || !std::isfinite(sigma2_innov))
-    throw Error("AR1: sigma2 must be a finite number > 0");
-  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
-    throw Error("AR1: a positive rate_hz is needed to convert AR1 to GM");
-  // phi = exp(-dt/T)  =>  T = -dt / ln(phi); ln(phi) = log1p(phi - 1) is exact
-  // for phi near 1 because phi - 1 is computed without rounding (Sterbenz).
-  const double dt = 1.0 / rate_hz;
-  const double T = -dt / std::log1p(phi - 1.0);
-  // Stationary variance of x_k = phi x_{k-1} + e_k: sigma2 / (1 - phi^2).
-  const double one_minus_phi2 = (1.0 - phi) * (1.0 + phi);
-  return gm(std::sqrt(sigma2_innov / one_minus_phi2), T);
-}
-
 bool Process::operator==(const Process& o) const {
   return kind == o.kind && sigma == o.sigma && Q == o.Q && gamma == o.gamma &&
          omega == o.omega && T == o.T && amp == o.amp && freq_hz == o.freq_hz;
@@ -103,43 +76,13 @@ Model convertRate(const Model& m, double new_rate_hz) {
   Model out;
   out.rate_hz = new_rate_hz;
   out.terms = m.terms;
-  for (auto& p : out.terms) {
-    switch (p.kind) {
-      case ProcessKind::WN:
-        // Same white-noise density N = sigma sqrt(dt): sigma_new^2 dt_new =
-        // sigma_old^2 dt_old  =>  sigma_new = sigma_old sqrt(new/old). Keeps the
-        // WV in seconds, sigma^2/(tau_s rate), identical at every scale.
-        p.sigma *= std::sqrt(r);
-        break;
-      case ProcessKind::QN:
-        // Same quantization Q_c = Q dt (unit*s): Q_new = Q_old new/old. Keeps
-        // 6 Q^2 / tau^2 = 6 Q^2 / (tau_s rate)^2 identical.
-        p.Q *= r;
-        break;
-      case ProcessKind::RW:
-        // Same continuous random walk K = gamma / sqrt(dt): gamma_new =
-        // gamma_old sqrt(old/new). Keeps the dominant gamma^2 tau / 12 =
-        // K^2 tau_s / 12 identical; the finite-sample 2 gamma^2/(12 tau) term
-        // is not invariant (it is O(dt/tau_s)^2 relative).
-        p.gamma /= std::sqrt(r);
-        break;
-      case ProcessKind::DR:
-        // Same ramp slope in unit/s, omega/dt: omega_new = omega_old old/new.
-        // Keeps omega^2 tau^2 / 16 = (omega rate)^2 tau_s^2 / 16 identical.
-        p.omega /= r;
-        break;
-      case ProcessKind::GM:
-        // The same continuous GM process (stationary sigma, correlation time T
-        // in seconds) sampled at another rate: both unchanged, phi = exp(-dt/T)
-        // follows dt. (Its discrete Haar WV in seconds is invariant only up to
-        // O((dt/T)^2) and O(dt/tau_s)^2 sampling effects.)
-        break;
-      case ProcessKind::SIN:
-        // The same sinusoid (amplitude in the signal's unit, frequency in Hz).
-        break;
-    }
-  }
+  // Per kind (processes/<name>.cpp): the same continuous-time process at the new rate.
+  for (auto& p : out.terms) detail::kindDef(p.kind).convertRate(p, r);
   return out;
+}
+
+double conversionWvBound(const Process& p, double rate_a_hz, double rate_b_hz, double tau_s) {
+  return detail::kindDef(p.kind).conversionWvBound(p, rate_a_hz, rate_b_hz, tau_s);
 }
 
 namespace {
@@ -162,29 +105,26 @@ void validate(const Model& m) {
     throw Error("model '" + formatTerms(m.terms) + "': rate_hz must be a finite number > 0");
   for (std::size_t i = 0; i < m.terms.size(); ++i) {
     const Process& p = m.terms[i];
-    switch (p.kind) {
-      case ProcessKind::WN: requirePositive(m, i, "sigma", p.sigma); break;
-      case ProcessKind::QN: requirePositive(m, i, "Q", p.Q); break;
-      case ProcessKind::RW: requirePositive(m, i, "gamma", p.gamma); break;
-      case ProcessKind::DR:
-        if (!std::isfinite(p.omega))
-          throw Error("model '" + formatTerms(m.terms) + "': " + termLabel(m, i) +
-                      ": omega must be finite");
-        break;
-      case ProcessKind::GM:
-        requirePositive(m, i, "sigma", p.sigma);
-        requirePositive(m, i, "T", p.T);
-        break;
-      case ProcessKind::SIN:
-        requirePositive(m, i, "amp", p.amp);
-        requirePositive(m, i, "freq", p.freq_hz);
-        if (!(p.freq_hz < 0.5 * m.rate_hz))
-          throw Error("model '" + formatTerms(m.terms) + "': " + termLabel(m, i) +
-                      ": freq must be below the Nyquist frequency rate_hz/2 = " +
-                      std::to_string(0.5 * m.rate_hz) + " Hz");
-        break;
+    const detail::KindDef& def = detail::kindDef(p.kind);
+    for (const ParamInfo& par : def.info().params) {
+      const double v = p.*par.field;
+      if (par.positive)
+        requirePositive(m, i, par.key, v);
+      else if (!std::isfinite(v))
+        throw Error("model '" + formatTerms(m.terms) + "': " + termLabel(m, i) + ": " + par.key +
+                    " must be finite");
     }
+    const std::string msg = def.check(p, m.rate_hz);
+    if (!msg.empty())
+      throw Error("model '" + formatTerms(m.terms) + "': " + termLabel(m, i) + ": " + msg);
   }
+}
+
+std::vector<ProcessKind> Model::structure() const {
+  std::vector<ProcessKind> k;
+  k.reserve(terms.size());
+  for (const auto& t : terms) k.push_back(t.kind);
+  return k;
 }
 
 }  // namespace navimpact::stochastic

@@ -1,26 +1,19 @@
-// State-space blocks of the latent processes with exact discretisation.
+// State-space blocks of the latent processes with exact discretisation (each
+// kind's F, Qc, H, P0 in processes/<name>.cpp).
 // Closed forms for the blocks navimpact builds (GM, RW, DR, SIN); any other
 // (F, Qc) pair falls back to Van Loan's method (Van Loan 1978, "Computing
 // integrals involving the matrix exponential"; Groves 2013 §3.2.4).
 #include "navimpact/stochastic/state_space.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "kind.hpp"
 #include "navimpact/core/error.hpp"
 
 namespace navimpact::stochastic {
 
 namespace {
-
-constexpr double kTwoPi = 6.283185307179586476925;
-
-std::string fmtg(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
 
 /// Van Loan: exp([[-F, Qc], [0, F^T]] dt) = [[., G12], [0, G22]];
 /// Phi = G22^T, Qd = Phi G12.
@@ -86,59 +79,18 @@ Eigen::MatrixXd StateSpaceBlock::Qd(double dt) const {
 
 StateSpaceBlock stateSpace(const Process& p, double rate_hz) {
   if (!(rate_hz > 0.0)) throw Error("stateSpace: rate_hz must be > 0");
-  const double dt = 1.0 / rate_hz;
+  const detail::KindDef& def = detail::kindDef(p.kind);
   StateSpaceBlock b;
-  auto setN = [&b](int n) {
-    b.n = n;
-    b.F = Eigen::MatrixXd::Zero(n, n);
-    b.Qc = Eigen::MatrixXd::Zero(n, n);
-    b.H = Eigen::RowVectorXd::Zero(n);
-    b.P0 = Eigen::MatrixXd::Zero(n, n);
-  };
-  switch (p.kind) {
-    case ProcessKind::WN:
-      setN(0);
-      b.white_psd = p.sigma * p.sigma * dt;  // N^2 = sigma^2 dt
-      break;
-    case ProcessKind::QN:
-      setN(0);
-      b.white_psd = 2.0 * p.Q * p.Q * dt;  // per-sample variance 2 Q^2 as white
-      break;
-    case ProcessKind::GM:
-      // x' = -x/T + w with Qc = 2 sigma^2 / T keeps var(x) = sigma^2 in steady state
-      // (first-order Gauss-Markov, Brown & Hwang "Introduction to Random Signals").
-      setN(1);
-      b.F(0, 0) = -1.0 / p.T;
-      b.Qc(0, 0) = 2.0 * p.sigma * p.sigma / p.T;
-      b.H(0) = 1.0;
-      b.P0(0, 0) = p.sigma * p.sigma;
-      b.names = {"GM(T=" + fmtg(p.T) + "s)"};
-      break;
-    case ProcessKind::RW:
-      // x' = w, Qc = K^2 = gamma^2 / dt.
-      setN(1);
-      b.Qc(0, 0) = p.gamma * p.gamma / dt;
-      b.H(0) = 1.0;
-      b.names = {"RW"};
-      break;
-    case ProcessKind::DR:
-      setN(2);
-      b.F(0, 1) = 1.0;
-      b.H(0) = 1.0;
-      b.P0(1, 1) = (p.omega / dt) * (p.omega / dt);  // zero-mean prior on the slope [unit/s]
-      b.names = {"DR bias", "DR rate"};
-      break;
-    case ProcessKind::SIN: {
-      setN(2);
-      const double w = kTwoPi * p.freq_hz;
-      b.F(0, 1) = w;
-      b.F(1, 0) = -w;
-      b.H(0) = 1.0;
-      b.P0(0, 0) = b.P0(1, 1) = 0.5 * p.amp * p.amp;
-      b.names = {"SIN(f=" + fmtg(p.freq_hz) + "Hz) sin", "SIN(f=" + fmtg(p.freq_hz) + "Hz) cos"};
-      break;
-    }
-  }
+  const int n = def.stateCount();
+  b.n = n;
+  b.F = Eigen::MatrixXd::Zero(n, n);
+  b.Qc = Eigen::MatrixXd::Zero(n, n);
+  b.H = Eigen::RowVectorXd::Zero(n);
+  b.P0 = Eigen::MatrixXd::Zero(n, n);
+  def.stateSpace(p, rate_hz, b);  // processes/<name>.cpp
+  if (static_cast<int>(b.names.size()) != n)
+    throw Error(std::string("internal: state-space block of ") + def.info().name + " has " +
+                std::to_string(n) + " states and " + std::to_string(b.names.size()) + " labels");
   return b;
 }
 

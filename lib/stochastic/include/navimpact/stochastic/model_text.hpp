@@ -33,5 +33,7 @@ std::string formatTerms(const std::vector<Process>& terms, int digits = 4);
 /// Parse a structure like "WN+GM+GM+DR" (also accepts "AR1" for GM, "SIN", "QN", "RW").
 std::vector<ProcessKind> parseStructure(const std::string& spec);
 std::string formatStructure(const std::vector<ProcessKind>& kinds);
+/// The structure of a model's terms, e.g. "WN+GM+DR" ("none" when empty).
+std::string formatStructure(const Model& m);
 
 }  // namespace navimpact::stochastic

@@ -18,13 +18,11 @@
 
 namespace navimpact::stochastic {
 
+/// The process kinds (process_kinds.def lists them with what each one is;
+/// process_kind.hpp describes each kind: parameters, units, ranges).
 enum class ProcessKind {
-  WN,   ///< white noise: x_k ~ N(0, sigma^2)
-  QN,   ///< quantization noise: x_k = sqrt(12 Q^2) (u_k - u_{k-1}), u ~ U(0,1)
-  RW,   ///< random walk: x_k = x_{k-1} + gamma z_k
-  DR,   ///< drift (ramp): x_k = omega k
-  GM,   ///< first-order Gauss-Markov: x_k = phi x_{k-1} + e_k, var(x) = sigma^2
-  SIN,  ///< sinusoid: x_k = amp sin(2 pi freq_hz k dt + random phase)
+#define NAVIMPACT_PROCESS_KIND(NAME, DOC) NAME,
+#include "navimpact/stochastic/process_kinds.def"
 };
 
 /// Short name as used in the text form ("WN", "QN", "RW", "DR", "GM", "SIN").
@@ -61,6 +59,8 @@ struct Model {
   bool empty() const { return terms.empty(); }
   /// Number of terms of a kind.
   int count(ProcessKind k) const;
+  /// The kinds of the terms in order (formatStructure() prints it as "WN+GM+DR").
+  std::vector<ProcessKind> structure() const;
 };
 
 /**
@@ -70,6 +70,16 @@ struct Model {
  * sigma and T; RW gamma by sqrt(old/new); DR omega by old/new; SIN unchanged.
  */
 Model convertRate(const Model& m, double new_rate_hz);
+
+/**
+ * Documented accuracy of convertRate() for one term: a bound on the relative
+ * change of its Haar WV in seconds, at the scale of @p tau_s seconds, between
+ * the rates @p rate_a_hz and @p rate_b_hz. 0 where the conversion keeps it
+ * exactly (WN, QN, DR); otherwise the excess of the sampled WV over its
+ * continuous-time limit at the slower rate: RW 2/tau^2, GM ~ 1/(2 n^2) +
+ * (dt/T)^2/12 (tau = 2n samples; evaluated exactly), SIN 1/sinc^2(pi f dt) - 1.
+ */
+double conversionWvBound(const Process& p, double rate_a_hz, double rate_b_hz, double tau_s);
 
 /**
  * Validate parameters (finite, sigma/Q/gamma/T/amp > 0, DR omega finite,

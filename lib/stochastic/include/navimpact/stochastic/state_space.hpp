@@ -5,7 +5,8 @@
  *
  * Continuous time: x' = F x + G w, E[w w^T] = Qc delta(t); sensor error = H x
  * (+ white noise of PSD white_psd). Exact discrete form over dt:
- * Phi = exp(F dt), Qd = int_0^dt exp(F s) Qc exp(F s)^T ds.
+ * Phi = exp(F dt), Qd = int_0^dt exp(F s) Qc exp(F s)^T ds. Each kind's block
+ * is defined in lib/stochastic/src/processes/<name>.cpp:
  *  - WN, QN: no state; white_psd = sigma^2 dt_model (QN: 2 Q^2 dt_model, its
  *    per-sample variance, a conservative white approximation).
  *  - GM: 1 state, F = -1/T, Qc = 2 sigma^2 / T, P0 = sigma^2 (stationary).
@@ -32,7 +33,9 @@ struct StateSpaceBlock {
   Eigen::RowVectorXd H;               ///< 1 x n: sensor error = H x
   Eigen::MatrixXd P0;                 ///< n x n initial covariance
   double white_psd = 0.0;             ///< white part added to sensor noise [unit^2 s]
-  std::vector<std::string> names;     ///< one label per state, e.g. "GM(T=3.22s)"
+  /// One label per state, appended to the term's name "<channel>.<KIND><k>" by
+  /// the filter: "(T=3.22s)" (GM), "" (RW), ".bias"/".rate" (DR), "(f=1.3Hz).a"/".b" (SIN).
+  std::vector<std::string> names;
 
   /// Exact transition over dt [s].
   Eigen::MatrixXd Phi(double dt) const;
