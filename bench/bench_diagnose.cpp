@@ -1,8 +1,8 @@
 // Cost of navimpact diagnose (analysis::diagnose, analysis::addNavigationGain):
 //  - Diagnose/simulated/N: a simulated six-channel record of N samples at 100 Hz
-//    (gyro WN+RW, acc WN+GM) against its own model, 16 simulations, 2 threads;
+//    (gyro WN+RW, acc WN+GM) against its own model, default simulations (8), 2 threads;
 //  - Diagnose/adis: the real ADIS16405 recording 1 (10^6 samples) against a
-//    fitted WN model (the heaviest real case: lines, steps, spikes found);
+//    fitted WN model (the heaviest real case: lines, level shifts, outliers found);
 //  - Diagnose/adis_nav: the same plus the navigation gain along the 600 s UAV
 //    flight, outage 200:60, 10 paired runs (skipped without ../shared).
 // Wall time per iteration (UseRealTime); the record is made outside the timing.

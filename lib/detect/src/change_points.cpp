@@ -81,26 +81,48 @@ ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunctio
       s.threshold = twoSidedNormalQuantile(alpha / (J * static_cast<double>(s.positions)));
     }
   }
+  // Largest |contrast| per scale, kept between iterations: removing a change
+  // at c alters only the windows that straddle c (|k - c| < m), so a scale is
+  // rescanned whole only when its maximum was among them.
+  std::vector<double> smax(scales.size(), 0.0);
+  std::vector<std::size_t> kmax(scales.size(), 0);
+  std::vector<char> stale(scales.size(), 1);
+  std::size_t last_c = 0;
+  bool have_last = false;
   for (int it = 0; it < opt.max_changes; ++it) {
     const auto S = prefix(x);
     ChangePoint best;
     double best_excess = 1.0;
-    for (const auto& s : scales) {
+    for (std::size_t si = 0; si < scales.size(); ++si) {
+      const auto& s = scales[si];
       if (!(s.sd > 0)) continue;
-      double dmax = 0;
-      std::size_t kmax = 0;
-      for (std::size_t k = s.m; k + s.m <= n; k += s.stride) {
-        const double d = meanOf(S, k, k + s.m) - meanOf(S, k - s.m, k);
-        if (std::abs(d) > std::abs(dmax)) {
-          dmax = d;
-          kmax = k;
+      auto scan = [&](std::size_t k0, std::size_t k1) {  // grid positions in [k0, k1]
+        std::size_t k = s.m;
+        if (k0 > s.m) k = s.m + ((k0 - s.m + s.stride - 1) / s.stride) * s.stride;
+        for (; k + s.m <= n && k <= k1; k += s.stride) {
+          const double d = meanOf(S, k, k + s.m) - meanOf(S, k - s.m, k);
+          if (std::abs(d) > std::abs(smax[si])) {
+            smax[si] = d;
+            kmax[si] = k;
+          }
         }
+      };
+      if (have_last && !stale[si]) {
+        const std::size_t lo = last_c > s.m ? last_c - s.m : 0, hi = last_c + s.m;
+        if (kmax[si] > lo && kmax[si] < hi) stale[si] = 1;
+        else scan(lo, hi);
       }
-      const double z = std::abs(dmax) / s.sd;
+      if (stale[si]) {
+        smax[si] = 0;
+        kmax[si] = 0;
+        scan(0, n);
+        stale[si] = 0;
+      }
+      const double z = std::abs(smax[si]) / s.sd;
       if (z / s.threshold > best_excess) {
         best_excess = z / s.threshold;
-        best.index = kmax;
-        best.contrast = dmax;
+        best.index = kmax[si];
+        best.contrast = smax[si];
         best.half_width = s.m;
         best.sd = s.sd;
         best.z = z;
@@ -147,6 +169,8 @@ ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunctio
                     : best.contrast;
     for (std::size_t k = best.index; k < n; ++k) x[k] -= best.size;
     res.changes.push_back(best);
+    last_c = best.index;
+    have_last = true;
   }
   // Clusters of changes closer than their detecting windows.
   std::vector<ChangePoint> byIndex = res.changes;

@@ -59,18 +59,31 @@ cplx hannSum(double theta, std::size_t n) {
 /// Least-squares mean + b sin + c cos at f over x[a, b); rotation recurrence re-seeded every 1024.
 void lsSinusoid(const std::vector<double>& x, std::size_t a, std::size_t b, double f, double fs,
                 double* bs, double* bc) {
+  // Sums in double over blocks of 1024 samples (where the phasor is re-seeded),
+  // blocks added in long double.
   long double S[3][3] = {{0}}, r[3] = {0};
   const double w = kTwoPi * f / fs;
   const cplx rot(std::cos(w), std::sin(w));
-  cplx ph;
-  for (std::size_t k = a; k < b; ++k) {
-    if (((k - a) & 1023) == 0) ph = std::polar(1.0, w * static_cast<double>(k));
-    const double v[3] = {1.0, ph.imag(), ph.real()};
-    for (int i = 0; i < 3; ++i) {
-      r[i] += v[i] * x[k];
-      for (int j = i; j < 3; ++j) S[i][j] += v[i] * v[j];
+  for (std::size_t k0 = a; k0 < b; k0 += 1024) {
+    const std::size_t k1 = std::min(b, k0 + 1024);
+    cplx ph = std::polar(1.0, w * static_cast<double>(k0));
+    double s1 = 0, ss = 0, sc = 0, sss = 0, ssc = 0, scc = 0, r0 = 0, rs = 0, rc = 0;
+    for (std::size_t k = k0; k < k1; ++k) {
+      const double sn = ph.imag(), cs = ph.real(), xv = x[k];
+      s1 += 1.0;
+      ss += sn;
+      sc += cs;
+      sss += sn * sn;
+      ssc += sn * cs;
+      scc += cs * cs;
+      r0 += xv;
+      rs += sn * xv;
+      rc += cs * xv;
+      ph *= rot;
     }
-    ph *= rot;
+    S[0][0] += s1; S[0][1] += ss; S[0][2] += sc;
+    S[1][1] += sss; S[1][2] += ssc; S[2][2] += scc;
+    r[0] += r0; r[1] += rs; r[2] += rc;
   }
   Eigen::Matrix3d A;
   Eigen::Vector3d y;
