@@ -182,6 +182,7 @@ class WvCost final : public ceres::CostFunction {
 /// Everything one fit needs about the data.
 struct Data {
   Eigen::VectorXd tau, nu_hat, w_rel, w_obj, omega, eta;
+  Eigen::VectorXd ci_w;  ///< width of the empirical WV's 95 % CI per scale (redundancy checks)
   /// Efficient weighting: W with W'W = Omega (empty otherwise: diagonal w_obj).
   Eigen::MatrixXd w_full;
   double rate = 0;
@@ -203,6 +204,7 @@ Data makeData(const WaveletVariance& wv) {
   d.tau = wv.tau;
   d.nu_hat = wv.wv;
   d.w_rel = wv.wv.cwiseInverse();
+  d.ci_w = wv.ci_high - wv.ci_low;
   d.omega = wv.weights();
   d.w_obj = d.omega.cwiseSqrt();
   d.rate = wv.rate_hz;
@@ -538,7 +540,224 @@ std::vector<Eigen::VectorXd> warmStarts(const Layout& L, const Model& warm, cons
   return out;
 }
 
-/// Point estimate: multi-start, returns the transformed theta (GMs sorted).
+// ---------------------------------------------------------------------------
+// Two terms that are one. A local minimum of the objective can spend two
+// terms on one feature of the WV: two GMs with (nearly) the same T, a GM
+// below one sample that is white at the data's precision next to a WN, a GM
+// far beyond the record next to a RW, two terms of one kind without a shape
+// parameter. Such a point is a saddle for the search (moving the two terms
+// apart does not change the objective to first order), so Levenberg-Marquardt
+// stays there although the structure could describe more of the WV. The fit
+// merges the pair into one term (same WV up to the merge's approximation),
+// frees the other one and restarts with the freed term placed across the
+// scale range (warmStarts of the reduced model): the returned solution never
+// has such a pair, and its objective is at most the merged point's.
+// ---------------------------------------------------------------------------
+
+/// Rules by which two terms are one (see redundantTerms in estimator.hpp).
+enum class DupRule { SameKind, GmPair, GmIsWhite, GmIsRandomWalk, SinPair };
+
+struct Duplicate {
+  int keep = -1;  ///< term that takes the merged amplitude
+  int drop = -1;  ///< term that is freed
+  DupRule rule = DupRule::SameKind;
+};
+
+/// WV profiles of every term (J x terms) at theta.
+Eigen::MatrixXd termProfiles(const Layout& L, const Eigen::VectorXd& th, const Eigen::VectorXd& tau) {
+  Eigen::MatrixXd P(tau.size(), static_cast<Eigen::Index>(L.kinds.size()));
+  for (std::size_t i = 0; i < L.kinds.size(); ++i)
+    for (Eigen::Index j = 0; j < tau.size(); ++j)
+      P(j, static_cast<Eigen::Index>(i)) = detail::termWv(L.kinds[i], th.data() + L.offset[i], tau[j]);
+  return P;
+}
+
+/// True when |a_j - b_j| < fraction * ci_w_j at every scale (the data cannot tell a from b).
+bool indistinguishable(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const Eigen::VectorXd& ci_w,
+                       double fraction) {
+  for (Eigen::Index j = 0; j < a.size(); ++j)
+    if (!(std::fabs(a[j] - b[j]) < fraction * ci_w[j])) return false;
+  return true;
+}
+
+/// GM stationary variance s2 and phi = exp(-1/T) (T in samples) from transformed parameters.
+void gmParams(const double* t, double& s2, double& phi) {
+  s2 = std::exp(2.0 * t[0]);
+  phi = std::exp(-std::exp(-t[1]));
+}
+
+/**
+ * Pairs of non-negligible terms of theta that are one (rules in DupRule):
+ * same kind without a shape parameter (WN, QN, RW, DR: proportional WVs);
+ * two GMs with T within kDuplicateTFactor; two SINs within 1 % in frequency;
+ * a GM with T below one sample whose WV is that of a white noise of its
+ * long-run variance s2 (1 + phi) / (1 - phi) within @p fraction of the CI
+ * width at every scale, when the structure has a WN; a GM whose WV is that
+ * of a random walk with gamma^2 = 2 s2 (1 - phi) (its short-lag increments)
+ * within the same margin, when the structure has a RW.
+ */
+std::vector<Duplicate> duplicates(const Layout& L, const Eigen::VectorXd& th, const Eigen::VectorXd& tau,
+                                  const Eigen::VectorXd& ci_w, double fraction) {
+  const int m = static_cast<int>(L.kinds.size());
+  const Eigen::MatrixXd P = termProfiles(L, th, tau);
+  std::vector<bool> neg(m, true);
+  for (int i = 0; i < m; ++i)
+    for (Eigen::Index j = 0; j < tau.size() && neg[i]; ++j)
+      if (!(P(j, i) < fraction * ci_w[j])) neg[i] = false;
+  std::vector<Duplicate> out;
+  const double logf = std::log(kDuplicateTFactor);
+  for (int a = 0; a < m; ++a) {
+    if (neg[a]) continue;
+    const ProcessKind ka = L.kinds[a];
+    const double* ta = th.data() + L.offset[a];
+    for (int b = a + 1; b < m; ++b) {
+      if (neg[b]) continue;
+      const ProcessKind kb = L.kinds[b];
+      const double* tb = th.data() + L.offset[b];
+      if (ka == kb) {
+        if (ka == ProcessKind::GM) {
+          if (std::fabs(ta[1] - tb[1]) < logf) out.push_back({a, b, DupRule::GmPair});
+        } else if (ka == ProcessKind::SIN) {
+          if (std::fabs(ta[1] - tb[1]) < std::log(1.01)) out.push_back({a, b, DupRule::SinPair});
+        } else {
+          out.push_back({a, b, DupRule::SameKind});
+        }
+        continue;
+      }
+      // GM against WN / RW: the GM is the one freed.
+      int g = -1, o = -1;
+      if (ka == ProcessKind::GM) g = a, o = b;
+      if (kb == ProcessKind::GM) g = b, o = a;
+      if (g < 0) continue;
+      double s2 = 0, phi = 0;
+      gmParams(th.data() + L.offset[g], s2, phi);
+      Eigen::VectorXd eq(tau.size());
+      if (L.kinds[o] == ProcessKind::WN && std::exp(th[L.offset[g] + 1]) < 1.0) {
+        const double w2 = s2 * (1.0 + phi) / (1.0 - phi);
+        for (Eigen::Index j = 0; j < tau.size(); ++j) eq[j] = w2 / tau[j];
+        if (indistinguishable(P.col(g), eq, ci_w, fraction)) out.push_back({o, g, DupRule::GmIsWhite});
+      } else if (L.kinds[o] == ProcessKind::RW) {
+        const double g2 = 2.0 * s2 * (1.0 - phi);
+        for (Eigen::Index j = 0; j < tau.size(); ++j) eq[j] = g2 * (tau[j] * tau[j] + 2.0) / (12.0 * tau[j]);
+        if (indistinguishable(P.col(g), eq, ci_w, fraction)) out.push_back({o, g, DupRule::GmIsRandomWalk});
+      }
+    }
+  }
+  return out;
+}
+
+/// The model with the pair @p dp merged into dp.keep and dp.drop removed (a sub-structure of L).
+Model mergeDuplicate(const Layout& L, const Eigen::VectorXd& th, double rate, const Duplicate& dp) {
+  Model m = detail::toModel(L, th, rate);
+  Process& k = m.terms[dp.keep];
+  const Process& x = m.terms[dp.drop];
+  auto rss = [](double a, double b) { return std::sqrt(a * a + b * b); };
+  double s2 = 0, phi = 0;
+  switch (dp.rule) {
+    case DupRule::SameKind:
+      k.sigma = rss(k.sigma, x.sigma);
+      k.Q = rss(k.Q, x.Q);
+      k.gamma = rss(k.gamma, x.gamma);
+      k.omega = rss(k.omega, x.omega);
+      break;
+    case DupRule::GmPair: {
+      const double a = k.sigma * k.sigma, b = x.sigma * x.sigma;
+      k.T = std::exp((a * std::log(k.T) + b * std::log(x.T)) / (a + b));
+      k.sigma = std::sqrt(a + b);
+      break;
+    }
+    case DupRule::SinPair: {
+      const double a = k.amp * k.amp, b = x.amp * x.amp;
+      k.freq_hz = (a * k.freq_hz + b * x.freq_hz) / (a + b);
+      k.amp = std::sqrt(a + b);
+      break;
+    }
+    case DupRule::GmIsWhite:
+      gmParams(th.data() + L.offset[dp.drop], s2, phi);
+      k.sigma = std::sqrt(k.sigma * k.sigma + s2 * (1.0 + phi) / (1.0 - phi));
+      break;
+    case DupRule::GmIsRandomWalk:
+      gmParams(th.data() + L.offset[dp.drop], s2, phi);
+      k.gamma = std::sqrt(k.gamma * k.gamma + 2.0 * s2 * (1.0 - phi));
+      break;
+  }
+  m.terms.erase(m.terms.begin() + dp.drop);
+  return m;
+}
+
+/// One solved starting point.
+struct Solved {
+  Eigen::VectorXd th;
+  double v = std::numeric_limits<double>::infinity();
+  bool conv = false;
+  bool dup = false;
+};
+
+/**
+ * The best solution without two terms that are one, from the solved points
+ * @p pts (objective under weights @p W): points with a pair that beat the best
+ * clean one are merged (mergeDuplicate) and restarted from the reduced model
+ * with the freed term placed across the scale range (warmStarts), for up to
+ * three rounds (a restart can meet another pair). If no clean point exists at
+ * all, the best point with its pairs merged and the freed terms negligible is
+ * returned. @p restarts counts the extra starting points.
+ */
+Solved resolveDuplicates(const Layout& L, std::vector<Solved> pts, const Data& d, const Weights& W,
+                         int* restarts) {
+  auto mark = [&](Solved& s) {
+    s.dup = !duplicates(L, s.th, d.tau, d.ci_w, kNegligibleFraction).empty();
+  };
+  for (auto& s : pts) mark(s);
+  std::sort(pts.begin(), pts.end(), [](const Solved& a, const Solved& b) { return a.v < b.v; });
+  Solved best;
+  for (auto& s : pts)
+    if (!s.dup) {
+      best = s;
+      break;
+    }
+  std::vector<Solved> queue;
+  for (auto& s : pts)
+    if (s.dup && s.v < best.v && queue.size() < 2) queue.push_back(s);
+  for (int round = 0; round < 3 && !queue.empty(); ++round) {
+    std::vector<Solved> next;
+    for (const Solved& q : queue) {
+      const auto dups = duplicates(L, q.th, d.tau, d.ci_w, kNegligibleFraction);
+      if (dups.empty()) continue;
+      const Model reduced = mergeDuplicate(L, q.th, d.rate, dups.front());
+      for (Eigen::VectorXd t : warmStarts(L, reduced, d)) {
+        Solved s;
+        s.v = solve(L, t, d, W, &s.conv);
+        sortTerms(L, t);
+        s.th = t;
+        mark(s);
+        if (restarts) ++*restarts;
+        if (!s.dup && s.v < best.v) best = s;
+        if (s.dup && s.v < best.v && next.size() < 2) next.push_back(s);
+      }
+    }
+    queue = next;
+  }
+  if (best.th.size() == 0) {
+    // Every point has a pair: merge them all and leave the freed terms negligible.
+    Solved s = pts.front();
+    for (int it = 0; it < static_cast<int>(L.kinds.size()); ++it) {
+      const auto dups = duplicates(L, s.th, d.tau, d.ci_w, kNegligibleFraction);
+      if (dups.empty()) break;
+      const auto w = warmStarts(L, mergeDuplicate(L, s.th, d.rate, dups.front()), d);
+      if (w.empty()) break;
+      s.th = w.front();
+      sortTerms(L, s.th);
+      s.v = criterion(L, s.th, d, W);
+      s.conv = false;
+    }
+    mark(s);
+    best = s;
+  }
+  return best;
+}
+
+/// Point estimate: multi-start, returns the transformed theta (GMs sorted),
+/// never with two terms that are one (resolveDuplicates).
 Eigen::VectorXd fitPoint(const Layout& L, const Data& d, const FitOptions& opt, int* starts,
                          bool* converged) {
   const std::size_t k = opt.max_starts > 0 ? std::max<std::size_t>(1, opt.max_starts / 2) : 4;
@@ -560,24 +779,22 @@ Eigen::VectorXd fitPoint(const Layout& L, const Data& d, const FitOptions& opt, 
   for (auto& s : best_obj) cands.push_back(s.th);
   for (const Model& w : opt.warm_starts)
     for (auto& t : warmStarts(L, w, d)) cands.push_back(t);
-  Eigen::VectorXd best_th;
-  double best_v = std::numeric_limits<double>::infinity();
-  bool best_conv = false;
+  std::vector<Solved> pts;
   for (auto& t : cands) {
-    bool conv = false;
-    const double v = solve(L, t, d, objW(d), &conv);
-    if (v < best_v) {
-      best_v = v;
-      best_th = t;
-      best_conv = conv;
-    }
+    Solved s;
+    s.v = solve(L, t, d, objW(d), &s.conv);
+    if (!std::isfinite(s.v)) continue;
+    sortTerms(L, t);
+    s.th = t;
+    pts.push_back(std::move(s));
   }
-  if (best_th.size() == 0) throw Error("GMWM fit of " + stochastic::formatStructure(L.kinds) +
-                                       ": no starting point gave a finite objective");
-  sortTerms(L, best_th);
-  if (starts) *starts = static_cast<int>(cands.size());
-  if (converged) *converged = best_conv;
-  return best_th;
+  if (pts.empty()) throw Error("GMWM fit of " + stochastic::formatStructure(L.kinds) +
+                               ": no starting point gave a finite objective");
+  int n_starts = static_cast<int>(cands.size());
+  const Solved best = resolveDuplicates(L, std::move(pts), d, objW(d), &n_starts);
+  if (starts) *starts = n_starts;
+  if (converged) *converged = best.conv;
+  return best.th;
 }
 
 /// Omega_jj = eta_j / (2 nu_j(theta)^2): inverse chi-square variance of nu_hat_j
@@ -657,19 +874,19 @@ int reweight(const Layout& L, Eigen::VectorXd& th, Data& d, const FitOptions& op
       setEfficientWeights(L, th, d, opt.efficient_min_eta);
     else
       setModelWeights(L, th, d);
-    Eigen::VectorXd t = th;
-    double v = solve(L, t, d, objW(d), converged);
-    sortTerms(L, t);
+    std::vector<Solved> pts(1);
+    pts[0].th = th;
+    pts[0].v = solve(L, pts[0].th, d, objW(d), &pts[0].conv);
+    sortTerms(L, pts[0].th);
     if (multistart && it == 0) {  // the fast basin need not be the best one under the new weights
-      bool c2 = false;
-      Eigen::VectorXd t2 = fitPoint(L, d, opt, nullptr, &c2);
-      const double v2 = criterion(L, t2, d, objW(d));
-      if (v2 < v) {
-        t = t2;
-        v = v2;
-        if (converged) *converged = c2;
-      }
+      Solved s;
+      s.th = fitPoint(L, d, opt, nullptr, &s.conv);
+      s.v = criterion(L, s.th, d, objW(d));
+      pts.push_back(s);
     }
+    const Solved best = resolveDuplicates(L, std::move(pts), d, objW(d), nullptr);
+    if (converged) *converged = best.conv;
+    const Eigen::VectorXd t = best.th;
     const double change = (t - th).cwiseAbs().maxCoeff();
     th = t;
     ++done;
@@ -929,6 +1146,64 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
   }
   r.ci = intervalsFromTheta(L, th, lo, hi, d.rate);
   return r;
+}
+
+std::vector<RedundantPair> redundantTerms(const Model& m, const WaveletVariance& wv, double fraction) {
+  if (!(fraction > 0.0 && fraction <= 1.0))
+    throw Error("redundantTerms: fraction " + std::to_string(fraction) + " outside (0, 1]");
+  if (wv.ci_high.size() != wv.tau.size() || wv.ci_low.size() != wv.tau.size())
+    throw Error("redundantTerms: the wavelet variance has no confidence interval");
+  std::vector<ProcessKind> kinds;
+  for (const auto& t : m.terms) kinds.push_back(t.kind);
+  const Layout L(kinds);
+  const double rate = m.rate_hz > 0 ? m.rate_hz : wv.rate_hz;
+  Model mm = m;
+  mm.rate_hz = rate;
+  const Eigen::VectorXd th = detail::fromModel(L, mm);
+  const Eigen::VectorXd ci_w = wv.ci_high - wv.ci_low;
+  std::vector<RedundantPair> out;
+  auto num = [](double v) {
+    std::ostringstream os;
+    os.precision(3);
+    os << v;
+    return os.str();
+  };
+  auto label = [&](int i) {
+    int k = 0;
+    for (int q = 0; q <= i; ++q)
+      if (kinds[q] == kinds[i]) ++k;
+    return std::string(stochastic::kindName(kinds[i])) + " " + std::to_string(k);
+  };
+  for (const Duplicate& dp : duplicates(L, th, wv.tau, ci_w, fraction)) {
+    RedundantPair r;
+    r.keep = dp.keep;
+    r.drop = dp.drop;
+    const Process& a = m.terms[dp.keep];
+    const Process& b = m.terms[dp.drop];
+    switch (dp.rule) {
+      case DupRule::SameKind:
+        r.why = label(dp.keep) + " and " + label(dp.drop) + " are the same process (proportional WVs)";
+        break;
+      case DupRule::GmPair:
+        r.why = label(dp.keep) + " and " + label(dp.drop) + " have T within a factor " + num(kDuplicateTFactor) +
+                " (" + num(a.T) + " s, " + num(b.T) + " s)";
+        break;
+      case DupRule::SinPair:
+        r.why = label(dp.keep) + " and " + label(dp.drop) + " have the same frequency (" + num(a.freq_hz) +
+                " Hz, " + num(b.freq_hz) + " Hz)";
+        break;
+      case DupRule::GmIsWhite:
+        r.why = label(dp.drop) + " (T = " + num(b.T) + " s, below one sample) is white noise at the data's "
+                "precision, next to " + label(dp.keep);
+        break;
+      case DupRule::GmIsRandomWalk:
+        r.why = label(dp.drop) + " (T = " + num(b.T) + " s) is a random walk at the data's precision, next to " +
+                label(dp.keep);
+        break;
+    }
+    out.push_back(r);
+  }
+  return out;
 }
 
 }  // namespace navimpact::gmwm

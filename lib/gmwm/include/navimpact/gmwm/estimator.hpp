@@ -164,6 +164,38 @@ constexpr double kNegligibleFraction = 0.1;
 std::vector<bool> negligibleTerms(const stochastic::Model& m, const WaveletVariance& wv,
                                   double fraction = kNegligibleFraction);
 
+/// Two GMs whose correlation times are within this factor are one term
+/// (their WV peaks are less than an octave apart, one Haar scale step).
+constexpr double kDuplicateTFactor = 2.0;
+
+/// Two terms of a model that are one (redundantTerms).
+struct RedundantPair {
+  int keep = -1;    ///< index of the term that would take the merged amplitude
+  int drop = -1;    ///< index of the term that is wasted
+  std::string why;  ///< plain-language reason, e.g. "GM 1 and GM 2 have T within a factor 2 (0.006 s, 0.006 s)"
+};
+
+/**
+ * Pairs of terms of @p m that are one, among the terms that are not
+ * negligible (negligibleTerms with @p fraction): two terms of one kind
+ * without a shape parameter (WN, QN, RW, DR: proportional WVs); two GMs with
+ * T within kDuplicateTFactor; two SINs within 1 % in frequency; a GM with T
+ * below one sample whose WV equals that of a white noise of its long-run
+ * variance sigma^2 (1+phi)/(1-phi) within @p fraction of the CI width at every
+ * scale, next to a WN; a GM whose WV equals that of a random walk with
+ * gamma^2 = 2 sigma^2 (1-phi) within the same margin, next to a RW.
+ * gmwm::fit never returns such a pair: it merges the two, frees one term and
+ * restarts the search with the freed term placed across the scale range.
+ * A GM below one sample that is measurably NOT white (lag-1 correlation the
+ * WV resolves) next to a vanishing WN is not a pair: it is the better model
+ * of the high-frequency noise (see stochastic::datasheetFigures for its ARW).
+ * @param[in] m         model (per-sample parameters at m.rate_hz = wv.rate_hz).
+ * @param[in] wv        empirical WV (its CI widths set the margins).
+ * @param[in] fraction  in (0, 1], default kNegligibleFraction.
+ */
+std::vector<RedundantPair> redundantTerms(const stochastic::Model& m, const WaveletVariance& wv,
+                                          double fraction = kNegligibleFraction);
+
 /// One candidate of an automatic model selection.
 struct RankedModel {
   FitResult fit;
