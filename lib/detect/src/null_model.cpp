@@ -1,41 +1,23 @@
 #include "navimpact/detect/null_model.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 
+#include "navimpact/stochastic/spectrum.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
 namespace navimpact::detect {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-
-/// Two-sided PSD times fs (i.e. per unit of w / 2 pi) at w in (0, pi].
-double psdTimesFs(const stochastic::Model& m, double w) {
-  double s = 0;
-  const double s2 = std::sin(0.5 * w);
-  for (const auto& p : m.terms) {
-    switch (p.kind) {
-      case stochastic::ProcessKind::WN: s += p.sigma * p.sigma; break;
-      case stochastic::ProcessKind::QN: s += 4.0 * p.Q * p.Q * s2 * s2; break;
-      case stochastic::ProcessKind::RW: s += p.gamma * p.gamma / (4.0 * s2 * s2); break;
-      case stochastic::ProcessKind::GM: {
-        const double phi = std::exp(-1.0 / (m.rate_hz * p.T));
-        s += p.sigma * p.sigma * (1.0 - phi * phi) / (1.0 - 2.0 * phi * std::cos(w) + phi * phi);
-        break;
-      }
-      case stochastic::ProcessKind::DR:
-      case stochastic::ProcessKind::SIN: break;
-    }
-  }
-  return s;
-}
 }  // namespace
 
 PsdFunction psdOf(const stochastic::Model& m) {
-  return [m](double f) {
-    const double w = 2.0 * kPi * f / m.rate_hz;
-    return psdTimesFs(m, w) / m.rate_hz;
-  };
+  // stochastic::Spectrum is one-sided; the detectors use the two-sided density.
+  auto sp = std::make_shared<stochastic::Spectrum>(m);
+  const double nyq = 0.5 * m.rate_hz;
+  return [sp, nyq](double f) { return 0.5 * (*sp)(std::min(std::max(f, 1e-300), nyq)); };
 }
 
 HaarWvFunction haarWvOf(const stochastic::Model& m) {
@@ -47,13 +29,16 @@ HaarWvFunction haarWvOf(const stochastic::Model& m) {
 }
 
 double secondDifferenceSd(const stochastic::Model& m) {
-  // (1/2pi) int_{-pi}^{pi} s(w) (1 - cos w)^2 dw, midpoint rule on (0, pi].
+  // (1/2pi) int_{-pi}^{pi} S(w) (1 - cos w)^2 dw with S the two-sided density
+  // per sample (Spectrum::perSample), midpoint rule on (0, pi].
+  const stochastic::Spectrum sp(m);
   const int K = 4096;
   double acc = 0;
   for (int i = 0; i < K; ++i) {
     const double w = (i + 0.5) * kPi / K;
     const double h = 1.0 - std::cos(w);
-    acc += psdTimesFs(m, w) * h * h;
+    const double s2 = std::sin(0.5 * w);
+    acc += sp.perSample(s2 * s2) * h * h;
   }
   return std::sqrt(acc / K);
 }

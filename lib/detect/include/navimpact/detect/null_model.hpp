@@ -4,11 +4,9 @@
  *        their null: two-sided PSD, Haar wavelet variance, sd of the second
  *        difference.
  *
- * PSD of the sampled processes (two-sided, [unit^2/Hz], w = 2 pi f / fs):
- * WN sigma^2/fs; QN (differenced white noise of variance Q^2)
- * 4 Q^2 sin^2(w/2)/fs; RW (pseudo-spectrum) gamma^2 / (4 sin^2(w/2) fs);
- * GM (AR(1), phi = e^{-1/(fs T)}) sigma^2 (1 - phi^2) / ((1 - 2 phi cos w + phi^2) fs);
- * DR and SIN are deterministic (a trend is removed, a model line is excluded).
+ * The PSD is stochastic::Spectrum's (the sampled processes, per kind from
+ * the process registry), halved to the two-sided density the detectors use;
+ * DR and SIN have no density (a trend is removed, a model line is excluded).
  */
 #pragma once
 
