@@ -10,6 +10,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/core/units.hpp"
+#include "navimpact/report/covariance_report.hpp"
 
 namespace {
 
@@ -58,7 +59,7 @@ navimpact::cli::Registrar reg({
             o->trajectory.empty() ? an::runCovarianceStudy(cfg, tick)
                                   : an::runCovarianceStudyAlongTrajectory(cfg, o->trajectory, tick);
         bar.finish();
-        an::writeCovarianceStudy(cfg, res, out);
+        navimpact::report::writeCovarianceStudy(cfg, res, out);
         out.commit();
         // short report, human units
         std::printf("%-14s %-12s %9s %9s %9s %10s %9s\n", "set", "model", "t [s]", "pos N [m]",

@@ -7,6 +7,7 @@
 #include "navimpact/analysis/replay.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
+#include "navimpact/report/replay_report.hpp"
 
 namespace {
 
@@ -46,11 +47,7 @@ navimpact::cli::Registrar reg({
         }
         if (o->propagate_every > 0) cfg.propagate_every = o->propagate_every;
         const auto r = navimpact::analysis::runReplay(cfg);
-        out.writeText("solution.csv", navimpact::analysis::solutionCsv(r));
-        out.writeText("summary.json", navimpact::analysis::summaryJson(r));
-        const auto staged = out.stage("errors_full.png").parent_path();
-        navimpact::analysis::writeReplayFigures(r, staged.string());
-        for (std::size_t i = 0; i < cfg.outages.size(); ++i) out.stage("errors_outage_" + std::to_string(i + 1) + ".png");
+        navimpact::report::writeReplayOutputs(r, out);
         out.commit();
         for (const auto& n : r.notices) std::printf("notice: %s\n", n.c_str());
         std::printf("replayed %s: %zu IMU steps at %g Hz, %zu GNSS and %zu baro updates, filter model %s "

@@ -67,24 +67,6 @@ TEST(CovarianceStudy, WhiteNoiseModelsFollowClosedFormsAndRicherModelsGrowFaster
   EXPECT_EQ(r.runs[5].states, 9 + 9);
 }
 
-TEST(CovarianceStudy, WritesAllOutputsOrNothing) {
-  const analysis::CovarianceStudyConfig cfg = shortConfig(2.0);
-  const analysis::CovarianceStudyResult r = analysis::runCovarianceStudy(cfg);
-  const auto dir = test::tempDir() / "out";
-  {
-    OutputSet out(dir);
-    analysis::writeCovarianceStudy(cfg, r, out);
-    // not committed: nothing may appear
-  }
-  EXPECT_FALSE(std::filesystem::exists(dir / "covariance.csv"));
-  OutputSet out(dir);
-  analysis::writeCovarianceStudy(cfg, r, out);
-  out.commit();
-  for (const char* f : {"covariance.csv", "summary.json", "covariance_accelerometer.png",
-                        "covariance_gyroscope.png"})
-    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
-}
-
 TEST(CovarianceStudy, ConfigErrorsNameTheKey) {
   const std::string path = (test::tempDir() / "bad.yaml").string();
   std::ofstream(path) << "model_file: " << test::sourcePath("config/models/navchip_table1.yaml")

@@ -5,6 +5,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/emulation/scenario.hpp"
 #include "navimpact/rawlog/writer.hpp"
+#include "navimpact/report/replay_report.hpp"
 #include "test_support.hpp"
 
 namespace emu = navimpact::emulation;
@@ -51,9 +52,9 @@ TEST(Replay, PerfectImuStaysWithinItsPredictedSigmaThroughAnOutage) {
   // An error-free IMU coasts better than the Ref-model filter expects.
   EXPECT_LT(e.err.head<2>().norm(), 3.0 * e.sigma.head<2>().norm());
   EXPECT_LT(std::abs(e.err[2]), 3.0 * e.sigma[2]);
-  const std::string csv = an::solutionCsv(r);
+  const std::string csv = navimpact::report::solutionCsv(r);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 602);
-  EXPECT_NE(an::summaryJson(r).find("\"horizontal_error_end_m\""), std::string::npos);
+  EXPECT_NE(navimpact::report::summaryJson(r).find("\"horizontal_error_end_m\""), std::string::npos);
 }
 
 TEST(Replay, BadInputIsAClearError) {

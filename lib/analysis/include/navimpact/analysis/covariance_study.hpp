@@ -29,7 +29,6 @@
 #include <string>
 #include <vector>
 
-#include "navimpact/core/output.hpp"
 #include "navimpact/filter/ekf.hpp"
 
 namespace navimpact::analysis {
@@ -105,12 +104,5 @@ CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,
 CovarianceStudyResult runCovarianceStudyAlongTrajectory(
     const CovarianceStudyConfig& cfg, const std::string& trajectory_csv,
     const std::function<void(int, int)>& progress = {});
-
-/**
- * Write covariance.csv, summary.json and one PNG per model set
- * (covariance_<set>.png) into @p out (staged; the caller commits).
- */
-void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStudyResult& res,
-                          OutputSet& out);
 
 }  // namespace navimpact::analysis

@@ -96,11 +96,4 @@ struct ReplayResult {
  */
 ReplayResult runReplay(const ReplayConfig& cfg);
 
-/// solution.csv text (one row per GT epoch; units in the header).
-std::string solutionCsv(const ReplayResult& r);
-/// summary.json text.
-std::string summaryJson(const ReplayResult& r);
-/// Write the figures (errors_full.png, errors_outage_K.png) into @p dir (existing).
-std::vector<std::string> writeReplayFigures(const ReplayResult& r, const std::string& dir);
-
 }  // namespace navimpact::analysis

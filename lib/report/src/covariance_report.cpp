@@ -1,0 +1,118 @@
+// Outputs of navimpact covariance: covariance.csv, summary.json, one figure per model set.
+#include "navimpact/report/covariance_report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "navimpact/core/units.hpp"
+#include "navimpact/plot/figure.hpp"
+
+namespace navimpact::report {
+
+using namespace analysis;
+
+namespace {
+const char* kCols[9] = {"sigma_pos_N_m",    "sigma_pos_E_m",     "sigma_pos_D_m",
+                        "sigma_vel_N_mps",  "sigma_vel_E_mps",   "sigma_vel_D_mps",
+                        "sigma_roll_rad",   "sigma_pitch_rad",   "sigma_yaw_rad"};
+
+std::size_t nearest(const std::vector<double>& t, double x) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < t.size(); ++i)
+    if (std::abs(t[i] - x) < std::abs(t[best] - x)) best = i;
+  return best;
+}
+}  // namespace
+
+void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStudyResult& res,
+                          OutputSet& out) {
+  // covariance.csv
+  {
+    std::ostringstream csv;
+    csv << "time_s,model_set,model";
+    for (const char* c : kCols) csv << "," << c;
+    csv << "\n";
+    char buf[64];
+    for (const CovarianceRun& r : res.runs) {
+      for (std::size_t i = 0; i < r.t.size(); ++i) {
+        std::snprintf(buf, sizeof buf, "%.6g", r.t[i]);
+        csv << buf << "," << r.model_set << "," << r.model;
+        for (double v : r.sigma[i]) {
+          std::snprintf(buf, sizeof buf, ",%.9g", v);
+          csv << buf;
+        }
+        csv << "\n";
+      }
+    }
+    out.writeText("covariance.csv", csv.str());
+  }
+  // summary.json
+  {
+    nlohmann::json j;
+    j["generator"] = "navimpact covariance";
+    j["config_file"] = cfg.source;
+    j["config"] = nlohmann::json::parse(cfg.echo);
+    j["units"] = "SI: m, m/s, rad (roll, pitch, yaw sigmas from the N, E, D attitude-error covariance)";
+    j["runs"] = nlohmann::json::array();
+    for (const CovarianceRun& r : res.runs) {
+      nlohmann::json jr;
+      jr["model_set"] = r.model_set;
+      jr["model"] = r.model;
+      jr["model_text"] = r.model_text;
+      jr["filter_states"] = r.states;
+      jr["at"] = nlohmann::json::array();
+      for (double ts : cfg.summary_times_s) {
+        const std::size_t i = nearest(r.t, ts);
+        nlohmann::json row;
+        row["t_s"] = r.t[i];
+        for (int c = 0; c < 9; ++c) row[kCols[c]] = r.sigma[i][c];
+        jr["at"].push_back(row);
+      }
+      j["runs"].push_back(jr);
+    }
+    out.writeText("summary.json", j.dump(2) + "\n");
+  }
+  // one figure per model set: rows position / velocity / attitude, columns N, E, D (roll, pitch, yaw)
+  for (const ModelSet& set : cfg.model_sets) {
+    plot::Figure fig;
+    fig.width = 1800;
+    fig.height = 1300;
+    fig.rows = 3;
+    fig.cols = 3;
+    fig.title = set.title;
+    struct Panel { int col; double scale; const char* title; const char* ylabel; };
+    const Panel panels[9] = {
+        {0, 1.0, "position north", "σ [m]"},   {1, 1.0, "position east", "σ [m]"},
+        {2, 1.0, "position down", "σ [m]"},    {3, 1.0, "velocity north", "σ [m/s]"},
+        {4, 1.0, "velocity east", "σ [m/s]"},  {5, 1.0, "velocity down", "σ [m/s]"},
+        {6, 1.0 / units::kDeg, "roll", "σ [deg]"}, {7, 1.0 / units::kDeg, "pitch", "σ [deg]"},
+        {8, 1.0 / units::kDeg, "yaw", "σ [deg]"}};
+    for (const Panel& p : panels) {
+      plot::Axes ax;
+      ax.title = p.title;
+      ax.xlabel = "time [s]";
+      ax.ylabel = p.ylabel;
+      ax.legend = plot::LegendPos::TopLeft;
+      int idx = 0;
+      for (const CovarianceRun& r : res.runs) {
+        if (r.model_set != set.name) continue;
+        plot::Series s;
+        s.label = r.model;
+        s.x = r.t;
+        s.y.reserve(r.t.size());
+        for (const auto& v : r.sigma) s.y.push_back(v[p.col] * p.scale);
+        s.color = plot::palette(idx);
+        s.style = idx % 2 == 0 ? plot::LineStyle::Solid : plot::LineStyle::Dashed;
+        ax.series.push_back(std::move(s));
+        ++idx;
+      }
+      fig.axes.push_back(std::move(ax));
+    }
+    plot::savePng(fig, out.stage("covariance_" + set.name + ".png").string());
+  }
+}
+
+}  // namespace navimpact::report
