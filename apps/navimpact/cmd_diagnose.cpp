@@ -16,14 +16,11 @@
 #include "cli_common.hpp"
 #include "input.hpp"
 #include "navimpact/analysis/diagnosis.hpp"
-#include "navimpact/core/csv_reader.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
-#include "navimpact/gmwm/estimator.hpp"
-#include "navimpact/gmwm/wavelet_variance.hpp"
+#include "navimpact/gmwm/channels.hpp"
 #include "navimpact/report/diagnosis_report.hpp"
 #include "navimpact/stochastic/model_file.hpp"
-#include "navimpact/stochastic/model_text.hpp"
 
 namespace {
 
@@ -45,20 +42,12 @@ struct Opts {
   bool overwrite = false;
 };
 
-/// `fit:SPEC`: fit the structure to each channel of the data first (GMWM).
-st::ImuModel fitModel(const std::string& spec, const navimpact::ImuSeries& s) {
-  const auto structure = st::parseStructure(spec);
-  if (structure.empty()) throw navimpact::Error("--model fit:" + spec + ": empty structure");
-  st::ImuModel m;
-  m.source = "fit:" + spec;
-  m.rate_hz = s.rate_hz;
-  for (std::size_t i = 0; i < navimpact::kChannelNames.size(); ++i) m.axis[i].rate_hz = s.rate_hz;
-  for (const auto& ch : s.channels) {
-    const auto wv = navimpact::gmwm::waveletVariance(ch.x.data(), ch.x.size(), s.rate_hz);
-    m.forChannel(ch.name) = navimpact::gmwm::fit(structure, wv).model;
-    m.forChannel(ch.name).rate_hz = s.rate_hz;
-  }
-  return m;
+/// `fit:SPEC`: the options of fitting SPEC to every channel of the data first (GMWM).
+navimpact::gmwm::RecordingFitOptions fitOptions(const std::string& spec) {
+  navimpact::gmwm::RecordingFitOptions f;
+  f.structure = spec;
+  f.intervals = "asymptotic";
+  return f;
 }
 
 std::vector<na::OutageWindow> checkOutages(const Opts& o) {
@@ -97,7 +86,7 @@ int run(const Opts& o) {
   // Model file problems are reported before the (long) data read.
   const bool fit = o.model.rfind("fit:", 0) == 0;
   st::ImuModel model;
-  if (fit) st::parseStructure(o.model.substr(4));
+  if (fit) navimpact::gmwm::checkRecordingFitOptions(fitOptions(o.model.substr(4)));
   else model = st::loadImuModel(o.model);
   navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
 
@@ -115,7 +104,10 @@ int run(const Opts& o) {
     nopt.threads = o.threads;
     plan = na::prepareNavGain(nopt, data.rate_hz, data.size());
   }
-  if (fit) model = fitModel(o.model.substr(4), data);
+  if (fit) {
+    model = navimpact::gmwm::fitRecording(data, fitOptions(o.model.substr(4))).model;
+    model.source = o.model;
+  }
 
   navimpact::cli::Progress bar("diagnose", 1000);
   na::DiagnoseOptions dopt;

@@ -1,0 +1,102 @@
+/**
+ * @file channels.hpp
+ * @brief GMWM on every channel of a recording: the wavelet variance (and
+ *        Allan deviation) of each channel, and the fit of one structure, or
+ *        the automatic selection, to each channel, giving an ImuModel.
+ *        Used by `navimpact wv`, `navimpact fit` and `diagnose --model fit:SPEC`.
+ */
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "navimpact/core/imu_series.hpp"
+#include "navimpact/gmwm/estimator.hpp"
+#include "navimpact/gmwm/wavelet_variance.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+
+namespace navimpact::gmwm {
+
+// ---------------------------------------------------------------------------
+// Wavelet variance of a recording
+
+/// Wavelet variance of one channel, with its overlapping Allan deviation when asked.
+struct ChannelWv {
+  std::string name;                 ///< canonical channel name, e.g. "gyro_z"
+  units::Quantity quantity{};       ///< fixes the SI unit
+  WaveletVariance wv;
+  std::vector<double> allan_tau_s;  ///< cluster times m / rate, m = 1, 2, 4, ... <= N/2 [s]
+  std::vector<double> adev;         ///< overlapping Allan deviation (IEEE Std 952) [unit]
+};
+
+/// Wavelet variances of every channel of a recording.
+struct RecordingWv {
+  std::string source;               ///< the recording (file path)
+  double rate_hz = 0.0;
+  std::size_t samples = 0;
+  WvOptions options;
+  bool allan = false;               ///< Allan deviations computed
+  std::vector<ChannelWv> channels;  ///< in the order of the recording's channels
+};
+
+/// WV of every channel of @p s (gmwm::waveletVariances) and, with @p allan, its Allan deviation.
+RecordingWv recordingWv(const ImuSeries& s, const WvOptions& opt, bool allan);
+
+// ---------------------------------------------------------------------------
+// Fit of a recording
+
+/// What to fit (the options of `navimpact fit`).
+struct RecordingFitOptions {
+  std::string structure = "auto";     ///< "auto" (WIC selection) or a structure, e.g. "WN+GM+GM+DR"
+  std::vector<std::string> channels;  ///< channels to fit, canonical names (empty: every channel)
+  int max_gm = 3;                     ///< auto: most GM terms among the candidates, 0..3
+  std::string weights = "r";          ///< "r" (the R package's), "model" or "efficient"
+  std::string intervals = "profile";  ///< 95 % intervals without bootstrap: "profile" or "asymptotic"
+  int bootstrap = 0;                  ///< parametric bootstrap replicates, >= 0
+  std::uint64_t seed = 20190101;      ///< root seed; channel c uses deriveSeed(seed, channelIndex(c))
+};
+
+/**
+ * Check @p opt before any data is read.
+ * @throws navimpact::Error naming the option (structure text with its
+ *         position, --max-gm, --weights, --intervals, --bootstrap, --channels).
+ */
+void checkRecordingFitOptions(const RecordingFitOptions& opt);
+
+/// The fit of one channel.
+struct ChannelFit {
+  std::string name;                  ///< canonical channel name
+  units::Quantity quantity{};
+  WaveletVariance wv;                ///< the empirical WV the model was fitted to
+  FitResult fit;
+  std::vector<bool> negligible;      ///< per term of fit.model (negligibleTerms)
+  std::vector<RankedModel> ranking;  ///< auto: every candidate, best first
+  std::string why;                   ///< auto: why the pick was chosen
+};
+
+/// The fits of a recording.
+struct RecordingFit {
+  RecordingFitOptions options;
+  std::string source;                ///< the recording (file path)
+  double rate_hz = 0.0;
+  std::size_t samples = 0;
+  std::vector<ChannelFit> channels;  ///< fitted channels, in the order asked
+  /// Per-axis models at rate_hz (the form model files hold); channels not fitted are "none".
+  stochastic::ImuModel model;
+};
+
+/**
+ * Fit every channel asked of @p s: the structure of @p opt, or with "auto"
+ * the candidates of defaultCandidates(max_gm) ranked by the WIC with R's
+ * weights (the WIC's optimism is derived for them), the pick refitted with
+ * the requested weights.
+ * @param[in] progress  optional callback(done, total) after each channel.
+ * @throws navimpact::Error "SOURCE: channel NAME: ..." when a fit fails, or
+ *         for invalid options (checkRecordingFitOptions) and unknown channels.
+ */
+RecordingFit fitRecording(const ImuSeries& s, const RecordingFitOptions& opt,
+                          const std::function<void(std::size_t, std::size_t)>& progress = {});
+
+}  // namespace navimpact::gmwm

@@ -1,0 +1,148 @@
+// GMWM on every channel of a recording (see channels.hpp).
+#include "navimpact/gmwm/channels.hpp"
+
+#include <cmath>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/simulate.hpp"
+
+namespace navimpact::gmwm {
+
+RecordingWv recordingWv(const ImuSeries& s, const WvOptions& opt, bool allan) {
+  RecordingWv r;
+  r.source = s.source;
+  r.rate_hz = s.rate_hz;
+  r.samples = s.size();
+  r.options = opt;
+  r.allan = allan;
+  std::vector<WaveletVariance> wvs = waveletVariances(s, opt);
+  // Cluster sizes m = 1, 2, 4, ... <= N/2 (IEEE Std 952 overlapping AVAR).
+  std::vector<double> m;
+  if (allan)
+    for (double v = 1; v <= static_cast<double>(s.size() / 2); v *= 2) m.push_back(v);
+  const Eigen::VectorXd mv = Eigen::Map<const Eigen::VectorXd>(m.data(), static_cast<Eigen::Index>(m.size()));
+  for (std::size_t c = 0; c < s.channels.size(); ++c) {
+    const ImuChannel& ch = s.channels[c];
+    ChannelWv w;
+    w.name = ch.name;
+    w.quantity = ch.quantity;
+    w.wv = std::move(wvs[c]);
+    if (allan) {
+      const Eigen::VectorXd avar = allanVariance(ch.x.data(), ch.x.size(), mv);
+      for (std::size_t k = 0; k < m.size(); ++k) {
+        w.allan_tau_s.push_back(m[k] / s.rate_hz);
+        w.adev.push_back(std::sqrt(avar[static_cast<Eigen::Index>(k)]));
+      }
+    }
+    r.channels.push_back(std::move(w));
+  }
+  return r;
+}
+
+namespace {
+
+Weighting weightingOf(const std::string& w) {
+  // r: the R package's objective (weights 1/(CI_hi - CI_lo)^2); model: iterated
+  // model-based diagonal weights; efficient: inverse of the full WV covariance.
+  if (w == "r") return Weighting::Fast;
+  if (w == "model") return Weighting::ModelBased;
+  if (w == "efficient") return Weighting::Efficient;
+  throw Error("--weights: expected 'r', 'model' or 'efficient', got '" + w + "'");
+}
+
+IntervalMethod intervalsOf(const std::string& i) {
+  if (i == "profile") return IntervalMethod::Profile;
+  if (i == "asymptotic") return IntervalMethod::Asymptotic;
+  throw Error("--intervals: expected 'profile' or 'asymptotic', got '" + i + "'");
+}
+
+std::vector<stochastic::ProcessKind> kindsOf(const stochastic::Model& m) {
+  std::vector<stochastic::ProcessKind> k;
+  for (const auto& t : m.terms) k.push_back(t.kind);
+  return k;
+}
+
+}  // namespace
+
+void checkRecordingFitOptions(const RecordingFitOptions& opt) {
+  if (opt.structure != "auto") stochastic::parseStructure(opt.structure);
+  if (opt.bootstrap < 0) throw Error("--bootstrap must be >= 0, got " + std::to_string(opt.bootstrap));
+  if (opt.max_gm < 0 || opt.max_gm > 3) throw Error("--max-gm must be in 0..3");
+  weightingOf(opt.weights);
+  intervalsOf(opt.intervals);
+  for (const auto& n : opt.channels)
+    if (channelIndex(n) < 0)
+      throw Error("--channels: unknown channel '" + n +
+                  "' (expected gyro_x, gyro_y, gyro_z, acc_x, acc_y, acc_z)");
+}
+
+RecordingFit fitRecording(const ImuSeries& s, const RecordingFitOptions& opt,
+                          const std::function<void(std::size_t, std::size_t)>& progress) {
+  checkRecordingFitOptions(opt);
+  const bool autoSel = opt.structure == "auto";
+  std::vector<stochastic::ProcessKind> structure;
+  if (!autoSel) structure = stochastic::parseStructure(opt.structure);
+
+  std::vector<const ImuChannel*> chans;
+  if (opt.channels.empty()) {
+    for (const auto& c : s.channels) chans.push_back(&c);
+  } else {
+    for (const auto& n : opt.channels) chans.push_back(&s.channel(n));
+  }
+  if (chans.empty()) throw Error(s.source + ": no IMU channel to fit");
+
+  FitOptions fo;
+  fo.bootstrap = opt.bootstrap;
+  fo.intervals = intervalsOf(opt.intervals);
+  fo.seed = opt.seed;
+  fo.weighting = weightingOf(opt.weights);
+  const auto cands = defaultCandidates(opt.max_gm);
+
+  RecordingFit r;
+  r.options = opt;
+  r.source = s.source;
+  r.rate_hz = s.rate_hz;
+  r.samples = s.size();
+  r.channels.resize(chans.size());
+  for (std::size_t i = 0; i < chans.size(); ++i) {
+    ChannelFit& c = r.channels[i];
+    c.name = chans[i]->name;
+    c.quantity = chans[i]->quantity;
+    c.wv = waveletVariance(chans[i]->x.data(), chans[i]->x.size(), s.rate_hz);
+    FitOptions fi = fo;
+    fi.seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(channelIndex(c.name)));
+    try {
+      if (autoSel) {
+        // The WIC's optimism is derived for R's weights: rank with them, then
+        // refit the pick with the requested weights.
+        FitOptions fr = fi;
+        fr.weighting = Weighting::Fast;
+        c.ranking = selectModel(cands, c.wv, fr, &c.why);
+        c.fit = c.ranking.front().fit;
+        if (fi.weighting != Weighting::Fast) {
+          fi.warm_starts = {c.fit.model};
+          c.fit = fit(kindsOf(c.fit.model), c.wv, fi);
+          c.why += "; ranked with the R weights, the pick refit with --weights " + opt.weights;
+        }
+      } else {
+        c.fit = fit(structure, c.wv, fi);
+      }
+    } catch (const Error& e) {
+      throw Error(s.source + ": channel " + c.name + ": " + e.what());
+    }
+    c.negligible = negligibleTerms(c.fit.model, c.wv);
+    if (progress) progress(i + 1, chans.size());
+  }
+
+  // Per-axis models at the data rate; channels not fitted stay "none".
+  r.model.rate_hz = s.rate_hz;
+  for (auto& m : r.model.axis) m.rate_hz = s.rate_hz;
+  for (const auto& c : r.channels) {
+    r.model.forChannel(c.name) = c.fit.model;
+    r.model.forChannel(c.name).rate_hz = s.rate_hz;
+  }
+  return r;
+}
+
+}  // namespace navimpact::gmwm

@@ -1,0 +1,172 @@
+// GMWM on every channel of a recording (gmwm/channels.hpp): the per-channel fit
+// is gmwm::fit of each channel's WV with that channel's seed, the model file
+// form keeps channels not fitted at "none", options are checked before any
+// data, and the Allan deviation is the overlapping AVAR at octave cluster sizes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/gmwm/channels.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/simulate.hpp"
+
+using namespace navimpact;
+using stochastic::Process;
+
+namespace {
+
+/// Six channels of WN + GM with parameters drawn log-uniformly (seeded and printed).
+ImuSeries simulatedRecording(std::uint64_t seed, std::size_t n, double rate_hz) {
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto logU = [&](double lo, double hi) { return lo * std::pow(hi / lo, u(g)); };
+  ImuSeries s;
+  s.source = "simulated.csv";
+  s.rate_hz = rate_hz;
+  for (std::size_t c = 0; c < kChannelNames.size(); ++c) {
+    stochastic::Model m;
+    m.rate_hz = rate_hz;
+    const double sw = logU(1e-4, 1e-2);
+    m.terms = {Process::wn(sw), Process::gm(sw * logU(0.05, 0.5), logU(0.5, 20.0))};
+    std::printf("seed %llu, %s: %s\n", static_cast<unsigned long long>(seed), kChannelNames[c],
+                stochastic::formatTerms(m.terms).c_str());
+    s.channels.push_back({kChannelNames[c], channelQuantity(kChannelNames[c]),
+                          stochastic::simulate(m, n, stochastic::deriveSeed(seed, c))});
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST(RecordingFit, EachChannelIsTheFitOfItsOwnWvWithItsOwnSeed) {
+  const ImuSeries s = simulatedRecording(4242, 1u << 14, 100.0);
+  gmwm::RecordingFitOptions o;
+  o.structure = "WN+GM";
+  o.channels = {"acc_y", "gyro_x"};
+  o.intervals = "asymptotic";
+  o.seed = 77;
+  std::size_t calls = 0;
+  const gmwm::RecordingFit f = gmwm::fitRecording(s, o, [&](std::size_t done, std::size_t total) {
+    ++calls;
+    EXPECT_EQ(done, calls);
+    EXPECT_EQ(total, 2u);
+  });
+  EXPECT_EQ(calls, 2u);
+  ASSERT_EQ(f.channels.size(), 2u);
+  EXPECT_EQ(f.channels[0].name, "acc_y");  // in the order asked
+  EXPECT_EQ(f.channels[1].name, "gyro_x");
+  EXPECT_EQ(f.source, s.source);
+  EXPECT_EQ(f.samples, s.size());
+  for (const auto& c : f.channels) {
+    const auto& x = s.channel(c.name).x;
+    const gmwm::WaveletVariance wv = gmwm::waveletVariance(x.data(), x.size(), s.rate_hz);
+    gmwm::FitOptions fo;
+    fo.intervals = gmwm::IntervalMethod::Asymptotic;
+    fo.seed = stochastic::deriveSeed(77, static_cast<std::uint64_t>(channelIndex(c.name)));
+    const gmwm::FitResult direct = gmwm::fit(stochastic::parseStructure("WN+GM"), wv, fo);
+    EXPECT_EQ(stochastic::formatTerms(c.fit.model.terms, 17), stochastic::formatTerms(direct.model.terms, 17))
+        << c.name;
+    EXPECT_EQ(c.fit.objective, direct.objective) << c.name;
+    EXPECT_EQ(c.negligible, gmwm::negligibleTerms(direct.model, wv)) << c.name;
+    EXPECT_TRUE(c.ranking.empty());
+    EXPECT_EQ(stochastic::formatTerms(f.model.forChannel(c.name).terms, 17),
+              stochastic::formatTerms(direct.model.terms, 17));
+  }
+  // The model file form: every axis at the data rate, channels not fitted "none".
+  EXPECT_EQ(f.model.rate_hz, 100.0);
+  for (const char* n : {"gyro_y", "gyro_z", "acc_x", "acc_z"}) {
+    EXPECT_TRUE(f.model.forChannel(n).empty()) << n;
+    EXPECT_EQ(f.model.forChannel(n).rate_hz, 100.0) << n;
+  }
+}
+
+TEST(RecordingFit, AutoRanksWithRWeightsAndRecordsTheReason) {
+  const ImuSeries s = simulatedRecording(9001, 1u << 13, 50.0);
+  gmwm::RecordingFitOptions o;
+  o.structure = "auto";
+  o.max_gm = 1;
+  o.intervals = "asymptotic";
+  o.channels = {"gyro_z"};
+  const gmwm::RecordingFit f = gmwm::fitRecording(s, o);
+  ASSERT_EQ(f.channels.size(), 1u);
+  const auto& c = f.channels[0];
+  EXPECT_EQ(c.ranking.size(), gmwm::defaultCandidates(1).size());
+  EXPECT_EQ(stochastic::formatTerms(c.fit.model.terms, 17),
+            stochastic::formatTerms(c.ranking.front().fit.model.terms, 17));
+  EXPECT_FALSE(c.why.empty());
+  EXPECT_EQ(c.fit.weighting, gmwm::Weighting::Fast);
+  // With other weights the pick is refitted under them and says so.
+  o.weights = "model";
+  const gmwm::RecordingFit fm = gmwm::fitRecording(s, o);
+  EXPECT_EQ(fm.channels[0].fit.weighting, gmwm::Weighting::ModelBased);
+  EXPECT_NE(fm.channels[0].why.find("refit with --weights model"), std::string::npos) << fm.channels[0].why;
+}
+
+TEST(RecordingFit, BadOptionsAreRefusedBeforeAnyData) {
+  auto msg = [](gmwm::RecordingFitOptions o) {
+    try {
+      gmwm::checkRecordingFitOptions(o);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  gmwm::RecordingFitOptions o;
+  EXPECT_EQ(msg(o), "");
+  o.structure = "WN+XX";
+  EXPECT_NE(msg(o).find("'XX'"), std::string::npos) << msg(o);
+  o = {};
+  o.max_gm = 4;
+  EXPECT_NE(msg(o).find("--max-gm"), std::string::npos);
+  o = {};
+  o.weights = "fast";
+  EXPECT_NE(msg(o).find("--weights"), std::string::npos);
+  o = {};
+  o.intervals = "bootstrap";
+  EXPECT_NE(msg(o).find("--intervals"), std::string::npos);
+  o = {};
+  o.bootstrap = -1;
+  EXPECT_NE(msg(o).find("--bootstrap"), std::string::npos);
+  o = {};
+  o.channels = {"gyro_w"};
+  EXPECT_NE(msg(o).find("'gyro_w'"), std::string::npos);
+  // A channel the recording lacks names the recording.
+  ImuSeries s = simulatedRecording(1, 1u << 12, 100.0);
+  s.channels.pop_back();
+  o = {};
+  o.channels = {"acc_z"};
+  try {
+    gmwm::fitRecording(s, o);
+    ADD_FAILURE() << "no error for a missing channel";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("simulated.csv"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RecordingWv, AllanDeviationAtOctaveClusterSizes) {
+  const std::size_t n = 5000;  // not a power of two: the largest cluster is 2048 <= n/2
+  const ImuSeries s = simulatedRecording(31337, n, 200.0);
+  const gmwm::RecordingWv w = gmwm::recordingWv(s, {}, true);
+  ASSERT_EQ(w.channels.size(), 6u);
+  EXPECT_TRUE(w.allan);
+  for (std::size_t c = 0; c < 6; ++c) {
+    const auto& ch = w.channels[c];
+    EXPECT_EQ(ch.name, s.channels[c].name);
+    const gmwm::WaveletVariance direct = gmwm::waveletVariance(s.channels[c].x.data(), n, 200.0);
+    EXPECT_EQ(ch.wv.wv, direct.wv);
+    ASSERT_EQ(ch.allan_tau_s.size(), 12u);  // m = 1 .. 2048
+    ASSERT_EQ(ch.adev.size(), 12u);
+    Eigen::VectorXd m(12);
+    for (int k = 0; k < 12; ++k) {
+      m[k] = std::ldexp(1.0, k);
+      EXPECT_DOUBLE_EQ(ch.allan_tau_s[k], m[k] / 200.0);
+    }
+    const Eigen::VectorXd avar = gmwm::allanVariance(s.channels[c].x.data(), n, m);
+    for (int k = 0; k < 12; ++k) EXPECT_DOUBLE_EQ(ch.adev[k] * ch.adev[k], avar[k]);
+  }
+  const gmwm::RecordingWv w0 = gmwm::recordingWv(s, {}, false);
+  EXPECT_TRUE(w0.channels[0].adev.empty());
+}
