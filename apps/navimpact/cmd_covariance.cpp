@@ -1,7 +1,6 @@
 // navimpact covariance: covariance analysis of navigation uncertainty per IMU
 // error model in static conditions (paper Figures 5 and 6).
 //   navimpact covariance --config config/paper/covariance_static.yaml --out DIR [--trajectory CSV]
-#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -9,7 +8,6 @@
 #include "navimpact/analysis/covariance_study.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
-#include "navimpact/core/units.hpp"
 #include "navimpact/report/covariance_report.hpp"
 
 namespace {
@@ -61,15 +59,7 @@ navimpact::cli::Registrar reg({
         bar.finish();
         navimpact::report::writeCovarianceStudy(cfg, res, out);
         out.commit();
-        // short report, human units
-        std::printf("%-14s %-12s %9s %9s %9s %10s %9s\n", "set", "model", "t [s]", "pos N [m]",
-                    "vel N[m/s]", "roll [deg]", "yaw [deg]");
-        for (const auto& r : res.runs) {
-          const auto& s = r.sigma.back();
-          std::printf("%-14s %-12s %9.1f %9.4f %9.5f %10.5f %9.5f\n", r.model_set.c_str(),
-                      r.model.c_str(), r.t.back(), s[0], s[3], s[6] / navimpact::units::kDeg,
-                      s[8] / navimpact::units::kDeg);
-        }
+        std::fputs(navimpact::report::covarianceSummary(res).c_str(), stdout);
         for (const auto& p : out.finalPaths()) std::printf("wrote %s\n", p.string().c_str());
         return 0;
       };

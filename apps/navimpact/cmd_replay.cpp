@@ -49,27 +49,7 @@ navimpact::cli::Registrar reg({
         const auto r = navimpact::analysis::runReplay(cfg);
         navimpact::report::writeReplayOutputs(r, out);
         out.commit();
-        for (const auto& n : r.notices) std::printf("notice: %s\n", n.c_str());
-        std::printf("replayed %s: %zu IMU steps at %g Hz, %zu GNSS and %zu baro updates, filter model %s "
-                    "(rawlog read %.3f s CPU, filter %.3f s)\n",
-                    cfg.rawlog.c_str(), r.run.steps, r.imu_rate_hz, r.run.gnss_updates, r.run.baro_updates,
-                    r.model_source.c_str(), r.read_s, r.run.wall_s);
-        if (!r.run.has_truth) std::printf("no ground truth in the rawlog: estimate and predicted sigmas only\n");
-        for (std::size_t i = 0; i < r.run.outages.size(); ++i) {
-          const auto& w = r.run.outages[i];
-          if (w.end_epoch < 0) continue;
-          const auto& e = r.run.epochs[static_cast<std::size_t>(w.end_epoch)];
-          if (!r.run.has_truth) {
-            std::printf("outage %zu (%g s from %g s): predicted horizontal 1-sigma at end %.2f m, vertical %.2f m\n",
-                        i + 1, cfg.outages[i].duration_s, cfg.outages[i].start_s, e.sigma.head<2>().norm(),
-                        e.sigma[2]);
-            continue;
-          }
-          std::printf("outage %zu (%g s from %g s): horizontal error at end %.2f m (1-sigma %.2f m), max %.2f m; "
-                      "vertical %.2f m (1-sigma %.2f m)\n",
-                      i + 1, cfg.outages[i].duration_s, cfg.outages[i].start_s, e.err.head<2>().norm(),
-                      e.sigma.head<2>().norm(), w.max_drift_h, std::abs(e.err[2]), e.sigma[2]);
-        }
+        std::fputs(navimpact::report::replaySummary(r).c_str(), stdout);
         std::printf("wrote %s/{solution.csv, summary.json, errors_*.png}\n", o->out.c_str());
         return 0;
       };

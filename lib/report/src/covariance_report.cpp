@@ -115,4 +115,19 @@ void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStud
   }
 }
 
+std::string covarianceSummary(const CovarianceStudyResult& res) {
+  std::string out;
+  char b[256];
+  std::snprintf(b, sizeof b, "%-14s %-12s %9s %9s %9s %10s %9s\n", "set", "model", "t [s]", "pos N [m]",
+                "vel N[m/s]", "roll [deg]", "yaw [deg]");
+  out += b;
+  for (const auto& r : res.runs) {
+    const auto& s = r.sigma.back();
+    std::snprintf(b, sizeof b, "%-14s %-12s %9.1f %9.4f %9.5f %10.5f %9.5f\n", r.model_set.c_str(),
+                  r.model.c_str(), r.t.back(), s[0], s[3], s[6] / units::kDeg, s[8] / units::kDeg);
+    out += b;
+  }
+  return out;
+}
+
 }  // namespace navimpact::report

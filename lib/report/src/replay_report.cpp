@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <cstdio>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -272,6 +273,36 @@ std::string summaryJson(const ReplayResult& r) {
                       {"epochs", ep.size()}};
   j["notices"] = r.notices;
   return j.dump(2) + "\n";
+}
+
+std::string replaySummary(const ReplayResult& r) {
+  std::string s;
+  char b[512];
+  for (const auto& n : r.notices) s += "notice: " + n + "\n";
+  std::snprintf(b, sizeof b,
+                "replayed %s: %zu IMU steps at %g Hz, %zu GNSS and %zu baro updates, filter model %s "
+                "(rawlog read %.3f s CPU, filter %.3f s)\n",
+                r.cfg.rawlog.c_str(), r.run.steps, r.imu_rate_hz, r.run.gnss_updates, r.run.baro_updates,
+                r.model_source.c_str(), r.read_s, r.run.wall_s);
+  s += b;
+  if (!r.run.has_truth) s += "no ground truth in the rawlog: estimate and predicted sigmas only\n";
+  for (std::size_t i = 0; i < r.run.outages.size(); ++i) {
+    const auto& w = r.run.outages[i];
+    if (w.end_epoch < 0) continue;
+    const auto& e = r.run.epochs[static_cast<std::size_t>(w.end_epoch)];
+    const auto& o = r.cfg.outages[i];
+    if (!r.run.has_truth)
+      std::snprintf(b, sizeof b, "outage %zu (%g s from %g s): predicted horizontal 1-sigma at end %.2f m, vertical %.2f m\n",
+                    i + 1, o.duration_s, o.start_s, e.sigma.head<2>().norm(), e.sigma[2]);
+    else
+      std::snprintf(b, sizeof b,
+                    "outage %zu (%g s from %g s): horizontal error at end %.2f m (1-sigma %.2f m), max %.2f m; "
+                    "vertical %.2f m (1-sigma %.2f m)\n",
+                    i + 1, o.duration_s, o.start_s, e.err.head<2>().norm(), e.sigma.head<2>().norm(),
+                    w.max_drift_h, std::abs(e.err[2]), e.sigma[2]);
+    s += b;
+  }
+  return s;
 }
 
 void writeReplayOutputs(const ReplayResult& r, OutputSet& out) {

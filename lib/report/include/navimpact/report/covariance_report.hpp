@@ -6,6 +6,8 @@
  */
 #pragma once
 
+#include <string>
+
 #include "navimpact/analysis/covariance_study.hpp"
 #include "navimpact/core/output.hpp"
 
@@ -17,5 +19,8 @@ namespace navimpact::report {
  */
 void writeCovarianceStudy(const analysis::CovarianceStudyConfig& cfg,
                           const analysis::CovarianceStudyResult& res, OutputSet& out);
+
+/// The sigmas at the end of every run, one line per model (human units: deg).
+std::string covarianceSummary(const analysis::CovarianceStudyResult& res);
 
 }  // namespace navimpact::report

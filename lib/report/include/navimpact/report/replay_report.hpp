@@ -20,6 +20,9 @@ std::string solutionCsv(const analysis::ReplayResult& r);
 /// summary.json text.
 std::string summaryJson(const analysis::ReplayResult& r);
 
+/// Notices, what was replayed, and per outage the error (or predicted sigma) at its end.
+std::string replaySummary(const analysis::ReplayResult& r);
+
 /// Stage solution.csv, summary.json, errors_full.png and errors_outage_K.png in @p out; the caller commits.
 void writeReplayOutputs(const analysis::ReplayResult& r, OutputSet& out);
 

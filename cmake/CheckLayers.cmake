@@ -1,0 +1,57 @@
+# The include rules of the layers (README, "Layout"), checked on every source
+# file: run as the CTest `layers` (cmake -DSOURCE_DIR=... -P CheckLayers.cmake).
+# A rule names an include prefix and the only folders whose files may include it.
+#   OpenCV            only lib/plot (and its test)
+#   MRPT              only lib/rawlog (and its test)
+#   navimpact/plot    only lib/report (the one layer that draws), lib/plot, tests/plot
+#   navimpact/report  never from another library module (reports sit on top)
+if(NOT SOURCE_DIR)
+  message(FATAL_ERROR "usage: cmake -DSOURCE_DIR=<checkout> -P CheckLayers.cmake")
+endif()
+# name | text searched in the #include lines | folders allowed (comma-separated)
+set(rules
+  "OpenCV|opencv|lib/plot/,tests/plot/"
+  "MRPT|mrpt/|lib/rawlog/,tests/rawlog/"
+  "navimpact/plot|navimpact/plot/|lib/plot/,lib/report/,tests/plot/"
+  "navimpact/report|navimpact/report/|lib/report/,apps/,tests/,bench/")
+file(GLOB_RECURSE files RELATIVE ${SOURCE_DIR}
+  ${SOURCE_DIR}/lib/*.cpp ${SOURCE_DIR}/lib/*.hpp ${SOURCE_DIR}/apps/*.cpp ${SOURCE_DIR}/apps/*.hpp
+  ${SOURCE_DIR}/tests/*.cpp ${SOURCE_DIR}/tests/*.hpp ${SOURCE_DIR}/bench/*.cpp ${SOURCE_DIR}/bench/*.hpp)
+set(bad 0)
+set(checked 0)
+foreach(f ${files})
+  file(STRINGS ${SOURCE_DIR}/${f} includes REGEX "^[ \t]*#[ \t]*include")
+  foreach(rule ${rules})
+    string(REPLACE "|" ";" parts "${rule}")
+    list(GET parts 0 name)
+    list(GET parts 1 pattern)
+    list(GET parts 2 allowed_text)
+    string(REPLACE "," ";" allowed "${allowed_text}")
+    set(ok FALSE)
+    foreach(a ${allowed})
+      string(FIND "${f}" "${a}" at)
+      if(at EQUAL 0)
+        set(ok TRUE)
+      endif()
+    endforeach()
+    if(ok)
+      continue()
+    endif()
+    foreach(line ${includes})
+      string(FIND "${line}" "${pattern}" hit)
+      if(NOT hit EQUAL -1)
+        string(STRIP "${line}" line)
+        message("${f}: '${line}': ${name} may be included only under ${allowed_text}")
+        math(EXPR bad "${bad} + 1")
+      endif()
+    endforeach()
+  endforeach()
+  math(EXPR checked "${checked} + 1")
+endforeach()
+if(checked EQUAL 0)
+  message(FATAL_ERROR "no source file found under ${SOURCE_DIR}")
+endif()
+if(bad GREATER 0)
+  message(FATAL_ERROR "${bad} include(s) break the layer rules")
+endif()
+message("layer rules hold in ${checked} source files")
