@@ -13,23 +13,10 @@
 
 using namespace navimpact;
 
-namespace {
-analysis::CovarianceStudyConfig shortConfig(double T) {
-  const std::string path = (test::tempDir() / "cov.yaml").string();
-  std::ofstream(path) << "model_file: " << test::sourcePath("config/models/navchip_table1.yaml")
-                      << "\nduration_s: " << T
-                      << "\nsummary_times_s: [1]\n"
-                         "static_state: {lat_deg: 46.52, lon_deg: 6.57, h_m: 400, yaw_deg: 20}\n"
-                         "baro: {rate_hz: 0, sigma_m: 1}\n"
-                         "model_sets:\n"
-                         "  - {name: accelerometer, models: [acc_model1, acc_model2, acc_model3, acc_ref]}\n"
-                         "  - {name: gyroscope, models: [gyro_model1, gyro_ref]}\n";
-  return analysis::loadCovarianceStudyConfig(path);
-}
-}  // namespace
-
 TEST(CovarianceReport, WritesAllOutputsOrNothing) {
-  const analysis::CovarianceStudyConfig cfg = shortConfig(2.0);
+  // The paper's static covariance configuration (60 s, 8 models).
+  const analysis::CovarianceStudyConfig cfg =
+      analysis::loadCovarianceStudyConfig(test::sourcePath("config/paper/covariance_static.yaml"));
   const analysis::CovarianceStudyResult r = analysis::runCovarianceStudy(cfg);
   const auto dir = test::tempDir() / "out";
   {
@@ -68,19 +55,25 @@ TEST(CovarianceReport, WritesAllOutputsOrNothing) {
     }
   EXPECT_FALSE(std::getline(csv, line)) << "extra row: " << line;
 
-  // summary.json: the sigmas at the summary time (1 s), per run.
+  // summary.json: the sigmas at every summary time, per run.
   std::ifstream js(dir / "summary.json");
   const nlohmann::json j = nlohmann::json::parse(js);
   ASSERT_EQ(j["runs"].size(), r.runs.size());
   for (std::size_t k = 0; k < r.runs.size(); ++k) {
     const auto& run = r.runs[k];
-    const auto& at = j["runs"][k]["at"][0];
-    std::size_t i = 0;
-    for (std::size_t m = 1; m < run.t.size(); ++m)
-      if (std::abs(run.t[m] - 1.0) < std::abs(run.t[i] - 1.0)) i = m;
-    EXPECT_EQ(at["t_s"].get<double>(), run.t[i]);
-    EXPECT_EQ(at["sigma_pos_N_m"].get<double>(), run.sigma[i][0]);
-    EXPECT_EQ(at["sigma_yaw_rad"].get<double>(), run.sigma[i][8]);
     EXPECT_EQ(j["runs"][k]["filter_states"].get<int>(), run.states);
+    ASSERT_EQ(j["runs"][k]["at"].size(), cfg.summary_times_s.size());
+    for (std::size_t q = 0; q < cfg.summary_times_s.size(); ++q) {
+      const double ts = cfg.summary_times_s[q];
+      const auto& at = j["runs"][k]["at"][q];
+      std::size_t i = 0;
+      for (std::size_t m = 1; m < run.t.size(); ++m)
+        if (std::abs(run.t[m] - ts) < std::abs(run.t[i] - ts)) i = m;
+      EXPECT_EQ(at["t_s"].get<double>(), run.t[i]);
+      EXPECT_EQ(at["sigma_pos_N_m"].get<double>(), run.sigma[i][0]);
+      EXPECT_EQ(at["sigma_vel_E_mps"].get<double>(), run.sigma[i][4]);
+      EXPECT_EQ(at["sigma_yaw_rad"].get<double>(), run.sigma[i][8]);
+    }
   }
+  EXPECT_NE(report::covarianceSummary(r).find(r.runs.back().model), std::string::npos);
 }

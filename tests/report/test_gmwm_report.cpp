@@ -6,7 +6,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -14,32 +13,21 @@
 #include "navimpact/report/fit_report.hpp"
 #include "navimpact/report/wv_report.hpp"
 #include "navimpact/stochastic/model_text.hpp"
-#include "navimpact/stochastic/simulate.hpp"
+#include "navimpact/core/csv_reader.hpp"
 #include "test_support.hpp"
 
 using namespace navimpact;
-using stochastic::Process;
 
 namespace {
 
-/// Six channels of WN + GM with parameters drawn log-uniformly (seeded and printed).
-ImuSeries simulatedRecording(std::uint64_t seed, std::size_t n, double rate_hz) {
-  std::mt19937_64 g(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  auto logU = [&](double lo, double hi) { return lo * std::pow(hi / lo, u(g)); };
-  ImuSeries s;
-  s.source = "/some/dir/simulated.csv";
-  s.rate_hz = rate_hz;
-  for (std::size_t c = 0; c < kChannelNames.size(); ++c) {
-    stochastic::Model m;
-    m.rate_hz = rate_hz;
-    const double sw = logU(1e-4, 1e-2);
-    m.terms = {Process::wn(sw), Process::gm(sw * logU(0.05, 0.5), logU(0.5, 20.0))};
-    std::printf("seed %llu, %s: %s\n", static_cast<unsigned long long>(seed), kChannelNames[c],
-                stochastic::formatTerms(m.terms).c_str());
-    s.channels.push_back({kChannelNames[c], channelQuantity(kChannelNames[c]),
-                          stochastic::simulate(m, n, stochastic::deriveSeed(seed, c))});
-  }
+/// The committed ADIS16405 excerpt (real static data, 2^18 samples at 100 Hz), cut to @p n samples.
+ImuSeries adisExcerpt(std::size_t n) {
+  CsvImuOptions o;
+  o.rate_hz = 100.0;
+  o.gyro_unit = "deg/s";
+  o.acc_unit = "g";
+  ImuSeries s = readImuCsv(test::sourcePath("datasets/adis16405_static_excerpt.csv.gz"), o);
+  for (auto& c : s.channels) c.x.resize(n);
   return s;
 }
 
@@ -55,13 +43,13 @@ std::vector<double> vec(const Eigen::VectorXd& v) { return {v.data(), v.data() +
 }  // namespace
 
 TEST(FitReport, ModelFileAndJsonHoldTheFit) {
-  const ImuSeries s = simulatedRecording(2718, 1u << 13, 100.0);
+  const ImuSeries s = adisExcerpt(1u << 16);
   gmwm::RecordingFitOptions o;
   o.structure = "WN+GM";
   o.intervals = "asymptotic";
   o.channels = {"gyro_y", "acc_x", "acc_z"};
   const gmwm::RecordingFit f = gmwm::fitRecording(s, o);
-  const std::string input = R"({"file": "/some/dir/simulated.csv", "format": "csv"})";
+  const std::string input = R"({"file": "adis16405_static_excerpt.csv.gz", "format": "csv"})";
   const auto dir = test::tempDir() / "fit";
   {
     OutputSet out(dir);
@@ -82,7 +70,7 @@ TEST(FitReport, ModelFileAndJsonHoldTheFit) {
   std::ifstream yaml(dir / "model.yaml");
   std::string first;
   std::getline(yaml, first);
-  EXPECT_NE(first.find("navimpact 9.9.9 of /some/dir/simulated.csv, structure WN+GM"), std::string::npos) << first;
+  EXPECT_NE(first.find("navimpact 9.9.9 of " + s.source + ", structure WN+GM"), std::string::npos) << first;
 
   // fit.json: input copied, per channel the model, objective, flags and WV exactly.
   std::ifstream js(dir / "fit.json");
@@ -116,7 +104,7 @@ TEST(FitReport, ModelFileAndJsonHoldTheFit) {
 }
 
 TEST(FitReport, OneSensorGivesOneFigure) {
-  const ImuSeries s = simulatedRecording(161803, 1u << 12, 50.0);
+  const ImuSeries s = adisExcerpt(1u << 12);
   gmwm::RecordingFitOptions o;
   o.structure = "WN";
   o.intervals = "asymptotic";
@@ -131,7 +119,7 @@ TEST(FitReport, OneSensorGivesOneFigure) {
 }
 
 TEST(WvReport, CsvAndJsonHoldTheEstimatesExactly) {
-  const ImuSeries s = simulatedRecording(1414, 3000, 200.0);
+  const ImuSeries s = adisExcerpt(3000);
   const gmwm::RecordingWv w = gmwm::recordingWv(s, {}, true);
   const auto dir = test::tempDir() / "wv";
   {
@@ -160,7 +148,7 @@ TEST(WvReport, CsvAndJsonHoldTheEstimatesExactly) {
       std::getline(ss, hi, ',');
       EXPECT_EQ(name, c.name);
       EXPECT_EQ(std::stoi(jj), i + 1);
-      EXPECT_EQ(std::stod(tau), c.wv.tau[i] / 200.0);
+      EXPECT_EQ(std::stod(tau), c.wv.tau[i] / 100.0);
       EXPECT_EQ(std::stod(v), c.wv.wv[i]);  // 17 digits: exact
       EXPECT_EQ(std::stod(lo), c.wv.ci_low[i]);
       EXPECT_EQ(std::stod(hi), c.wv.ci_high[i]);
@@ -179,5 +167,5 @@ TEST(WvReport, CsvAndJsonHoldTheEstimatesExactly) {
   }
   EXPECT_TRUE(isPng(dir / "wv_gyroscope.png"));
   EXPECT_TRUE(isPng(dir / "wv_accelerometer.png"));
-  EXPECT_NE(report::wvSummary(w).find("3000 samples at 200 Hz"), std::string::npos) << report::wvSummary(w);
+  EXPECT_NE(report::wvSummary(w).find("3000 samples at 100 Hz"), std::string::npos) << report::wvSummary(w);
 }
