@@ -23,6 +23,7 @@
 #include "navimpact/gmwm/wavelet_variance.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 #include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/process_kind.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
@@ -94,28 +95,19 @@ Cause causeOf(ProcessKind k) {
 }
 
 /// The parameter of a process whose square scales its WV.
-double& mainParam(Process& p) {
-  switch (p.kind) {
-    case ProcessKind::WN: return p.sigma;
-    case ProcessKind::QN: return p.Q;
-    case ProcessKind::RW: return p.gamma;
-    case ProcessKind::DR: return p.omega;
-    case ProcessKind::GM: return p.sigma;
-    case ProcessKind::SIN: return p.amp;
-  }
-  return p.sigma;
-}
+/// The parameter of a process whose square scales its WV: the first
+/// parameter of its kind in the registry (WN sigma, QN Q, RW gamma, DR omega,
+/// GM sigma, SIN amp).
+double& mainParam(Process& p) { return p.*(stochastic::kindInfo(p.kind).params.front().field); }
 
-Process unitProcess(ProcessKind k, double T = 1.0) {
-  switch (k) {
-    case ProcessKind::WN: return Process::wn(1.0);
-    case ProcessKind::QN: return Process::qn(1.0);
-    case ProcessKind::RW: return Process::rw(1.0);
-    case ProcessKind::DR: return Process::dr(1.0);
-    case ProcessKind::GM: return Process::gm(1.0, T);
-    case ProcessKind::SIN: return Process::sin(1.0, 1.0);
-  }
-  return Process::wn(1.0);
+/// A process of kind @p k with unit scale and, where the kind has a second
+/// (shape) parameter, that parameter set to @p shape (GM T [s], SIN freq [Hz]).
+Process unitProcess(ProcessKind k, double shape = 1.0) {
+  Process p;
+  p.kind = k;
+  const auto& params = stochastic::kindInfo(k).params;
+  for (std::size_t i = 0; i < params.size(); ++i) p.*(params[i].field) = i == 0 ? 1.0 : shape;
+  return p;
 }
 
 std::vector<double> wvOf(const Process& p, double rate, const std::vector<double>& tau) {
