@@ -14,6 +14,7 @@
 #include "navimpact/analysis/diagnose_power.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
+#include "navimpact/report/power_report.hpp"
 
 namespace {
 
@@ -85,7 +86,7 @@ int run(const Opts& o) {
   const pw::PowerResult r = pw::runPower(p);
   bar.finish();
   navimpact::OutputSet out(o.out);
-  const std::string table = pw::powerTable(r);
+  const std::string table = navimpact::report::powerTable(r);
   std::ostringstream md;
   md << "# Detection power of navimpact diagnose\n\nSeed " << o.seed << ", alpha " << o.alpha << ", "
      << o.runs << " runs per cause, " << o.null_runs << " null records; SNR = effect size / detection limit "
@@ -93,7 +94,7 @@ int run(const Opts& o) {
      << (o.duration_h.empty() ? "samples " + o.samples : "duration " + o.duration_h + " h") << ".\n\n"
      << table << "\nCost: " << r.cpu_s << " s CPU, " << r.wall_s << " s wall.\n";
   out.writeText("power.md", md.str());
-  out.writeText("power.json", pw::powerJson(r));
+  out.writeText("power.json", navimpact::report::powerJson(r));
   out.commit();
   std::cout << table << "cost: " << r.cpu_s << " s CPU, " << r.wall_s << " s wall\n"
             << "wrote " << (std::filesystem::path(o.out) / "power.md").string() << " and power.json\n";

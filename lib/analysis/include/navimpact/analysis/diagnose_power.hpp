@@ -117,10 +117,4 @@ struct PowerResult {
 
 PowerResult runPower(const PowerOptions& opt);
 
-/// Markdown table: power (detected) and right cause/parameter per SNR bin and cause.
-std::string powerTable(const PowerResult& r);
-
-/// power.json text.
-std::string powerJson(const PowerResult& r);
-
 }  // namespace navimpact::analysis::power
