@@ -16,44 +16,15 @@ model_sets:
   - {name: accelerometer, models: [acc_model1, acc_ref]}
   - {name: gyroscope, models: [gyro_model1, gyro_ref]}
 ")
-file(WRITE ${_cdir}/check_outputs.cmake [=[
-file(REMOVE_RECURSE "${OUTDIR}")
-execute_process(COMMAND ${NI} covariance --config ${CONFIG} --out ${OUTDIR} --print-states
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "exit ${rc}: ${err}")
-endif()
-foreach(f covariance.csv summary.json covariance_accelerometer.png covariance_gyroscope.png)
-  if(NOT EXISTS ${OUTDIR}/${f})
-    message(FATAL_ERROR "missing ${f}")
-  endif()
-endforeach()
-if(NOT out MATCHES "acc_x.GM1\\(T=3.22s\\)")
-  message(FATAL_ERROR "--print-states did not list acc_x.GM1(T=3.22s):\n${out}")
-endif()
-file(STRINGS ${OUTDIR}/covariance.csv rows)
-list(LENGTH rows n)
-# header + 4 models x 51 rows (0..5 s at 10 Hz)
-if(NOT n EQUAL 205)
-  message(FATAL_ERROR "covariance.csv has ${n} lines, expected 205")
-endif()
-file(READ ${OUTDIR}/summary.json js)
-string(JSON nruns LENGTH "${js}" runs)
-if(NOT nruns EQUAL 4)
-  message(FATAL_ERROR "summary.json has ${nruns} runs")
-endif()
-]=])
-add_test(NAME cli_covariance_short
-         COMMAND ${CMAKE_COMMAND} -DNI=${NI} -DCONFIG=${_cdir}/short.yaml -DOUTDIR=${_cdir}/out_short
-                 -P ${_cdir}/check_outputs.cmake)
+navimpact_cli_check(cli_covariance_short CHECK covariance_outputs
+  DEFINES CONFIG=${_cdir}/short.yaml OUTDIR=${_cdir}/out_short)
 
 # bad inputs: (name, config body, expected stderr regex)
 function(_cov_bad name body regex)
   file(WRITE ${_cdir}/${name}.yaml "${body}")
-  add_test(NAME cli_covariance_bad_${name}
-           COMMAND ${CMAKE_COMMAND} -DNI=${NI} "-DARGS=covariance|--config|${_cdir}/${name}.yaml|--out|${_cdir}/out_${name}"
-                   "-DREGEX=${regex}" -DOUTDIR=${_cdir}/out_${name}
-                   -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_fail.cmake)
+  navimpact_cli_fail(cli_covariance_bad_${name}
+    ARGS covariance --config ${_cdir}/${name}.yaml --out ${_cdir}/out_${name}
+    REGEX "${regex}" NOOUT ${_cdir}/out_${name})
 endfunction()
 set(_base "duration_s: 2\nstatic_state: {lat_deg: 46.5, lon_deg: 6.5, h_m: 400}\n")
 file(WRITE ${_cdir}/m_unknown.yaml "rate_hz: 200\nmodels:\n  bad:\n    accelerometer: \"WN(sigma=1e-3) + XX(sigma=1)\"\n")
@@ -81,8 +52,6 @@ add_test(NAME cli_covariance_trajectory
          COMMAND ${NI} covariance --config ${_cdir}/short.yaml --out ${_cdir}/out_traj --overwrite
                  --trajectory ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz)
 set_tests_properties(cli_covariance_trajectory PROPERTIES PASS_REGULAR_EXPRESSION "gyro_ref +5\\.0")
-add_test(NAME cli_covariance_bad_trajectory
-         COMMAND ${CMAKE_COMMAND} -DNI=${NI}
-                 "-DARGS=covariance|--config|${_cdir}/short.yaml|--out|${_cdir}/out_badtraj|--trajectory|${_cdir}/no_such.csv"
-                 "-DREGEX=no_such.csv" -DOUTDIR=${_cdir}/out_badtraj
-                 -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_fail.cmake)
+navimpact_cli_fail(cli_covariance_bad_trajectory
+  ARGS covariance --config ${_cdir}/short.yaml --out ${_cdir}/out_badtraj --trajectory ${_cdir}/no_such.csv
+  REGEX "no_such.csv" NOOUT ${_cdir}/out_badtraj)

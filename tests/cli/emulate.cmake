@@ -27,54 +27,16 @@ set_tests_properties(cli_emulate_uav30 PROPERTIES FIXTURES_SETUP emu_rawlog
   PASS_REGULAR_EXPRESSION "IMU 6000 samples at 200 Hz, GNSS 31 fixes, BARO 301, GT 301")
 
 # rawlog-edit (package mrpt-apps) must see the labels at their rates.
-file(WRITE ${_edir}/rawlog_edit_info.cmake [=[
-find_program(RAWLOG_EDIT rawlog-edit)
-if(NOT RAWLOG_EDIT)
-  message("rawlog-edit not installed (apt-get install mrpt-apps): check skipped")
-  return()
-endif()
-execute_process(COMMAND ${RAWLOG_EDIT} --info -i ${RAWLOG} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "rawlog-edit --info failed (${rc}): ${out}${err}")
-endif()
-foreach(re "All sensor labels *: *, BARO, GNSS, GT, IMU"
-           "IMU / +6000 /200\\.000"
-           "GNSS / +31 /1\\.000"
-           "BARO / +301 /10\\.000"
-           "GT / +301 /10\\.000"
-           "Observations format *: Yes")
-  if(NOT "${out}" MATCHES "${re}")
-    message(FATAL_ERROR "rawlog-edit --info output does not match '${re}':\n${out}")
-  endif()
-endforeach()
-message("rawlog-edit --info: labels and rates as expected")
-]=])
-add_test(NAME cli_emulate_rawlog_edit_info
-  COMMAND ${CMAKE_COMMAND} -DRAWLOG=${_edir}/uav30.rawlog -P ${_edir}/rawlog_edit_info.cmake)
+navimpact_cli_check(cli_emulate_rawlog_edit_info CHECK rawlog_edit_info DEFINES RAWLOG=${_edir}/uav30.rawlog)
 set_tests_properties(cli_emulate_rawlog_edit_info PROPERTIES FIXTURES_REQUIRED emu_rawlog)
 
 # Bad input: one-line error, nothing written.
-file(WRITE ${_edir}/expect_fail_nofile.cmake [=[
-string(REPLACE "|" ";" _args "${ARGS}")
-file(REMOVE ${OUTFILE})
-execute_process(COMMAND ${NI} ${_args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(rc EQUAL 0)
-  message(FATAL_ERROR "expected a non-zero exit, got 0; output: ${out}${err}")
-endif()
-if(NOT "${out}${err}" MATCHES "${REGEX}")
-  message(FATAL_ERROR "output does not match '${REGEX}': ${out}${err}")
-endif()
-if(EXISTS ${OUTFILE})
-  message(FATAL_ERROR "${OUTFILE} was written although the command failed")
-endif()
-]=])
-add_test(NAME cli_emulate_bad_key
-  COMMAND ${CMAKE_COMMAND} -DNI=${NI} "-DARGS=emulate|--config|${_edir}/bad_key.yaml|--out|${_edir}/bad.rawlog"
-          -DOUTFILE=${_edir}/bad.rawlog "-DREGEX=bad_key.yaml.*imu.sede.*unknown key" -P ${_edir}/expect_fail_nofile.cmake)
-add_test(NAME cli_emulate_static_rate_mismatch
-  COMMAND ${CMAKE_COMMAND} -DNI=${NI} "-DARGS=emulate|--config|${_edir}/static_rate.yaml|--out|${_edir}/static.rawlog"
-          -DOUTFILE=${_edir}/static.rawlog "-DREGEX=static recording is at 100 Hz, emulation at 200 Hz"
-          -P ${_edir}/expect_fail_nofile.cmake)
+navimpact_cli_fail(cli_emulate_bad_key
+  ARGS emulate --config ${_edir}/bad_key.yaml --out ${_edir}/bad.rawlog
+  REGEX "bad_key.yaml.*imu.sede.*unknown key" NOOUT ${_edir}/bad.rawlog)
+navimpact_cli_fail(cli_emulate_static_rate_mismatch
+  ARGS emulate --config ${_edir}/static_rate.yaml --out ${_edir}/static.rawlog
+  REGEX "static recording is at 100 Hz, emulation at 200 Hz" NOOUT ${_edir}/static.rawlog)
 
 # --gzip-level: the fast default and the smallest level both round-trip through
 # the reader (replay of the level-9 file runs); an out-of-range level is refused.

@@ -3,18 +3,6 @@ set(_models ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml)
 set(_mdir ${CMAKE_CURRENT_BINARY_DIR}/model_cli)
 file(MAKE_DIRECTORY ${_mdir})
 
-# Runs NI with ARGS ('|'-separated), requires a non-zero exit and stderr/stdout
-# matching REGEX. (PASS_REGULAR_EXPRESSION alone would ignore the exit code.)
-file(WRITE ${_mdir}/expect_fail.cmake [=[
-string(REPLACE "|" ";" _args "${ARGS}")
-execute_process(COMMAND ${NI} ${_args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(rc EQUAL 0)
-  message(FATAL_ERROR "expected a non-zero exit, got 0; output: ${out}${err}")
-endif()
-if(NOT "${out}${err}" MATCHES "${REGEX}")
-  message(FATAL_ERROR "output does not match '${REGEX}': ${out}${err}")
-endif()
-]=])
 
 add_test(NAME cli_model_show_gyro_ref
   COMMAND ${NI} model show ${_models}:gyro_ref)
@@ -44,13 +32,9 @@ set_tests_properties(cli_model_convert_stdout PROPERTIES PASS_REGULAR_EXPRESSION
 # an unparsable model string: non-zero exit, message names the file's key and position
 file(WRITE ${_mdir}/bad_model.yaml
   "rate_hz: 200\nmodels:\n  broken:\n    gyroscope: \"WN(sigma=1e-3) + GM(sigma=2e-5 T=3)\"\n")
-add_test(NAME cli_model_bad_string
-  COMMAND ${CMAKE_COMMAND} -DNI=${NI} "-DARGS=model|show|${_mdir}/bad_model.yaml:broken"
-          "-DREGEX=navimpact: error: .*bad_model.yaml: key 'models.broken.gyroscope': model .*at position 32: expected ',' or '\\)'"
-          -P ${_mdir}/expect_fail.cmake)
+navimpact_cli_fail(cli_model_bad_string ARGS model show ${_mdir}/bad_model.yaml:broken
+  REGEX "navimpact: error: .*bad_model.yaml: key 'models.broken.gyroscope': model .*at position 32: expected ',' or '\\)'")
 
 # unknown model name: non-zero exit, lists the available names
-add_test(NAME cli_model_unknown_name
-  COMMAND ${CMAKE_COMMAND} -DNI=${NI} "-DARGS=model|show|${_models}:gyro_model9"
-          "-DREGEX=no model named 'gyro_model9' \\(available: acc_model1, acc_model2, acc_model3, acc_ref, gyro_model1, gyro_model2, gyro_model3, gyro_ref, ref\\)"
-          -P ${_mdir}/expect_fail.cmake)
+navimpact_cli_fail(cli_model_unknown_name ARGS model show ${_models}:gyro_model9
+  REGEX "no model named 'gyro_model9' \\(available: acc_model1, acc_model2, acc_model3, acc_ref, gyro_model1, gyro_model2, gyro_model3, gyro_ref, ref\\)")

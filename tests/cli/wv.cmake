@@ -2,56 +2,15 @@
 # (each: non-zero exit, a one-line error naming the file, no output directory).
 set(_wv_dir ${CMAKE_CURRENT_BINARY_DIR}/wv_cli)
 set(_wv_data ${CMAKE_SOURCE_DIR}/datasets/adis16405_static_excerpt.csv.gz)
-set(_wv_fail ${CMAKE_CURRENT_SOURCE_DIR}/expect_fail.cmake)
 file(MAKE_DIRECTORY ${_wv_dir})
 
-# Excerpt: 262144 samples -> 18 scales, six channels; outputs present.
-file(WRITE ${_wv_dir}/check_wv_json.cmake [=[
-file(READ ${DIR}/wv.json j)
-string(JSON nch LENGTH "${j}" channels)
-if(NOT nch EQUAL 6)
-  message(FATAL_ERROR "wv.json: ${nch} channels, expected 6")
-endif()
-math(EXPR last "${nch} - 1")
-foreach(c RANGE ${last})
-  string(JSON name GET "${j}" channels ${c} name)
-  foreach(key tau_s wv ci_low ci_high)
-    string(JSON n LENGTH "${j}" channels ${c} ${key})
-    if(NOT n EQUAL 18)
-      message(FATAL_ERROR "wv.json: channel ${name} has ${n} ${key} values, expected 18")
-    endif()
-  endforeach()
-  string(JSON n LENGTH "${j}" channels ${c} allan adev)
-  if(n LESS 10)
-    message(FATAL_ERROR "wv.json: channel ${name} has ${n} Allan deviations")
-  endif()
-endforeach()
-string(JSON unit GET "${j}" channels 0 unit)
-if(NOT unit STREQUAL "(rad/s)^2")
-  message(FATAL_ERROR "wv.json: gyro unit '${unit}'")
-endif()
-string(JSON rate GET "${j}" input rate_hz)
-if(NOT rate EQUAL 100)
-  message(FATAL_ERROR "wv.json: rate ${rate}")
-endif()
-file(STRINGS ${DIR}/wv.csv rows)
-list(LENGTH rows nrows)
-if(NOT nrows EQUAL 109)  # header + 6 x 18
-  message(FATAL_ERROR "wv.csv: ${nrows} lines, expected 109")
-endif()
-foreach(f wv_gyroscope.png wv_accelerometer.png)
-  if(NOT EXISTS ${DIR}/${f})
-    message(FATAL_ERROR "missing ${DIR}/${f}")
-  endif()
-endforeach()
-]=])
 add_test(NAME cli_wv_excerpt
   COMMAND ${NI} wv --input ${_wv_data} --rate 100 --gyro-unit deg/s --acc-unit g --allan
           --out ${_wv_dir}/excerpt --overwrite)
 set_tests_properties(cli_wv_excerpt PROPERTIES
   PASS_REGULAR_EXPRESSION "262144 samples at 100 Hz, 18 scales")
-add_test(NAME cli_wv_excerpt_outputs
-  COMMAND ${CMAKE_COMMAND} -DDIR=${_wv_dir}/excerpt -P ${_wv_dir}/check_wv_json.cmake)
+# Excerpt: 262144 samples -> 18 scales, six channels; outputs present.
+navimpact_cli_check(cli_wv_excerpt_outputs CHECK wv_json DEFINES DIR=${_wv_dir}/excerpt)
 set_tests_properties(cli_wv_excerpt_outputs PROPERTIES DEPENDS cli_wv_excerpt)
 
 # Rawlog input (committed, 64 samples, label XSENS): reads with the right label.
@@ -76,10 +35,8 @@ file(WRITE ${_wv_dir}/three.csv "${_hdr}\n1,2,3,4,5,6\n2,3,4,5,6,7\n0,1,2,3,4,5\
 # wv_expect_fail(NAME REGEX ARG...): navimpact wv ARG... --out DIR must fail
 # with stderr matching REGEX and leave no DIR.
 function(wv_expect_fail name regex)
-  string(REPLACE ";" "|" _a "${ARGN}")
-  add_test(NAME cli_wv_bad_${name}
-    COMMAND ${CMAKE_COMMAND} -DNI=${NI} "-DARGS=wv|${_a}|--out|${_wv_dir}/out_${name}"
-            "-DREGEX=${regex}" -DOUTDIR=${_wv_dir}/out_${name} -P ${_wv_fail})
+  navimpact_cli_fail(cli_wv_bad_${name} ARGS wv ${ARGN} --out ${_wv_dir}/out_${name}
+                     REGEX "${regex}" NOOUT ${_wv_dir}/out_${name})
 endfunction()
 set(_u --rate 100 --gyro-unit deg/s --acc-unit g)
 wv_expect_fail(empty "empty\\.csv: empty file" --input ${_wv_dir}/empty.csv ${_u})
