@@ -7,8 +7,10 @@
 #        the command must fail (exit code EXIT when given, else non-zero) with
 #        a one-line message on stderr matching REGEX, and leave no NOOUT
 #        (a file or folder, removed before the run);
-#      navimpact_cli_check(NAME CHECK name [DEFINES VAR=value ...])
-#        runs the check `name` below with the variables given (NI is always set);
+#      navimpact_cli_check(NAME CHECK name [DEFINES VAR=value ...] [ARGS a b ...]
+#                          [JSON path=regex ...] [FILES f ...])
+#        runs the check `name` below with the variables given (NI is always
+#        set; ARGS becomes one '|'-separated string, JSON and FILES lists);
 #  - run as a script, `cmake -DCHECK=name -DVAR=value ... -P cli_helpers.cmake`,
 #    it runs the check function check_<name>() defined below.
 # Command arguments travel as one '|'-separated string (';' would be split by
@@ -33,10 +35,21 @@ if(NOT CMAKE_SCRIPT_MODE_FILE)
   endfunction()
 
   function(navimpact_cli_check name)
-    cmake_parse_arguments(C "" "CHECK" "DEFINES" ${ARGN})
+    cmake_parse_arguments(C "" "CHECK" "DEFINES;ARGS;JSON;FILES" ${ARGN})
     set(_defs)
     foreach(d ${C_DEFINES})
       list(APPEND _defs "-D${d}")
+    endforeach()
+    if(C_ARGS)
+      string(REPLACE ";" "|" _args "${C_ARGS}")
+      list(APPEND _defs "-DARGS=${_args}")
+    endif()
+    # list values travel as one argument (escaped ';' keeps it whole)
+    foreach(_l JSON FILES)
+      if(C_${_l})
+        string(REPLACE ";" "\\;" _v "${C_${_l}}")
+        list(APPEND _defs "-D${_l}=${_v}")
+      endif()
     endforeach()
     add_test(NAME ${name}
              COMMAND ${CMAKE_COMMAND} -DCHECK=${C_CHECK} -DNI=${NI} ${_defs} -P ${NAVIMPACT_CLI_HELPERS})
@@ -348,6 +361,211 @@ function(check_wv_json)
   endif()
   require_lines(${DIR}/wv.csv 109 "header + 6 x 18")
   require_files(${DIR} wv_gyroscope.png wv_accelerometer.png)
+endfunction()
+
+# Run ARGS (exit 0 required) with --out OUT, then in OUT: each JSON item
+# "path/with/slashes=REGEX" must match the value at that path of JSON_FILE
+# (array indices as numbers), and each of FILES must exist.
+function(check_run_json)
+  string(REPLACE "|" ";" _args "${ARGS}")
+  file(REMOVE_RECURSE ${OUT})
+  run_ni(${_args})
+  file(READ ${OUT}/${JSON_FILE} j)
+  foreach(c ${JSON})
+    string(FIND "${c}" "=" eq)
+    string(SUBSTRING "${c}" 0 ${eq} path)
+    math(EXPR vs "${eq} + 1")
+    string(SUBSTRING "${c}" ${vs} -1 rx)
+    string(REPLACE "/" ";" keys "${path}")
+    string(JSON v ERROR_VARIABLE jerr GET "${j}" ${keys})
+    if(jerr)
+      fail("${JSON_FILE}: ${path}: ${jerr}")
+    endif()
+    if(NOT v MATCHES "${rx}")
+      fail("${JSON_FILE}: ${path} = '${v}' does not match '${rx}'")
+    endif()
+  endforeach()
+  require_files(${OUT} ${FILES})
+endfunction()
+
+# diagnose the excerpt DATA against a fitted white-noise-only model into OUT:
+# every output, verdict inadequate, six channels, every finding's cause from
+# the vocabulary with an explanation, model_extended.yaml loads back.
+function(check_diagnose_excerpt)
+  file(REMOVE_RECURSE ${OUT})
+  run_ni(diagnose --input ${DATA} --rate 100 --gyro-unit deg/s --acc-unit g
+         --model fit:WN --simulations 4 --out ${OUT})
+  require_files(${OUT} diagnosis.json report.md model_extended.yaml wv_envelope.png)
+  file(READ ${OUT}/diagnosis.json j)
+  string(JSON verdict GET "${j}" verdict)
+  if(NOT verdict STREQUAL "inadequate")
+    fail("a white-noise-only model of the ADIS16405 should be inadequate, got ${verdict}")
+  endif()
+  string(JSON nch LENGTH "${j}" channels)
+  if(NOT nch EQUAL 6)
+    fail("expected 6 channels, got ${nch}")
+  endif()
+  math(EXPR last "${nch} - 1")
+  foreach(c RANGE ${last})
+    string(JSON nf LENGTH "${j}" channels ${c} findings)
+    if(nf GREATER 0)
+      math(EXPR lf "${nf} - 1")
+      foreach(i RANGE ${lf})
+        string(JSON cause GET "${j}" channels ${c} findings ${i} cause)
+        if(NOT cause MATCHES "^(white_noise|quantization_noise|random_walk|drift|gauss_markov|sinusoid|level_shift|outliers)$")
+          fail("cause '${cause}' not in the vocabulary")
+        endif()
+        string(JSON ex GET "${j}" channels ${c} findings ${i} explanation)
+        if(ex STREQUAL "")
+          fail("finding without explanation")
+        endif()
+      endforeach()
+    endif()
+  endforeach()
+  run_ni(model show ${OUT}/model_extended.yaml)
+endfunction()
+
+# All-or-nothing outputs of the real binary, case CASE in the scratch folder W
+# (SRC the source folder):
+#   refuse      a non-empty --out is refused before any work and left untouched
+#   replace     --overwrite replaces the folder whole: files of an earlier run with
+#               more outages (errors_outage_2.png) and strangers do not survive
+#   file        a single-file output (model convert --out FILE): refused when it
+#               exists, replaced with --overwrite, staged next to the file
+#   fail        a failing command creates neither its output nor missing parents
+#   cwd         --overwrite refuses the current folder (and leaves it untouched)
+# run_ni_expect(EXIT 0|1 [WD dir] ARGS ...): exit 0 or a failure; sets `err`.
+function(run_ni_expect)
+  cmake_parse_arguments(R "" "EXIT;WD" "ARGS" ${ARGN})
+  if(NOT R_WD)
+    set(R_WD ${W})
+  endif()
+  execute_process(COMMAND ${NI} ${R_ARGS} WORKING_DIRECTORY ${R_WD}
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(R_EXIT STREQUAL "0" AND NOT rc EQUAL 0)
+    message(FATAL_ERROR "navimpact ${R_ARGS}: exit ${rc}\n${out}${err}")
+  elseif(NOT R_EXIT STREQUAL "0" AND rc EQUAL 0)
+    message(FATAL_ERROR "navimpact ${R_ARGS}: expected a failure, got exit 0\n${out}")
+  endif()
+  set(err "${err}" PARENT_SCOPE)
+endfunction()
+function(expect_files dir)
+  file(GLOB have RELATIVE ${dir} ${dir}/* ${dir}/.*)
+  list(SORT have)
+  set(want ${ARGN})
+  list(SORT want)
+  if(NOT "${have}" STREQUAL "${want}")
+    message(FATAL_ERROR "${dir} holds [${have}], expected [${want}]")
+  endif()
+endfunction()
+function(expect_no_staging dir)
+  file(GLOB st ${dir}/.navimpact-staging*)
+  if(st)
+    message(FATAL_ERROR "staging left behind: ${st}")
+  endif()
+endfunction()
+
+function(check_output)
+  file(REMOVE_RECURSE ${W})
+  file(MAKE_DIRECTORY ${W})
+  set(XSENS ${SRC}/tests/data/imu_label_xsens.rawlog)
+  set(WV wv --input ${XSENS} --label XSENS)
+
+  if(CASE STREQUAL "refuse")
+    file(WRITE ${W}/out/notes.txt "mine\n")
+    run_ni_expect(EXIT 1 ARGS ${WV} --out ${W}/out)
+    if(NOT err MATCHES "out: output folder exists and is not empty \\(pass --overwrite to replace it whole\\)")
+      message(FATAL_ERROR "unexpected message: ${err}")
+    endif()
+    expect_files(${W}/out notes.txt)
+    expect_no_staging(${W})
+    # an empty folder is fine
+    file(MAKE_DIRECTORY ${W}/empty)
+    run_ni_expect(EXIT 0 ARGS ${WV} --out ${W}/empty)
+    expect_files(${W}/empty wv.csv wv.json wv_accelerometer.png wv_gyroscope.png)
+    expect_no_staging(${W})
+
+  elseif(CASE STREQUAL "replace")
+    set(RL ${SRC}/datasets/uav_flight_260s_ref.rawlog)
+    run_ni_expect(EXIT 0 ARGS replay --rawlog ${RL} --outage 100:10 --outage 150:10 --out ${W}/r)
+    expect_files(${W}/r errors_full.png errors_outage_1.png errors_outage_2.png solution.csv summary.json)
+    file(WRITE ${W}/r/stranger.txt "x\n")
+    run_ni_expect(EXIT 0 ARGS replay --rawlog ${RL} --outage 100:10 --out ${W}/r --overwrite)
+    expect_files(${W}/r errors_full.png errors_outage_1.png solution.csv summary.json)
+    expect_no_staging(${W})
+    # a failing --overwrite run keeps the earlier output intact
+    file(READ ${W}/r/summary.json before)
+    run_ni_expect(EXIT 1 ARGS replay --rawlog ${RL} --outage 250:30 --out ${W}/r --overwrite)
+    file(READ ${W}/r/summary.json after)
+    if(NOT before STREQUAL after)
+      message(FATAL_ERROR "a failing --overwrite run changed the earlier output")
+    endif()
+    expect_no_staging(${W})
+
+  elseif(CASE STREQUAL "file")
+    set(M ${SRC}/config/models/navchip_table1.yaml:ref)
+    run_ni_expect(EXIT 0 ARGS model convert ${M} --rate 100 --out ${W}/sub/m.yaml)
+    file(WRITE ${W}/sub/m.yaml "keep\n")
+    run_ni_expect(EXIT 1 ARGS model convert ${M} --rate 100 --out ${W}/sub/m.yaml)
+    if(NOT err MATCHES "m.yaml: output file exists \\(pass --overwrite to replace it\\)")
+      message(FATAL_ERROR "unexpected message: ${err}")
+    endif()
+    file(READ ${W}/sub/m.yaml c)
+    if(NOT c STREQUAL "keep\n")
+      message(FATAL_ERROR "refused output file was modified")
+    endif()
+    run_ni_expect(EXIT 0 ARGS model convert ${M} --rate 100 --out ${W}/sub/m.yaml --overwrite)
+    file(READ ${W}/sub/m.yaml c)
+    if(NOT c MATCHES "rate_hz: 100")
+      message(FATAL_ERROR "--overwrite did not replace the file: ${c}")
+    endif()
+    expect_files(${W}/sub m.yaml)
+    expect_no_staging(${W})
+    # relative output in the working folder: staged there, not in its parent
+    file(MAKE_DIRECTORY ${W}/wd)
+    run_ni_expect(EXIT 0 WD ${W}/wd ARGS model convert ${M} --rate 50 --out rel.yaml)
+    expect_files(${W}/wd rel.yaml)
+    expect_files(${W} sub wd)
+
+  elseif(CASE STREQUAL "fail")
+    # a failing command: no output folder, and the missing parents it needed are gone too
+    run_ni_expect(EXIT 1 ARGS replay --rawlog ${SRC}/datasets/uav_flight_260s_ref.rawlog --outage 250:30
+                       --out ${W}/new/deeper/out)
+    expect_files(${W})
+    run_ni_expect(EXIT 1 ARGS ${WV} --robust --eff 2 --out ${W}/new/out)
+    expect_files(${W})
+
+  elseif(CASE STREQUAL "cwd")
+    file(WRITE ${W}/precious.txt "x\n")
+    run_ni_expect(EXIT 1 ARGS ${WV} --out . --overwrite)
+    if(NOT err MATCHES "--overwrite: refusing to replace the current folder")
+      message(FATAL_ERROR "unexpected message: ${err}")
+    endif()
+    run_ni_expect(EXIT 1 ARGS ${WV} --out .. --overwrite WD ${W})
+    expect_files(${W} precious.txt)
+  else()
+    message(FATAL_ERROR "unknown CASE ${CASE}")
+  endif()
+  message(STATUS "ok: ${CASE}")
+endfunction()
+
+# diagnose-power on a tiny sweep into OUT: exit 0, power.md and power.json
+# written, the run counts and the seed recorded.
+function(check_diagnose_power)
+  file(REMOVE_RECURSE ${OUT})
+  run_ni(diagnose-power --out ${OUT} --runs 2 --null-runs 1 --snr 5:5
+         --samples 8192:16384 --causes sinusoid,level_shift,outliers --threads 2)
+  require_files(${OUT} power.md power.json)
+  file(READ ${OUT}/power.json j)
+  string(JSON nr GET "${j}" null runs)
+  string(JSON n LENGTH "${j}" runs)
+  if(NOT nr EQUAL 1 OR NOT n EQUAL 6)
+    fail("power.json: expected 1 null run and 6 effect runs, got ${nr} and ${n}")
+  endif()
+  string(JSON seed GET "${j}" seed)
+  if(NOT seed MATCHES "^[0-9]+$")
+    fail("power.json: no seed recorded")
+  endif()
 endfunction()
 
 if(NOT DEFINED CHECK OR NOT COMMAND check_${CHECK})
