@@ -144,35 +144,15 @@ int run(const Opts& o) {
     in["outages"] = o.outages;
     in["nav_runs"] = o.nav_runs;
   }
-  const auto figs =
-      navimpact::report::diagnosisFigures(d, [&out](const std::string& n) { return out.stage(n).string(); });
-  out.writeText("diagnosis.json", navimpact::report::diagnosisJson(d, in.dump()));
-  out.writeText("report.md", navimpact::report::diagnosisReport(d, figs));
-  std::string comment = "extended by navimpact diagnose from " + o.in.input + " (model " + o.model +
-                        ", seed " + std::to_string(o.seed) + ")";
-  out.writeText("model_extended.yaml", st::toYaml(d.model_after, comment));
+  const std::string comment = "extended by navimpact diagnose from " + o.in.input + " (model " + o.model +
+                              ", seed " + std::to_string(o.seed) + ")";
+  const std::size_t figs = navimpact::report::writeDiagnosisOutputs(d, in.dump(), comment, out);
   out.commit();
 
   for (const auto& n : d.notices) std::cerr << "navimpact: notice: " << n << "\n";
-  std::cout << "verdict: " << (d.adequate ? "adequate" : "inadequate") << "\n";
-  for (const auto& c : d.channels) {
-    std::cout << "  " << c.name << ": " << (c.adequate ? "adequate" : "inadequate");
-    for (const auto& f : c.findings) std::cout << " " << na::causeName(f.cause);
-    if (!c.adequate)
-      std::cout << "  (scales outside CI " << c.gain.outside_before << " -> "
-                << c.gain.outside_after << ", " << c.gain.basis << ", gain "
-                << (c.gain.significant ? "significant" : "not significant") << ")";
-    std::cout << "\n";
-  }
-  if (d.navigation)
-    for (const auto& g : d.navigation->outages)
-      std::cout << "  navigation, outage " << g.start_s << " s + " << g.duration_s
-                << " s: horizontal error at end " << g.mean_h_before << " -> " << g.mean_h_after
-                << " m (mean of " << d.navigation->runs << " runs; after better in " << g.wins
-                << "; " << (g.significant ? "significant" : "not significant") << ", sign test p = "
-                << g.sign_p << ")\n";
+  std::cout << navimpact::report::diagnosisSummary(d);
   std::cout << "wrote " << (std::filesystem::path(o.out) / "diagnosis.json").string()
-            << ", report.md, model_extended.yaml and " << figs.size() << " figure(s)\n";
+            << ", report.md, model_extended.yaml and " << figs << " figure(s)\n";
   return 0;
 }
 

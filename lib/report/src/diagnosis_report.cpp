@@ -9,6 +9,7 @@
 #include "navimpact/analysis/diagnosis.hpp"
 #include "navimpact/plot/figure.hpp"
 #include "navimpact/report/diagnosis_report.hpp"
+#include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
@@ -583,6 +584,35 @@ std::vector<std::string> diagnosisFigures(
     }
   }
   return names;
+}
+
+std::size_t writeDiagnosisOutputs(const Diagnosis& d, const std::string& input_json,
+                                  const std::string& model_comment, OutputSet& out) {
+  const auto figs = diagnosisFigures(d, [&out](const std::string& n) { return out.stage(n).string(); });
+  out.writeText("diagnosis.json", diagnosisJson(d, input_json));
+  out.writeText("report.md", diagnosisReport(d, figs));
+  out.writeText("model_extended.yaml", stochastic::toYaml(d.model_after, model_comment));
+  return figs.size();
+}
+
+std::string diagnosisSummary(const Diagnosis& d) {
+  std::ostringstream os;
+  os << "verdict: " << (d.adequate ? "adequate" : "inadequate") << "\n";
+  for (const auto& c : d.channels) {
+    os << "  " << c.name << ": " << (c.adequate ? "adequate" : "inadequate");
+    for (const auto& f : c.findings) os << " " << causeName(f.cause);
+    if (!c.adequate)
+      os << "  (scales outside CI " << c.gain.outside_before << " -> " << c.gain.outside_after << ", "
+         << c.gain.basis << ", gain " << (c.gain.significant ? "significant" : "not significant") << ")";
+    os << "\n";
+  }
+  if (d.navigation)
+    for (const auto& g : d.navigation->outages)
+      os << "  navigation, outage " << g.start_s << " s + " << g.duration_s << " s: horizontal error at end "
+         << g.mean_h_before << " -> " << g.mean_h_after << " m (mean of " << d.navigation->runs
+         << " runs; after better in " << g.wins << "; " << (g.significant ? "significant" : "not significant")
+         << ", sign test p = " << g.sign_p << ")\n";
+  return os.str();
 }
 
 }  // namespace navimpact::report

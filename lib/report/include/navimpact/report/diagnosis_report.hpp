@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "navimpact/analysis/diagnosis.hpp"
+#include "navimpact/core/output.hpp"
 
 namespace navimpact::report {
 
@@ -29,5 +30,16 @@ std::string diagnosisReport(const analysis::Diagnosis& d, const std::vector<std:
  */
 std::vector<std::string> diagnosisFigures(
     const analysis::Diagnosis& d, const std::function<std::string(const std::string&)>& path_for);
+
+/**
+ * Stage the figures, diagnosis.json, report.md and model_extended.yaml (the
+ * extended model, @p model_comment as its header) in @p out; the caller commits.
+ * @return the number of figures.
+ */
+std::size_t writeDiagnosisOutputs(const analysis::Diagnosis& d, const std::string& input_json,
+                                  const std::string& model_comment, OutputSet& out);
+
+/// The verdict, one line per channel (causes, scales outside the CI, gain) and the navigation gain.
+std::string diagnosisSummary(const analysis::Diagnosis& d);
 
 }  // namespace navimpact::report
