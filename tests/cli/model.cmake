@@ -38,3 +38,12 @@ navimpact_cli_fail(cli_model_bad_string ARGS model show ${_mdir}/bad_model.yaml:
 # unknown model name: non-zero exit, lists the available names
 navimpact_cli_fail(cli_model_unknown_name ARGS model show ${_models}:gyro_model9
   REGEX "no model named 'gyro_model9' \\(available: acc_model1, acc_model2, acc_model3, acc_ref, gyro_model1, gyro_model2, gyro_model3, gyro_ref, ref\\)")
+
+# rate_hz 1e308: the datasheet's Allan-deviation search is bounded (it used to
+# loop forever when 1e6 s * rate overflowed); the command ends, printing the
+# figures, or refuses the rate with a message naming it.
+file(WRITE ${_mdir}/huge_rate.yaml
+  "rate_hz: 1e308\ngyroscope: \"WN(sigma=1e-3) + GM(sigma=1e-4, T=10) + RW(gamma=1e-7)\"\naccelerometer: \"WN(sigma=1e-3)\"\n")
+add_test(NAME cli_model_show_huge_rate COMMAND ${NI} model show ${_mdir}/huge_rate.yaml)
+set_tests_properties(cli_model_show_huge_rate PROPERTIES TIMEOUT 60
+  PASS_REGULAR_EXPRESSION "ARW +[0-9.e+-]+ deg/sqrt\\(h\\)|rate_hz")

@@ -1,8 +1,10 @@
 // Datasheet figures (IEEE Std 952-1997 Allan-variance terms) from a model.
 #include "navimpact/stochastic/datasheet.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "kind.hpp"
@@ -27,41 +29,95 @@ std::string line(const char* label, double v, const char* unit) {
   return buf;
 }
 
+/// " (incl. 1 GM with T < 4 samples, 97 % of N^2)" when short GMs carry white noise.
+std::string whiteNote(const DatasheetFigures& f) {
+  if (f.noise_density_gms == 0) return "";
+  char buf[120];
+  std::snprintf(buf, sizeof buf, " (incl. %d GM%s with T < %g samples, %.0f %% of N^2)", f.noise_density_gms,
+                f.noise_density_gms > 1 ? "s" : "", kWhiteGmMaxSamples, 100.0 * f.noise_density_gm_share);
+  return buf;
+}
+
 }  // namespace
 
-DatasheetFigures datasheetFigures(const Model& m) {
+DatasheetFigures datasheetFigures(const Model& m, double max_averaging_s) {
   DatasheetFigures f;
-  if (m.terms.empty() || !(m.rate_hz > 0.0)) return f;
+  if (m.terms.empty() || !(m.rate_hz > 0.0) || !std::isfinite(m.rate_hz)) return f;
   const double dt = 1.0 / m.rate_hz;
   // Each kind adds its own figure (processes/<name>.cpp): WN the noise
-  // density N = sigma sqrt(dt), RW the rate random walk K = gamma / sqrt(dt),
+  // density N = sigma sqrt(dt), a GM with T < kWhiteGmMaxSamples its
+  // long-run variance to N, RW the rate random walk K = gamma / sqrt(dt),
   // QN the quantization Q dt, DR the drift rate omega / dt; independent terms
   // of one kind add in variance, drifts add.
   for (const auto& p : m.terms) detail::kindDef(p.kind).addDatasheet(p, m.rate_hz, f);
+  if (f.noise_density && *f.noise_density > 0.0)
+    f.noise_density_gm_share = std::min(1.0, f.noise_density_gm_n2 / (*f.noise_density * *f.noise_density));
 
-  // Bias instability: first local minimum of the model ADEV on a log grid of
-  // averaging times from 1 sample to 1e6 s (50 points per decade), divided by
-  // 0.664 = sqrt(2 ln 2 / pi) (IEEE 952, flicker floor). Empty when the ADEV
-  // has no interior local minimum on the grid (e.g. WN alone, or WN + GM whose
-  // curve only decreases). The first local minimum is the datasheet reading
-  // (the floor after the white-noise slope), even if a later GM with a very
-  // long T bends the curve down again beyond 1e6 s.
-  const double m_max = 1e6 * m.rate_hz;
+  // Bias instability (IEEE 952): the flat region of the model ADEV, i.e. its
+  // lowest local minimum at or beyond kFirstScalesSamples, on a log grid of
+  // averaging times (50 points per decade) from 1 sample to the longest
+  // averaging time, bounded to 12 decades of samples whatever the rate.
+  const double max_s = max_averaging_s > 0.0 ? max_averaging_s : kDefaultMaxAveragingS;
+  const double m_max = std::min(max_s * m.rate_hz, 1e12);
+  if (!(m_max > 1.0)) return f;
   const int per_decade = 50;
-  std::vector<double> ms;
-  for (int i = 0;; ++i) {
-    const double mm = std::pow(10.0, static_cast<double>(i) / per_decade);
-    if (mm > m_max) break;
-    ms.push_back(mm);
+  const int n_pts = static_cast<int>(std::floor(std::log10(m_max) * per_decade)) + 1;
+  std::vector<double> lm(n_pts), adev(n_pts);  // log10 m, ADEV
+  auto adevAt = [&](double log10m) { return std::sqrt(modelAvar(m, std::pow(10.0, log10m))); };
+  for (int i = 0; i < n_pts; ++i) {
+    lm[i] = static_cast<double>(i) / per_decade;
+    adev[i] = adevAt(lm[i]);
   }
-  std::vector<double> adev(ms.size());
-  for (std::size_t i = 0; i < ms.size(); ++i) adev[i] = std::sqrt(modelAvar(m, ms[i]));
-  for (std::size_t i = 1; i + 1 < ms.size(); ++i) {
-    if (adev[i] < adev[i - 1] && adev[i] <= adev[i + 1]) {
-      f.bias_instability = adev[i] / 0.664;
-      f.bias_instability_tau_s = ms[i] * dt;
-      break;
+  int best = -1, first = -1;
+  for (int i = 1; i + 1 < n_pts; ++i) {
+    if (!(adev[i] < adev[i - 1] && adev[i] <= adev[i + 1])) continue;
+    if (std::pow(10.0, lm[i]) < kFirstScalesSamples) {
+      if (first < 0 || adev[i] < adev[first]) first = i;
+    } else if (best < 0 || adev[i] < adev[best]) {
+      best = i;
     }
+  }
+  if (n_pts >= 2 && adev[0] <= adev[1] && (first < 0 || adev[0] < adev[first])) first = 0;  // rises at once
+  // Only a minimum at the first scales: it is the reading (with a warning)
+  // unless the ADEV ends lower, falling (then no flat region is reached).
+  const int pick = best >= 0 ? best : (first >= 0 && adev[first] <= adev[n_pts - 1] ? first : -1);
+  char buf[200];
+  if (pick < 0) {
+    std::snprintf(buf, sizeof buf,
+                  "no flat region: the Allan deviation still falls at the longest averaging time (%.3g s)",
+                  std::pow(10.0, lm[n_pts - 1]) * dt);
+    f.bias_instability_warning = buf;
+    return f;
+  }
+  // Golden-section refinement of the minimum between the grid neighbours.
+  double a = lm[std::max(pick - 1, 0)], b = lm[std::min(pick + 1, n_pts - 1)];
+  const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
+  double c = b - gr * (b - a), d = a + gr * (b - a), fc = adevAt(c), fd = adevAt(d);
+  for (int it = 0; it < 60 && b - a > 1e-12; ++it) {
+    if (fc < fd) {
+      b = d;
+      d = c;
+      fd = fc;
+      c = b - gr * (b - a);
+      fc = adevAt(c);
+    } else {
+      a = c;
+      c = d;
+      fc = fd;
+      d = a + gr * (b - a);
+      fd = adevAt(d);
+    }
+  }
+  double x = 0.5 * (a + b), v = adevAt(x);
+  if (adev[pick] < v) x = lm[pick], v = adev[pick];
+  f.bias_instability = v / 0.664;
+  f.bias_instability_tau_s = std::pow(10.0, x) * dt;
+  if (best < 0) {
+    std::snprintf(buf, sizeof buf,
+                  "the Allan deviation minimum sits at the first scales (%.3g samples): not the flat region of "
+                  "IEEE Std 952 (quantisation, sub-sample correlation or a short hump, not a bias floor)",
+                  std::pow(10.0, x));
+    f.bias_instability_warning = buf;
   }
   return f;
 }
@@ -72,22 +128,24 @@ std::string formatDatasheet(const DatasheetFigures& f, units::Quantity q) {
   char buf[64];
   if (q == Quantity::AngularRate) {
     // N [rad/sqrt(s)]: angle std after t is N sqrt(t) -> deg/sqrt(h) = N (180/pi) 60.
-    if (f.noise_density) s += line("ARW", *f.noise_density / kDeg * kSqrtHour, "deg/sqrt(h)");
+    if (f.noise_density) s += line("ARW", *f.noise_density / kDeg * kSqrtHour, ("deg/sqrt(h)" + whiteNote(f)).c_str());
     if (f.bias_instability) {
       std::snprintf(buf, sizeof buf, "deg/h (ADEV min at %.3g s)", *f.bias_instability_tau_s);
       s += line("bias instability", *f.bias_instability / kDeg * kHour, buf);
     }
+    if (!f.bias_instability_warning.empty()) s += "  warning: bias instability: " + f.bias_instability_warning + "\n";
     // K [rad/s/sqrt(s)] -> deg/h/sqrt(h) = K (180/pi) 3600 * 60.
     if (f.random_walk) s += line("RRW", *f.random_walk / kDeg * kHour * kSqrtHour, "deg/h/sqrt(h)");
     if (f.quantization) s += line("quantization", *f.quantization / kDeg * 3600.0, "arcsec");
     if (f.drift_rate) s += line("drift rate", *f.drift_rate / kDeg * kHour * kHour, "deg/h/h");
   } else {
     // N [m/s^2*sqrt(s) = m/s/sqrt(s)] -> m/s/sqrt(h) = N 60.
-    if (f.noise_density) s += line("VRW", *f.noise_density * kSqrtHour, "m/s/sqrt(h)");
+    if (f.noise_density) s += line("VRW", *f.noise_density * kSqrtHour, ("m/s/sqrt(h)" + whiteNote(f)).c_str());
     if (f.bias_instability) {
       std::snprintf(buf, sizeof buf, "mg (ADEV min at %.3g s)", *f.bias_instability_tau_s);
       s += line("bias instability", *f.bias_instability / kG0 * 1e3, buf);
     }
+    if (!f.bias_instability_warning.empty()) s += "  warning: bias instability: " + f.bias_instability_warning + "\n";
     // K [m/s^2/sqrt(s)] -> mg/sqrt(h) = K 60 / g0 * 1e3.
     if (f.random_walk) s += line("acc random walk", *f.random_walk * kSqrtHour / kG0 * 1e3, "mg/sqrt(h)");
     if (f.quantization) s += line("quantization", *f.quantization, "m/s");

@@ -199,8 +199,19 @@ class GaussMarkov final : public KindDef {
                  g2 = 4.0 * std::exp(-L);
     return [g0, g1, g2](double s) { return g0 / (g1 + g2 * s); };
   }
-  // No datasheet figure of its own: a GM shows in the bias instability of the
-  // model's Allan deviation (datasheet.cpp).
+  // A GM with T below kWhiteGmMaxSamples samples is white noise at every
+  // averaging time beyond a few samples: its flat PSD level (the AR(1)
+  // density at f = 0, the long-run variance sigma^2 (1+phi)/(1-phi) per
+  // sample) adds to the noise density N^2 = dt S(0). Longer GMs show in the
+  // bias instability of the model's Allan deviation (datasheet.cpp).
+  void addDatasheet(const Process& p, double rate_hz, DatasheetFigures& f) const override {
+    if (!(p.T > 0.0) || !(p.T * rate_hz < kWhiteGmMaxSamples)) return;
+    const double n2 = density(p, rate_hz)(0.0) / rate_hz;
+    const double prev = f.noise_density ? *f.noise_density * *f.noise_density : 0.0;
+    f.noise_density = std::sqrt(prev + n2);
+    f.noise_density_gm_n2 += n2;
+    ++f.noise_density_gms;
+  }
 };
 
 }  // namespace
