@@ -12,19 +12,19 @@ navimpact_cli_check(cli_diagnose_excerpt_wn CHECK diagnose_excerpt DEFINES DATA=
 # Bad input: each fails before any work with a one-line error naming the problem.
 navimpact_cli_fail(cli_diagnose_missing_model EXIT 1 NOOUT ${_dg_out}/bad1
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model /nonexistent/model.yaml --out ${_dg_out}/bad1
-  REGEX "error: .*nonexistent/model.yaml")
+  REGEX "^navimpact: .*nonexistent/model.yaml")
 navimpact_cli_fail(cli_diagnose_bad_structure EXIT 1 NOOUT ${_dg_out}/bad2
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN+XYZ --out ${_dg_out}/bad2
-  REGEX "error: .*XYZ")
+  REGEX "^navimpact: .*XYZ")
 navimpact_cli_fail(cli_diagnose_outage_without_trajectory EXIT 1 NOOUT ${_dg_out}/bad3
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --outage 100:30 --out ${_dg_out}/bad3
-  REGEX "error: --outage needs --trajectory")
+  REGEX "^navimpact: --outage needs --trajectory")
 navimpact_cli_fail(cli_diagnose_bad_outage EXIT 1 NOOUT ${_dg_out}/bad4
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --trajectory ${_dg_data} --outage abc --out ${_dg_out}/bad4
-  REGEX "error: --outage 'abc': expected START:DURATION")
+  REGEX "^navimpact: --outage 'abc': expected START:DURATION")
 navimpact_cli_fail(cli_diagnose_missing_unit EXIT 1 NOOUT ${_dg_out}/bad5
   ARGS diagnose --input ${_dg_data} --rate 100 --model fit:WN --out ${_dg_out}/bad5
-  REGEX "error: .*unit")
+  REGEX "^navimpact: .*unit")
 
 # A record of 999 samples (written here) with a white-noise model.
 set(_dg_short ${CMAKE_CURRENT_BINARY_DIR}/diagnose_short)
@@ -39,7 +39,7 @@ file(WRITE ${_dg_short}/model.yaml "rate_hz: 100\naccelerometer: \"WN(sigma=1e-2
 set(_dg_short_args diagnose --input ${_dg_short}/short.csv ${_dg_u} --model ${_dg_short}/model.yaml)
 navimpact_cli_fail(cli_diagnose_short_record EXIT 1 NOOUT ${_dg_out}/bad6
   ARGS ${_dg_short_args} --out ${_dg_out}/bad6
-  REGEX "error: .*samples; diagnose needs at least 4096")
+  REGEX "^navimpact: .*samples; diagnose needs at least 4096")
 
 # MRPT rawlog input through the shared loader (--label): the committed UAV
 # rawlog (200 Hz, 52,000 IMU samples; it moves, so the model is inadequate,
@@ -52,7 +52,7 @@ navimpact_cli_check(cli_diagnose_rawlog CHECK run_json
   FILES report.md model_extended.yaml)
 navimpact_cli_fail(cli_diagnose_rawlog_bad_label EXIT 1 NOOUT ${_dg_out}/bad7
   ARGS diagnose --input ${_dg_rawlog} --label XSENS --model fit:WN --out ${_dg_out}/bad7
-  REGEX "error: .*no CObservationIMU with label 'XSENS'")
+  REGEX "^navimpact: .*no CObservationIMU with label 'XSENS'")
 
 # Navigation gain along the committed UAV excerpt with the excerpt's measured
 # errors as the truth: before/after per outage, NEES band, figure.
@@ -67,17 +67,17 @@ navimpact_cli_check(cli_diagnose_navigation CHECK run_json
   FILES navigation_error.png report.md)
 navimpact_cli_fail(cli_diagnose_outage_past_trajectory EXIT 1 NOOUT ${_dg_out}/bad8
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --trajectory ${_dg_traj} --outage 250:30 --out ${_dg_out}/bad8
-  REGEX "error: --outage 250:30 ends at 280 s, after the end of the trajectory")
+  REGEX "^navimpact: --outage 250:30 ends at 280 s, after the end of the trajectory")
 navimpact_cli_fail(cli_diagnose_recording_shorter_than_trajectory EXIT 1 NOOUT ${_dg_out}/bad9
   ARGS ${_dg_short_args} --out ${_dg_out}/bad9 --trajectory ${_dg_traj} --outage 100:30
-  REGEX "error: static recording too short for the navigation gain: 9.99 s available, 2.* s needed")
+  REGEX "^navimpact: static recording too short for the navigation gain: 9.99 s available, 2.* s needed")
 
 # Detection-power sweep: a tiny run writes its table and records every run;
 # bad flags fail before any work.
 navimpact_cli_check(cli_diagnose_power_small CHECK diagnose_power DEFINES OUT=${_dg_out}/power)
 navimpact_cli_fail(cli_diagnose_power_bad_cause EXIT 1 NOOUT ${_dg_out}/bad10
   ARGS diagnose-power --out ${_dg_out}/bad10 --causes sinusoid,wobble
-  REGEX "error: --causes: unknown cause 'wobble'")
+  REGEX "^navimpact: --causes: unknown cause 'wobble'")
 navimpact_cli_fail(cli_diagnose_power_bad_snr EXIT 1 NOOUT ${_dg_out}/bad11
   ARGS diagnose-power --out ${_dg_out}/bad11 --snr 5
-  REGEX "error: --snr '5': expected LO:HI")
+  REGEX "^navimpact: --snr '5': expected LO:HI")

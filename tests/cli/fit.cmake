@@ -32,18 +32,18 @@ set_tests_properties(cli_fit_auto PROPERTIES
 # a bad structure string: error naming the position, no output left behind
 navimpact_cli_fail(cli_fit_bad_structure
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GX+DR --out ${_fdir}/bad
-  REGEX "navimpact: error: .*structure.*position 4.*'GX'" NOOUT ${_fdir}/bad)
+  REGEX "^navimpact: .*structure.*position 4.*'GX'" NOOUT ${_fdir}/bad)
 
 # more parameters (WN + 9 GM = 19) than the 18 scales of 2^18 samples: clear error
 navimpact_cli_fail(cli_fit_too_many_parameters
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+9GM --out ${_fdir}/big
-  REGEX "navimpact: error: .*channel gyro_x: .*19 parameters but the wavelet variance has only 18 scales"
+  REGEX "^navimpact: .*channel gyro_x: .*19 parameters but the wavelet variance has only 18 scales"
   NOOUT ${_fdir}/big)
 
 # an unknown channel name is rejected
 navimpact_cli_fail(cli_fit_bad_channel
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --channels gyro_q --out ${_fdir}/badch
-  REGEX "navimpact: error: --channels: unknown channel 'gyro_q'" NOOUT ${_fdir}/badch)
+  REGEX "^navimpact: --channels: unknown channel 'gyro_q'" NOOUT ${_fdir}/badch)
 
 # --weights: default r (the R package's objective) is recorded; efficient is
 # recorded with the R objective of the same model next to it; every term
@@ -64,7 +64,7 @@ set_tests_properties(cli_fit_weights_efficient_json PROPERTIES FIXTURES_REQUIRED
 # an unknown weighting is a one-line error before any output
 navimpact_cli_fail(cli_fit_bad_weights
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --weights optimal --out ${_fdir}/badw
-  REGEX "navimpact: error: --weights: expected 'r', 'model' or 'efficient', got 'optimal'" NOOUT ${_fdir}/badw)
+  REGEX "^navimpact: --weights: expected 'r', 'model' or 'efficient', got 'optimal'" NOOUT ${_fdir}/badw)
 
 # A term pushed to its lower bound is reported, not hidden: on gyro_x of the
 # excerpt, WN+GM+RW+DR puts the white noise into a GM with T < 1 sample and

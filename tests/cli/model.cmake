@@ -33,7 +33,7 @@ set_tests_properties(cli_model_convert_stdout PROPERTIES PASS_REGULAR_EXPRESSION
 file(WRITE ${_mdir}/bad_model.yaml
   "rate_hz: 200\nmodels:\n  broken:\n    gyroscope: \"WN(sigma=1e-3) + GM(sigma=2e-5 T=3)\"\n")
 navimpact_cli_fail(cli_model_bad_string ARGS model show ${_mdir}/bad_model.yaml:broken
-  REGEX "navimpact: error: .*bad_model.yaml: key 'models.broken.gyroscope': model .*at position 32: expected ',' or '\\)'")
+  REGEX "^navimpact: .*bad_model.yaml: key 'models.broken.gyroscope': model .*at position 32: expected ',' or '\\)'")
 
 # unknown model name: non-zero exit, lists the available names
 navimpact_cli_fail(cli_model_unknown_name ARGS model show ${_models}:gyro_model9

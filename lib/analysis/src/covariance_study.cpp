@@ -85,6 +85,7 @@ std::string modelText(const stochastic::ImuModel& m) {
 }  // namespace
 
 CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
+  InputScope scope(path);
   CovarianceStudyConfig c;
   c.source = path;
   YAML::Node root;

@@ -59,6 +59,7 @@ ReplayOutage parseOutage(const std::string& text) {
 }
 
 ReplayConfig loadReplayConfig(const std::string& path) {
+  InputScope scope(path);
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);

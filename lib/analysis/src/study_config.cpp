@@ -81,6 +81,7 @@ std::string resolveModelSpec(const Ctx& c, const std::string& spec) {
 }  // namespace
 
 StudyConfig loadStudyConfig(const std::string& path) {
+  InputScope scope(path);
   StudyConfig cfg;
   cfg.config_file = path;
   cfg.config_text = readFileMaybeGz(path);

@@ -13,7 +13,7 @@ void parseAxesSpec(const std::string& spec, int src[3], double sign[3]) {
   const auto parts = splitView(spec, ',');
   bool used[3] = {false, false, false};
   auto bad = [&](const std::string& why) {
-    return Error("axes spec '" + spec + "': " + why +
+    return Error("axes spec '" + printable(spec) + "': " + why +
                  " (expected a signed permutation of x,y,z such as \"x,-y,-z\")");
   };
   if (parts.size() != 3) throw bad("needs three comma-separated axes");
@@ -24,7 +24,7 @@ void parseAxesSpec(const std::string& spec, int src[3], double sign[3]) {
       s = p.front() == '-' ? -1.0 : 1.0;
       p.remove_prefix(1);
     }
-    if (p.size() != 1 || p[0] < 'x' || p[0] > 'z') throw bad("unknown axis '" + std::string(parts[i]) + "'");
+    if (p.size() != 1 || p[0] < 'x' || p[0] > 'z') throw bad("unknown axis '" + printable(parts[i]) + "'");
     const int a = p[0] - 'x';
     if (used[a]) throw bad("axis '" + std::string(p) + "' used twice");
     used[a] = true;
@@ -43,6 +43,7 @@ struct Column {
 }  // namespace
 
 ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
+  InputScope scope(path);
   const std::string text = readFileMaybeGz(path);
   if (trim(text).empty()) throw fileError(path, 0, "file is empty");
 
@@ -61,7 +62,7 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
     if (lb != std::string_view::npos) {
       const auto rb = n.find(']', lb);
       if (rb == std::string_view::npos)
-        throw fileError(path, 1, "column " + std::to_string(c + 1) + " '" + std::string(n) +
+        throw fileError(path, 1, "column " + std::to_string(c + 1) + " '" + printable(n) +
                                      "': unit bracket not closed");
       unit = std::string(trim(n.substr(lb + 1, rb - lb - 1)));
       n = trim(n.substr(0, lb));
@@ -88,13 +89,13 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
     try {
       cols[c].factor = units::toSiFactor(q, unit);
     } catch (const Error& e) {
-      throw fileError(path, 1, "column '" + name + "': " + e.what());
+      throw fileError(path, 1, "column '" + printable(name) + "': " + e.what());
     }
     cols[c].channel = idx;
   }
   if (std::all_of(std::begin(present), std::end(present), [](int p) { return p < 0; }))
     throw fileError(path, 1,
-                    "no IMU column in header '" + std::string(trim(header)) +
+                    "no IMU column in header '" + printable(trim(header), 120) +
                         "' (expected some of gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z and optional t)");
 
   // --- rows ----------------------------------------------------------------
@@ -128,12 +129,12 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
         const std::string_view field = line.substr(start, comma - start);
         if (!parseDouble(field, v))
           throw fileError(path, lineNo, "column " + std::to_string(c + 1) + " ('" +
-                                            std::string(trim(names[c])) + "'): '" +
-                                            std::string(field) + "' is not a number");
+                                            printable(trim(names[c])) + "'): '" + printable(field) +
+                                            "' is not a number");
         if (!std::isfinite(v))
           throw fileError(path, lineNo, "column " + std::to_string(c + 1) + " ('" +
-                                            std::string(trim(names[c])) + "'): value is " +
-                                            std::string(trim(field)));
+                                            printable(trim(names[c])) + "'): value is " +
+                                            printable(trim(field)));
         if (cols[c].channel == -2)
           times.push_back(v);
         else

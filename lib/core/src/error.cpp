@@ -1,5 +1,8 @@
 #include "navimpact/core/error.hpp"
 
+#include <cstdio>
+#include <exception>
+
 namespace navimpact {
 
 Error fileError(const std::string& file, std::size_t line, const std::string& what) {
@@ -12,8 +15,117 @@ Error fileError(const std::string& file, std::size_t line, const std::string& wh
 Error keyError(const std::string& file, const std::string& key, const std::string& what) {
   std::string msg;
   if (!file.empty()) msg = file + ": ";
-  msg += "key '" + key + "': " + what;
+  msg += "key '" + printable(key, 80) + "': " + what;
   return Error(msg);
 }
+
+namespace {
+
+/// Length of the valid UTF-8 sequence starting at s[i] (1..4), or 0 if invalid.
+std::size_t utf8Length(std::string_view s, std::size_t i) {
+  const auto c = static_cast<unsigned char>(s[i]);
+  std::size_t n = 0;
+  unsigned min = 0;
+  if (c >= 0xC2 && c <= 0xDF) n = 2, min = 0x80;
+  else if (c >= 0xE0 && c <= 0xEF) n = 3, min = 0x800;
+  else if (c >= 0xF0 && c <= 0xF4) n = 4, min = 0x10000;
+  else return 0;
+  if (i + n > s.size()) return 0;
+  unsigned cp = c & (0x3F >> (n - 1));
+  for (std::size_t k = 1; k < n; ++k) {
+    const auto d = static_cast<unsigned char>(s[i + k]);
+    if ((d & 0xC0) != 0x80) return 0;
+    cp = (cp << 6) | (d & 0x3F);
+  }
+  if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return 0;
+  return n;
+}
+
+/// Appends the escaped form of s[i..] up to @p budget input bytes; returns bytes consumed.
+std::size_t appendEscaped(std::string& out, std::string_view s, std::size_t i, std::size_t budget,
+                          bool raw = true) {
+  const std::size_t start = i;
+  while (i < s.size() && i - start < budget) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c == '\\' && raw) {
+      out += "\\\\";
+      ++i;
+    } else if (c == '\t' && !raw) {
+      out += ' ';
+      ++i;
+    } else if (c == '\n') {
+      out += "\\n";
+      ++i;
+    } else if (c == '\t') {
+      out += "\\t";
+      ++i;
+    } else if (c == '\r') {
+      out += "\\r";
+      ++i;
+    } else if (c >= 0x20 && c < 0x7F) {
+      out += static_cast<char>(c);
+      ++i;
+    } else if (const std::size_t n = c >= 0x80 ? utf8Length(s, i) : 0; n > 0) {
+      out.append(s.substr(i, n));
+      i += n;
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02X", c);
+      out += buf;
+      ++i;
+    }
+  }
+  return i - start;
+}
+
+thread_local std::string g_failedInput;
+
+}  // namespace
+
+std::string printable(std::string_view raw, std::size_t max) {
+  std::string out;
+  const std::size_t used = appendEscaped(out, raw, 0, max);
+  if (used < raw.size()) out += "...(" + std::to_string(raw.size()) + " bytes)";
+  return out;
+}
+
+std::string oneLine(std::string_view msg, std::size_t max) {
+  std::string flat;
+  flat.reserve(std::min(msg.size(), 4 * max) + 8);
+  // Line breaks (and the white space around them) become "; ".
+  std::size_t i = 0;
+  while (i < msg.size() && flat.size() < 8 * max) {
+    if (msg[i] == '\n' || msg[i] == '\r') {
+      while (!flat.empty() && (flat.back() == ' ' || flat.back() == '\t')) flat.pop_back();
+      while (i < msg.size() && (msg[i] == '\n' || msg[i] == '\r' || msg[i] == ' ' || msg[i] == '\t')) ++i;
+      if (!flat.empty() && i < msg.size()) flat += "; ";
+      continue;
+    }
+    const std::size_t used = appendEscaped(flat, msg, i, 1, false);
+    i += used ? used : 1;
+  }
+  const bool cutInput = i < msg.size();
+  if (flat.size() <= max && !cutInput) return flat;
+  // Keep the start (where) and the end (what is accepted); cut on character boundaries.
+  const std::size_t tail = max / 4, head = max - tail - 5;
+  auto continuation = [&flat](std::size_t k) {
+    return k < flat.size() && (static_cast<unsigned char>(flat[k]) & 0xC0) == 0x80;
+  };
+  std::size_t h = head, t = flat.size() - tail;
+  while (h > 0 && continuation(h)) --h;
+  while (t < flat.size() && continuation(t)) ++t;
+  return flat.substr(0, h) + " ... " + flat.substr(t);
+}
+
+InputScope::InputScope(std::string name) : name_(std::move(name)), uncaught_(std::uncaught_exceptions()) {}
+
+InputScope::~InputScope() {
+  // Unwinding because of an exception: the innermost scope it leaves names the input.
+  if (std::uncaught_exceptions() > uncaught_ && g_failedInput.empty()) g_failedInput = name_;
+}
+
+std::string InputScope::failedInput() { return g_failedInput; }
+
+void InputScope::clearFailedInput() { g_failedInput.clear(); }
 
 }  // namespace navimpact

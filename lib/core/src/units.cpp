@@ -31,7 +31,7 @@ double toSiFactor(Quantity q, std::string_view unit) {
   for (const auto& n : acceptedUnits(q)) list += (list.empty() ? "" : ", ") + n;
   throw Error("unknown " +
               std::string(q == Quantity::AngularRate ? "angular-rate" : "specific-force") +
-              " unit '" + std::string(unit) + "' (expected one of: " + list + ")");
+              " unit '" + printable(unit, 40) + "' (expected one of: " + list + ")");
 }
 
 std::vector<std::string> acceptedUnits(Quantity q) {

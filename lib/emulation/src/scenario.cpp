@@ -87,6 +87,7 @@ std::string quote(const std::string& s) {
 }  // namespace
 
 EmulationConfig loadEmulationConfig(const std::string& path) {
+  InputScope scope(path);
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);

@@ -33,6 +33,7 @@ double angleFactor(const std::string& unit, const std::string& key, const std::s
 }  // namespace
 
 SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
+  InputScope scope(spec.file);
   const std::string& path = spec.file;
   const bool geo = spec.system == "geodetic";
   if (!geo && spec.system != "ned")

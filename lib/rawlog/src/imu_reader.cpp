@@ -17,18 +17,12 @@
 #include <sstream>
 #include <vector>
 
+#include "mrpt_errors.hpp"
 #include "navimpact/core/error.hpp"
 
 namespace navimpact::rawlog {
 
 namespace {
-
-/// First line of an MRPT exception text (MRPT appends call-stack lines).
-std::string firstLine(const std::string& s) {
-  std::string l = s.substr(0, s.find('\n'));
-  if (l.size() > 200) l = l.substr(0, 200) + "...";
-  return l;
-}
 
 std::string fmtTime(double t) {
   std::ostringstream os;
@@ -48,7 +42,7 @@ void openOrThrow(mrpt::io::CFileGZInputStream& f, const std::string& path) {
   try {
     ok = f.open(path);
   } catch (const std::exception& e) {
-    throw Error(path + ": cannot open rawlog (" + firstLine(e.what()) + ")");
+    throw Error(path + ": cannot open rawlog (" + detail::mrptCause(e) + ")");
   }
   if (!ok) throw Error(path + ": cannot open rawlog");
 }
@@ -56,6 +50,7 @@ void openOrThrow(mrpt::io::CFileGZInputStream& f, const std::string& path) {
 }  // namespace
 
 ImuSeries readImuRawlog(const std::string& path, const std::string& label) {
+  InputScope scope(path);
   mrpt::obs::registerAllClasses_mrpt_obs();
   mrpt::io::CFileGZInputStream f;
   openOrThrow(f, path);
@@ -71,7 +66,7 @@ ImuSeries readImuRawlog(const std::string& path, const std::string& label) {
     if (!imu || imu->sensorLabel != label) {
       std::string cls = obs->GetRuntimeClass()->className;
       if (const auto p = cls.rfind("::"); p != std::string::npos) cls = cls.substr(p + 2);
-      ++labelsFound["'" + obs->sensorLabel + "' (" + cls + ")"];
+      if (labelsFound.size() < 20) ++labelsFound["'" + printable(obs->sensorLabel, 40) + "' (" + cls + ")"];
       return;
     }
     using namespace mrpt::obs;
@@ -100,7 +95,7 @@ ImuSeries readImuRawlog(const std::string& path, const std::string& label) {
       break;  // clean end of file, between two objects
     } catch (const std::exception& e) {
       throw Error(path + ": entry " + std::to_string(entry) +
-                  ": truncated or malformed rawlog object (" + firstLine(e.what()) + ")");
+                  ": truncated or malformed rawlog object (" + detail::mrptCause(e) + ")");
     }
     if (!obj) continue;
     if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj)) {

@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "mrpt_errors.hpp"
 #include "navimpact/core/error.hpp"
 
 namespace navimpact::rawlog {
@@ -214,6 +215,7 @@ void writeRawlog(const std::string& path, const emulation::EmulationData& d, con
 }
 
 emulation::EmulationData readRawlog(const std::string& path) {
+  InputScope scope(path);
   if (!std::filesystem::exists(path)) throw Error(path + ": rawlog not found");
   // Read through a 1 MiB buffer: MRPT's archive reads every field with its own
   // small Read() call, which on the bare gzip stream costs a gzread() each.
@@ -232,7 +234,7 @@ emulation::EmulationData readRawlog(const std::string& path) {
   Eigen::Matrix3d C_LtoE = Eigen::Matrix3d::Identity();
   auto where = [&](const std::string& label, double t) {
     std::string s = path + ": entry " + std::to_string(entry);
-    if (!label.empty()) s += " (label " + label + (std::isfinite(t) ? ", t = " + std::to_string(t) + " s" : "") + ")";
+    if (!label.empty()) s += " (label " + printable(label, 40) + (std::isfinite(t) ? ", t = " + std::to_string(t) + " s" : "") + ")";
     return s;
   };
   for (;; ++entry) {
@@ -243,10 +245,7 @@ emulation::EmulationData readRawlog(const std::string& path) {
     } catch (const mrpt::serialization::CExceptionEOF&) {
       throw Error(where("", NAN) + ": truncated entry (the file ends inside it)");
     } catch (const std::exception& e) {
-      std::string msg = e.what();
-      const auto nl = msg.find('\n');
-      if (nl != std::string::npos) msg = msg.substr(0, nl);
-      throw Error(where("", NAN) + ": malformed or truncated entry (" + msg + ")");
+      throw Error(where("", NAN) + ": malformed or truncated entry (" + detail::mrptCause(e) + ")");
     }
     if (!obj) break;
     if (auto c = std::dynamic_pointer_cast<mrpt::obs::CObservationComment>(obj)) {
@@ -290,7 +289,7 @@ emulation::EmulationData readRawlog(const std::string& path) {
     }
     const double t = haveBase ? static_cast<double>((o->timestamp - base).count()) * kTick : 0.0;
     if (t < lastT)
-      throw Error(where(label, t) + ": timestamp goes backwards (previous entry, label " + lastLabel + ", at t = " +
+      throw Error(where(label, t) + ": timestamp goes backwards (previous entry, label " + printable(lastLabel, 40) + ", at t = " +
                   std::to_string(lastT) + " s)");
     lastT = t;
     lastLabel = label;

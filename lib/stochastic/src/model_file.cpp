@@ -155,10 +155,12 @@ Model& ImuModel::forChannel(const std::string& channel) {
 }
 
 std::vector<std::string> listModels(const std::string& file) {
+  InputScope scope(file);
   return modelNames(loadYaml(file), file);
 }
 
 ImuModel loadImuModel(const std::string& spec) {
+  InputScope scope(spec);
   std::string file, name;
   splitSpec(spec, file, name);
   const YAML::Node root = loadYaml(file);

@@ -94,11 +94,11 @@ class Parser {
     } else {
       ++j;
     }
-    return "'" + s_.substr(i_, j - i_) + "'";
+    return "'" + printable(std::string_view(s_).substr(i_, j - i_), 40) + "'";
   }
 
   [[noreturn]] void fail(std::size_t at, const std::string& expected, const std::string& found) {
-    throw Error(std::string(what_) + " '" + s_ + "': at position " + std::to_string(at + 1) +
+    throw Error(std::string(what_) + " '" + printable(s_, 80) + "': at position " + std::to_string(at + 1) +
                 ": expected " + expected + ", found " + found);
   }
   [[noreturn]] void failHere(const std::string& expected) {
@@ -142,8 +142,8 @@ class Parser {
     errno = 0;
     char* end = nullptr;
     const double v = std::strtod(tok.c_str(), &end);
-    if (end != tok.c_str() + tok.size()) fail(start, "a number", "'" + tok + "'");
-    if (!std::isfinite(v)) fail(start, "a finite number", "'" + tok + "'");
+    if (end != tok.c_str() + tok.size()) fail(start, "a number", "'" + printable(tok, 40) + "'");
+    if (!std::isfinite(v)) fail(start, "a finite number", "'" + printable(tok, 40) + "'");
     i_ = j;
     return v;
   }
@@ -165,7 +165,7 @@ Process parseTerm(Parser& P, double rate_hz) {
   const TermSpec* spec = nullptr;
   for (const auto& sp : specs())
     if (iequals(name, sp.name)) spec = &sp;
-  if (!spec) P.fail(name_pos, "a process name (" + namesList() + ")", "'" + name + "'");
+  if (!spec) P.fail(name_pos, "a process name (" + namesList() + ")", "'" + printable(name, 40) + "'");
   const int nkeys = static_cast<int>(spec->keys.size());
 
   std::string keylist;
@@ -189,7 +189,7 @@ Process parseTerm(Parser& P, double rate_hz) {
       if (iequals(key, spec->keys[k])) idx = k;
     if (idx < 0)
       P.fail(key_pos, "a key of " + std::string(spec->name) + " (" + keylist + ")",
-             "unknown key '" + key + "'");
+             "unknown key '" + printable(key, 40) + "'");
     if (values[idx])
       P.fail(key_pos, "each key once (" + keylist + ")",
              "duplicate key '" + std::string(spec->keys[idx]) + "'");
@@ -298,7 +298,7 @@ std::vector<ProcessKind> parseStructure(const std::string& spec) {
       while (j < s.size() && std::isdigit(static_cast<unsigned char>(s[j]))) ++j;
       count = std::atoi(s.substr(at, j - at).c_str());
       if (count < 1 || count > 16 || j - at > 2)
-        P.fail(at, "a repetition count 1..16", "'" + s.substr(at, j - at) + "'");
+        P.fail(at, "a repetition count 1..16", "'" + printable(std::string_view(s).substr(at, j - at), 40) + "'");
       P.advanceTo(j);
       if (P.peek() == '*') P.expect('*', "'*'");
     }

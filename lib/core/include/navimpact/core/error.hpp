@@ -8,8 +8,10 @@
  */
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace navimpact {
 
@@ -35,5 +37,42 @@ Error fileError(const std::string& file, std::size_t line, const std::string& wh
  * @param[in] what  what is wrong.
  */
 Error keyError(const std::string& file, const std::string& key, const std::string& what);
+
+/**
+ * Raw input made safe to echo in a message: control characters, bytes that are
+ * not valid UTF-8 and the backslash are escaped (\n, \t, \xHH, \\), and the
+ * text is cut after @p max bytes of input with "...(N bytes)" saying how long it was.
+ */
+std::string printable(std::string_view raw, std::size_t max = 60);
+
+/**
+ * A message as the CLI prints it: one line (line breaks become "; "), printable
+ * (see printable()), at most @p max characters: a longer one keeps its start
+ * (where the file, line or key is named) and its end (what is accepted),
+ * joined by " ... ".
+ */
+std::string oneLine(std::string_view msg, std::size_t max = 300);
+
+/**
+ * Names the input a piece of code is processing (a file, usually), for errors
+ * that are not navimpact::Error (out of memory, an exception from a third-party
+ * library): when such an exception leaves the scope, the innermost scope it
+ * crossed is remembered and failedInput() returns it, so that the CLI can still
+ * say which input it was working on. Scopes nest; per thread.
+ */
+class InputScope {
+ public:
+  explicit InputScope(std::string name);
+  ~InputScope();
+  InputScope(const InputScope&) = delete;
+  InputScope& operator=(const InputScope&) = delete;
+  /// Innermost input an exception left since the last clearFailedInput(), or "".
+  static std::string failedInput();
+  static void clearFailedInput();
+
+ private:
+  std::string name_;
+  int uncaught_;
+};
 
 }  // namespace navimpact
