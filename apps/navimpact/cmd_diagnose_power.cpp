@@ -23,6 +23,7 @@ namespace pw = navimpact::analysis::power;
 
 struct Opts {
   std::string out;
+  bool overwrite = false;
   int runs = 40, null_runs = 40;
   std::string snr = "0.25:10", rate = "50:1000", duration_h, samples = "65536:262144";
   std::string causes;
@@ -46,6 +47,7 @@ std::pair<double, double> range(const std::string& flag, const std::string& v) {
 }
 
 int run(const Opts& o) {
+  navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
   pw::PowerOptions p;
   p.runs_per_cause = o.runs;
   p.null_runs = o.null_runs;
@@ -85,7 +87,6 @@ int run(const Opts& o) {
   p.progress = [&bar](double f) { bar.update(static_cast<std::size_t>(f * 1000)); };
   const pw::PowerResult r = pw::runPower(p);
   bar.finish();
-  navimpact::OutputSet out(o.out);
   const std::string table = navimpact::report::powerTable(r);
   std::ostringstream md;
   md << "# Detection power of navimpact diagnose\n\nSeed " << o.seed << ", alpha " << o.alpha << ", "
@@ -107,6 +108,7 @@ navimpact::cli::Registrar reg(
      [](CLI::App& app) {
        auto o = std::make_shared<Opts>();
        app.add_option("--out", o->out, "output directory")->required();
+       navimpact::cli::addOverwriteFlag(app, o->overwrite);
        app.add_option("--runs", o->runs, "records per cause")->capture_default_str();
        app.add_option("--null-runs", o->null_runs, "null records (six channels, drawn from the model)")->capture_default_str();
        app.add_option("--snr", o->snr, "effect size as multiples of the detection limit, drawn log-uniform LO:HI")->capture_default_str();
