@@ -122,9 +122,12 @@ OutputSet::OutputSet(fs::path dest, Overwrite ow, Kind kind) : dest_(std::move(d
     if (p == p.root_path()) break;
   }
   for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
-    if (!fs::create_directory(*it, ec) || ec) {
+    const bool created = fs::create_directory(*it, ec);
+    if (!created && !ec && fs::is_directory(*it, ec)) continue;  // another job created it meanwhile
+    if (!created || ec) {
       removeCreatedParents();
-      throw Error(it->string() + ": cannot create folder for " + shown + " (" + ec.message() + ")");
+      throw Error(it->string() + ": cannot create folder for " + shown + " (" +
+                  (ec ? ec.message() : std::string("exists and is not a folder")) + ")");
     }
     createdParents_.push_back(*it);
   }
