@@ -118,8 +118,7 @@ TEST(CsvReader, BadInputsNameFileAndLine) {
 }
 
 TEST(CsvReader, ReadsTheFullStaticRecording) {
-  NAVIMPACT_REQUIRE_SHARED();
-  const ImuSeries s = readImuCsv(test::sharedPath("data/imu_static/adis16405_static_1.csv.gz"), degG());
+  const ImuSeries s = readImuCsv(test::dataPath("adis16405_static_1.csv.gz"), degG());
   ASSERT_EQ(s.size(), 1000000u);
   ASSERT_EQ(s.channels.size(), 6u);
   // First row of the file: -0.05,-0.3,0.7,-0.00666,0,-1.01565

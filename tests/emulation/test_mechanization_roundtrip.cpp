@@ -29,7 +29,7 @@ Drift unaidedDrift(const emu::SmoothTrajectory& tr, double rate_hz) {
 
 emu::SmoothTrajectory uav(double end_s) {
   emu::TrajectorySpec spec;
-  spec.file = navimpact::test::sharedPath("data/trajectories/uav_flight_600s_ellipsoidal.csv");
+  spec.file = navimpact::test::dataPath("uav_flight_600s_ellipsoidal.csv.gz");  // committed (tests/data)
   spec.end_s = end_s;
   return emu::SmoothTrajectory(emu::readTrajectoryCsv(spec), {});
 }
@@ -41,7 +41,6 @@ emu::SmoothTrajectory uav(double end_s) {
 // mechanization's own error is of order dt^2 or better, so quadrupling the rate
 // must cut the drift by clearly more than 4 (here: 10, order > 1.66).
 TEST(MechanizationRoundTrip, DriftConvergesWithImuRate) {
-  NAVIMPACT_REQUIRE_SHARED();
   const auto tr = uav(120.0);
   const Drift d200 = unaidedDrift(tr, 200.0), d800 = unaidedDrift(tr, 800.0);
   std::printf("120 s unaided drift: 200 Hz %.3e m %.3e rad; 800 Hz %.3e m %.3e rad\n", d200.pos_m,
@@ -55,7 +54,6 @@ TEST(MechanizationRoundTrip, DriftConvergesWithImuRate) {
 // sculling; measured 4.6e-3 m / 6.1e-9 rad, was 0.74 m / 1.9e-8 rad with the
 // first-order rotation and two-sample coning).
 TEST(MechanizationRoundTrip, UavFlight600sAt200HzUnaided) {
-  NAVIMPACT_REQUIRE_SHARED();
   const Drift d = unaidedDrift(uav(1e9), 200.0);
   std::printf("600 s unaided at 200 Hz: %.3e m, %.3e rad\n", d.pos_m, d.att_rad);
   EXPECT_LT(d.pos_m, 0.05);

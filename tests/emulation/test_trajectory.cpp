@@ -1,5 +1,8 @@
-// Trajectory CSV import: both shared trajectories, units, and bad input.
+// Trajectory CSV import: the real UAV flight, the synthetic lemniscate, units,
+// and bad input.
+#include <cmath>
 #include <fstream>
+#include <sstream>
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/emulation/trajectory.hpp"
@@ -90,10 +93,9 @@ TEST(Trajectory, BadInputNamesFileAndLine) {
   EXPECT_NE(errorOf(badCol).find("'heading' not found"), std::string::npos);
 }
 
-TEST(Trajectory, ReadsBothSharedTrajectories) {
-  NAVIMPACT_REQUIRE_SHARED();
+TEST(Trajectory, ReadsTheUavFlight) {
   emu::TrajectorySpec g;
-  g.file = navimpact::test::sharedPath("data/trajectories/uav_flight_600s_ellipsoidal.csv");
+  g.file = navimpact::test::dataPath("uav_flight_600s_ellipsoidal.csv.gz");  // committed (tests/data)
   auto a = emu::readTrajectoryCsv(g);
   EXPECT_EQ(a.t.size(), 60000u);
   EXPECT_NEAR(a.origin.lat, 0.81278354095, 1e-12);
@@ -102,9 +104,15 @@ TEST(Trajectory, ReadsBothSharedTrajectories) {
   const auto s = ta.at(300.0);
   EXPECT_GT(s.v_N.head<2>().norm(), 1.0);
   EXPECT_LT(s.v_N.norm(), 60.0);
+}
 
+namespace {
+// The synthetic figure-eight of the R package navigation: x_N = 50 sin(w t),
+// x_E = 25 sin(2 w t), x_D = 0, w = 2 pi / 60, 100 Hz over 600 s (60,001
+// rows), columns as in the distributed file; level, heading along the path.
+void checkLemniscate(const std::string& file) {
   emu::TrajectorySpec n;
-  n.file = navimpact::test::sharedPath("data/trajectories/lemniscate_600s_ned.csv");
+  n.file = file;
   n.system = "ned";
   n.origin = navimpact::earth::Geodetic{46.5 * M_PI / 180, 6.5 * M_PI / 180, 400};
   auto b = emu::readTrajectoryCsv(n);
@@ -115,4 +123,28 @@ TEST(Trajectory, ReadsBothSharedTrajectories) {
   const auto sb = tb.at(100.0);
   EXPECT_NEAR(sb.v_N[0], 50 * w * std::cos(w * 100.0), 1e-3);
   EXPECT_NEAR(sb.v_N[1], 25 * 2 * w * std::cos(2 * w * 100.0), 1e-3);
+}
+}  // namespace
+
+TEST(Trajectory, LemniscateFromItsFormula) {
+  const double w = 2 * M_PI / 60;
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "time_s,x_N_m,x_E_m,x_D_m,roll_rad,pitch_rad,yaw_rad\n";
+  double yaw_prev = 0;
+  for (int k = 0; k <= 60000; ++k) {
+    const double t = k / 100.0;
+    double yaw = std::atan2(50 * w * std::cos(2 * w * t), 50 * w * std::cos(w * t));
+    yaw += 2 * M_PI * std::round((yaw_prev - yaw) / (2 * M_PI));  // unwrapped, as in the file
+    yaw_prev = yaw;
+    csv << t << "," << 50 * std::sin(w * t) << "," << 25 * std::sin(2 * w * t) << ",0,0,0," << yaw << "\n";
+  }
+  checkLemniscate(writeCsv("lemniscate_600s_ned.csv", csv.str()));
+}
+
+// The same on the file as the R package distributes it (attitudes of its own
+// generator), when the shared data folder is present.
+TEST(Trajectory, ReadsTheDistributedLemniscateFile) {
+  NAVIMPACT_REQUIRE_SHARED("data/trajectories/lemniscate_600s_ned.csv");
+  checkLemniscate(navimpact::test::sharedPath("data/trajectories/lemniscate_600s_ned.csv"));
 }

@@ -98,18 +98,20 @@ std::vector<double> simplePyramidWv(const std::vector<double>& x, int J) {
 
 class WvReference : public ::testing::TestWithParam<int> {};
 
+// Acquisition 1 is committed (tests/data); 2 and 3 come from ../shared when present.
 TEST_P(WvReference, MatchesRPackageOnFullRecording) {
-  NAVIMPACT_REQUIRE_SHARED();
   const int acq = GetParam();
+  const std::string file = "adis16405_static_" + std::to_string(acq) + ".csv.gz";
+  if (acq != 1) NAVIMPACT_REQUIRE_SHARED("data/imu_static/" + file);
   CsvImuOptions opt;
   opt.rate_hz = 100.0;
   opt.gyro_unit = "rad/s";  // factor 1: values stay in deg/s and g as in the R reference
   opt.acc_unit = "m/s2";
-  const auto series = readImuCsv(
-      test::sharedPath("data/imu_static/adis16405_static_" + std::to_string(acq) + ".csv.gz"), opt);
+  const auto series =
+      readImuCsv(acq == 1 ? test::dataPath(file) : test::sharedPath("data/imu_static/" + file), opt);
   ASSERT_EQ(series.size(), 1000000u);
-  const auto rows = readReference(test::sharedPath("reference/gmwm_r_reference/wv_adis_16405_imu" +
-                                                   std::to_string(acq) + ".csv"));
+  const auto rows =
+      readReference(test::dataPath("gmwm_r_reference/wv_adis_16405_imu" + std::to_string(acq) + ".csv"));
   ASSERT_FALSE(rows.empty());
   const auto wvs = gmwm::waveletVariances(series);
   std::map<std::string, const WaveletVariance*> byName;

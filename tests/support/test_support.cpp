@@ -17,6 +17,8 @@ std::string sharedPath(const std::string& rel) { return (fs::path(sharedDir()) /
 
 std::string sourcePath(const std::string& rel) { return (fs::path(NAVIMPACT_SOURCE_DIR) / rel).string(); }
 
+std::string dataPath(const std::string& rel) { return (fs::path(NAVIMPACT_SOURCE_DIR) / "tests" / "data" / rel).string(); }
+
 fs::path tempDir() {
   static std::atomic<int> counter{0};
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
