@@ -422,3 +422,70 @@ TEST(Plot, UnwritablePathIsAnErrorNamingThePath) {
     EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
   }
 }
+
+TEST(Plot, HeatMapCellsTileTheirDataRectanglesWithTextOutlineAndCategoricalTicks) {
+  // 3 x 2 cells over [0, 3] x [0, 2]: cell (i, j) spans x in [i, i+1], y in [j, j+1].
+  np::Figure f = bare(700, 460);
+  np::Axes& ax = f.axes[0];
+  ax.xlim = std::make_pair(0.0, 3.0);
+  ax.ylim = std::make_pair(0.0, 2.0);
+  const np::Color fills[2] = {{0, 114, 178}, {230, 159, 0}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 2; ++j) {
+      np::Cell c;
+      c.x0 = i;
+      c.x1 = i + 1;
+      c.y0 = j;
+      c.y1 = j + 1;
+      c.fill = fills[(i + j) % 2];
+      if (i == 1 && j == 0) {
+        c.text = "1.23";
+        c.text_color = {255, 255, 255};
+      }
+      if (i == 2 && j == 1) {
+        c.outline = 4;
+        c.outline_color = {0, 0, 0};
+      }
+      ax.cells.push_back(c);
+    }
+  ax.xticks = {{0.5, "5 s"}, {1.5, "10 s"}, {2.5, "60 s"}};
+  ax.yticks = {{0.5, "WN"}, {1.5, "Ref"}};
+  const cv::Mat img = renderAndRead(f, "heat.png");
+  const auto a = np::plotAreas(f)[0];
+  auto px = [&](double x, double y) {
+    const int c = a.x + static_cast<int>(std::lround(x / 3.0 * a.width - 0.5));
+    const int r = a.y + static_cast<int>(std::lround((1.0 - y / 2.0) * a.height - 0.5));
+    return img.at<cv::Vec3b>(r, c);
+  };
+  auto same = [](const cv::Vec3b& p, np::Color c) { return p[2] == c.r && p[1] == c.g && p[0] == c.b; };
+  // Fill at a quarter of each cell (away from text), corners of neighbours exact.
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 2; ++j)
+      EXPECT_TRUE(same(px(i + 0.2, j + 0.2), fills[(i + j) % 2])) << "cell " << i << "," << j;
+  // No white gap between adjacent cells along a shared edge.
+  const int yr = a.y + a.height / 4;
+  for (int x = a.x + 2; x < a.x + a.width - 2; ++x) EXPECT_FALSE(isWhite(img.at<cv::Vec3b>(yr, x))) << x;
+  // Text: light pixels near the centre of cell (1, 0) only.
+  auto lightAround = [&](double x, double y) {
+    int n = 0;
+    for (double dx = -0.3; dx <= 0.3; dx += 0.005)
+      for (double dy = -0.1; dy <= 0.1; dy += 0.005) n += px(x + dx, y + dy)[0] > 150 ? 1 : 0;
+    return n;
+  };
+  EXPECT_GT(lightAround(1.5, 0.5), 20);
+  EXPECT_EQ(lightAround(0.5, 1.5), 0);  // an orange cell without text
+  // Outline: black at the inner edge of cell (2, 1), its fill further inside.
+  const int cx = a.x + static_cast<int>(std::lround(2.5 / 3.0 * a.width));
+  EXPECT_LT(img.at<cv::Vec3b>(a.y + 1, cx)[0], 40);
+  EXPECT_TRUE(same(img.at<cv::Vec3b>(a.y + 8, cx), fills[1]));
+  // Categorical tick labels: ink below the frame under each tick, none between.
+  auto inkBelow = [&](int x) {
+    int n = 0;
+    for (int y = a.y + a.height + 8; y < std::min(img.rows, a.y + a.height + 40); ++y)
+      for (int dx = -12; dx <= 12; ++dx) n += img.at<cv::Vec3b>(y, x + dx)[0] < 120 ? 1 : 0;
+    return n;
+  };
+  EXPECT_GT(inkBelow(a.x + a.width / 6), 5);
+  EXPECT_GT(inkBelow(a.x + a.width * 5 / 6), 5);
+  EXPECT_EQ(inkBelow(a.x + a.width / 3), 0);
+}

@@ -178,6 +178,11 @@ void computeLimits(const Axes& ax, std::size_t index, Scale& xs, Scale& ys) {
       if (validOn(sp.x0, ax.logx)) r.add(sp.x0);
       if (validOn(sp.x1, ax.logx)) r.add(sp.x1);
     }
+    for (const auto& c : ax.cells)
+      for (double v : {c.x0, c.x1}) {
+        if (std::isfinite(v)) anyFiniteX = true;
+        if (validOn(v, ax.logx)) r.add(v);
+      }
     if (r.empty() && anyFiniteX && ax.logx)
       throw Error(where + ": log x axis but no positive finite x value to plot");
     auto l = padRange(r, ax.logx, ax.logx ? 0.03 : 0.0);
@@ -209,6 +214,11 @@ void computeLimits(const Axes& ax, std::size_t index, Scale& xs, Scale& ys) {
       if (std::isfinite(h.y)) anyFiniteY = true;
       if (validOn(h.y, ax.logy)) r.add(h.y);
     }
+    for (const auto& c : ax.cells)
+      for (double v : {c.y0, c.y1}) {
+        if (std::isfinite(v)) anyFiniteY = true;
+        if (validOn(v, ax.logy)) r.add(v);
+      }
     if (r.empty() && anyFiniteY && ax.logy)
       throw Error(where + ": log y axis but no positive finite y value to plot");
     auto l = padRange(r, ax.logy, 0.05);
@@ -257,6 +267,20 @@ std::vector<Tick> chooseTicks(const Scale& sc, double len, bool isX, const TextR
     if (fits(t)) return t;
   }
   return sc.log ? detail::logTicks(sc.lo, sc.hi, 1, false, 1) : detail::linearTicks(sc.lo, sc.hi, 1);
+}
+
+/// Ticks given by the caller (categorical axes): all major and labelled.
+std::vector<Tick> explicitTicks(const std::vector<TickMark>& marks) {
+  std::vector<Tick> out;
+  for (const auto& m : marks) {
+    Tick t;
+    t.value = m.value;
+    t.major = true;
+    t.labeled = true;
+    t.label.base = m.label;
+    out.push_back(t);
+  }
+  return out;
 }
 
 struct Margins {
@@ -348,8 +372,9 @@ Layout computeLayout(const Figure& fig, const TextRenderer& tr) {
   std::vector<Margins> keep(fig.axes.size());
   for (int pass = 0; pass < 3; ++pass) {
     for (auto& p : L.panels) {
-      p.xt = chooseTicks(p.xs, p.area.width, true, tr, sz.tick);
-      p.yt = chooseTicks(p.ys, p.area.height, false, tr, sz.tick);
+      p.xt = p.ax->xticks.empty() ? chooseTicks(p.xs, p.area.width, true, tr, sz.tick) : explicitTicks(p.ax->xticks);
+      p.yt = p.ax->yticks.empty() ? chooseTicks(p.ys, p.area.height, false, tr, sz.tick)
+                                  : explicitTicks(p.ax->yticks);
       if (pass == 2) continue;
       Margins m = marginsFor(p, sz, tr);
       Margins& k = keep[p.index];
@@ -698,6 +723,7 @@ class PanelPainter {
   void draw() {
     if (ax_.grid) drawGrid();
     drawSpans();
+    drawCells();
     drawBands();
     drawHLines();
     drawSeries();
@@ -740,6 +766,38 @@ class PanelPainter {
       std::vector<cv::Point> fp;
       for (const auto& q : poly) fp.push_back(fixedPt(q));
       blendFill(roi_, {fp}, bgr(sp.color), sp.alpha);
+    }
+  }
+
+  void drawCells() {
+    for (const auto& c : ax_.cells) {
+      if (!validOn(c.x0, ax_.logx) || !validOn(c.x1, ax_.logx) || !validOn(c.y0, ax_.logy) ||
+          !validOn(c.y1, ax_.logy))
+        continue;
+      const double xa = std::clamp(std::min(X(c.x0), X(c.x1)), -4.0, roi_.cols + 4.0);
+      const double xb = std::clamp(std::max(X(c.x0), X(c.x1)), -4.0, roi_.cols + 4.0);
+      const double ya = std::clamp(std::min(Y(c.y0), Y(c.y1)), -4.0, roi_.rows + 4.0);
+      const double yb = std::clamp(std::max(Y(c.y0), Y(c.y1)), -4.0, roi_.rows + 4.0);
+      if (xb - xa < 1.0 || yb - ya < 1.0) continue;
+      // Pixel centres inside [xa, xb) x [ya, yb): adjacent cells tile exactly.
+      const cv::Rect r = cv::Rect(cv::Point(static_cast<int>(std::ceil(xa - 0.5)), static_cast<int>(std::ceil(ya - 0.5))),
+                                  cv::Point(static_cast<int>(std::ceil(xb - 0.5)), static_cast<int>(std::ceil(yb - 0.5)))) &
+                         cv::Rect(0, 0, roi_.cols, roi_.rows);
+      if (r.empty()) continue;
+      roi_(r).setTo(bgr(c.fill));
+      if (!occupancy_.empty()) occupancy_(r).setTo(cv::Scalar(40));
+      if (c.outline > 0.0) {
+        const int w = std::max(1, static_cast<int>(std::lround(c.outline)));
+        for (int i = 0; i < w && 2 * i < std::min(r.width, r.height); ++i)
+          cv::rectangle(roi_, cv::Point(r.x + i, r.y + i), cv::Point(r.x + r.width - 1 - i, r.y + r.height - 1 - i),
+                        bgr(c.outline_color), 1, cv::LINE_8);
+      }
+      if (!c.text.empty()) {
+        const int px = fitPx(tr_, c.text, sz_.tick, std::max(1, r.width - 4));
+        cv::Mat full = canvas_;
+        tr_.draw(full, c.text, {p_.area.x + r.x + r.width / 2, p_.area.y + r.y + r.height / 2}, px,
+                 bgr(c.text_color), HAlign::Center, VAlign::Middle);
+      }
     }
   }
 

@@ -4,7 +4,8 @@
  *
  * A Figure is a grid of Axes; each Axes holds line series, shaded bands
  * (confidence intervals, +-sigma envelopes), shaded x-spans (GNSS outages)
- * and horizontal reference lines, on linear or log10 axes, with a legend.
+ * horizontal reference lines and heat-map cells, on linear or log10 axes
+ * (or categorical ones through explicit ticks), with a legend.
  * This module is the only one that includes OpenCV.
  *
  * Conventions: data in any unit (the caller converts to the unit it labels);
@@ -96,6 +97,25 @@ struct HLine {
   LineStyle style = LineStyle::Dashed;
 };
 
+/// Filled rectangle x0..x1 by y0..y1 in data units, drawn opaque with an
+/// optional centred one-line text and outline: the cells of a heat map.
+/// Cells are drawn after spans and before bands; they count in the automatic
+/// limits. The text shrinks (down to 60 %) to fit the cell's width.
+struct Cell {
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;  ///< data units, either order
+  Color fill{255, 255, 255};
+  std::string text;                       ///< "" = none
+  Color text_color{34, 34, 34};
+  double outline = 0.0;                   ///< outline width [px] inside the cell, 0 = none
+  Color outline_color{0, 0, 0};
+};
+
+/// An explicit tick: position in data units and its label (categorical axes).
+struct TickMark {
+  double value = 0;
+  std::string label;
+};
+
 /// One plot panel.
 struct Axes {
   std::string title, xlabel, ylabel;  ///< "" = none (no space is reserved)
@@ -104,6 +124,10 @@ struct Axes {
   std::vector<Band> bands;
   std::vector<Series> series;
   std::vector<HLine> hlines;
+  std::vector<Cell> cells;      ///< heat-map cells (see Cell)
+  /// Explicit ticks replacing the automatic ones (all labelled, no minor ticks);
+  /// empty = automatic.
+  std::vector<TickMark> xticks, yticks;
   /// Limits (lower < upper; > 0 on log axes); default: data range, see @file.
   std::optional<std::pair<double, double>> xlim, ylim;
   LegendPos legend = LegendPos::Best;  ///< Best: corner hiding the least data
