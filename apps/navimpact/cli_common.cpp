@@ -2,7 +2,11 @@
 
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <vector>
 
 namespace navimpact::cli {
 
@@ -14,6 +18,34 @@ std::vector<Command>& registry() {
 void addOverwriteFlag(CLI::App& app, bool& flag) {
   app.add_flag("--overwrite", flag,
                "replace an existing, non-empty output whole (default: refuse it before any work)");
+}
+
+std::string executablePath() {
+  std::error_code ec;
+  const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string() : p.string();
+}
+
+std::string buildId() {
+  static const std::string id = [] {
+    std::uint64_t h = 1469598103934665603ull;  // FNV-1a 64 of the executable
+    std::ifstream f("/proc/self/exe", std::ios::binary);
+    std::vector<char> buf(1 << 20);
+    bool any = false;
+    while (f) {
+      f.read(buf.data(), static_cast<std::streamsize>(buf.size()));
+      const auto n = static_cast<std::size_t>(f.gcount());
+      for (std::size_t i = 0; i < n; ++i) {
+        h ^= static_cast<unsigned char>(buf[i]);
+        h *= 1099511628211ull;
+      }
+      any = any || n > 0;
+    }
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    return std::string(NAVIMPACT_VERSION) + "+" + (any ? hex : "unknown");
+  }();
+  return id;
 }
 
 bool stderrIsTerminal() { return isatty(fileno(stderr)) != 0; }

@@ -31,6 +31,14 @@ struct Registrar {
 void addOverwriteFlag(CLI::App& app, bool& flag);
 inline Overwrite overwriteMode(bool flag) { return flag ? Overwrite::Replace : Overwrite::Refuse; }
 
+/// Identity of this build: navimpact version plus an FNV-1a 64 hash of the
+/// running executable (/proc/self/exe), e.g. "0.1.0+3f2a...". Shards of a
+/// sweep record it so that a merge refuses results of another build.
+std::string buildId();
+
+/// Absolute path of the running executable ("" when unknown).
+std::string executablePath();
+
 /// True when stderr is a terminal (progress bars are shown only then).
 bool stderrIsTerminal();
 

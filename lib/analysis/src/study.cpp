@@ -156,6 +156,8 @@ class StudyPlan {
   NavRunOptions nav;
 };
 
+const StudyMeta& studyMeta(const StudyPlan& plan) { return plan.meta; }
+
 namespace {
 
 stochastic::ImuModel atRate(const stochastic::ImuModel& m, double rate, std::vector<std::string>& notices) {
@@ -306,8 +308,10 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
      << num(cfg.gnss.sigma_pos_h_m) << " m horizontal / " << num(cfg.gnss.sigma_pos_v_m)
      << " m vertical, velocity sigma " << num(cfg.gnss.sigma_vel_h_mps) << " / " << num(cfg.gnss.sigma_vel_v_mps)
      << " m/s\n"
-     << "barometer " << num(cfg.baro.rate_hz) << " Hz, sigma " << num(cfg.baro.sigma_m) << " m, "
-     << (cfg.baro_in_outage ? "kept during GNSS outages" : "off during GNSS outages") << "\n"
+     << (cfg.use_baro ? "barometer " + num(cfg.baro.rate_hz) + " Hz, sigma " + num(cfg.baro.sigma_m) + " m, " +
+                            (cfg.baro_in_outage ? "kept during GNSS outages" : "off during GNSS outages")
+                      : std::string("no barometer"))
+     << "\n"
      << "EKF: covariance propagated every " << cfg.ekf.propagate_every << " IMU samples ("
      << (cfg.ekf.discretization == filter::Discretization::Series ? "series" : "Van Loan")
      << " discretisation); initial error sigmas " << num(cfg.initial_sigma(0)) << " m, "
@@ -343,7 +347,8 @@ RunRecord doRun(const StudyPlan& p, std::uint64_t index) {
   }
   const EmulatedRun run = emulateRun(p.perfect, err, *p.traj, p.t0, p.t1, cfg.gnss, cfg.baro, p.truth0,
                                      cfg.initial_sigma, rec.seed);
-  const NavRunInput in = run.input(p.truth);
+  NavRunInput in = run.input(p.truth);
+  if (!cfg.use_baro) in.baro = nullptr;
 
   const std::size_t E = p.truth.t.size(), O = p.nav.outages.size();
   for (const auto& model : p.filter_models) {
@@ -429,6 +434,11 @@ void StudyAccumulator::add(const RunRecord& r, std::size_t E, std::size_t O) {
 
 StudyResults runStudy(const std::shared_ptr<const StudyPlan>& plan, const Shard& shard, unsigned threads,
                       const ProgressFn& progress) {
+  return runStudy(plan, shard, threads, progress, RunSink{});
+}
+
+StudyResults runStudy(const std::shared_ptr<const StudyPlan>& plan, const Shard& shard, unsigned threads,
+                      const ProgressFn& progress, const RunSink& sink) {
   if (!plan) throw Error("study: no plan");
   const StudyPlan& p = *plan;
   StudyResults res;
@@ -467,7 +477,8 @@ StudyResults runStudy(const std::shared_ptr<const StudyPlan>& plan, const Shard&
       // Add in run-index order: the sums do not depend on scheduling.
       for (auto it = pending.find(merged); it != pending.end(); it = pending.find(merged)) {
         res.acc.add(it->second, E, O);
-        if (!shard.whole()) res.records.push_back(std::move(it->second));
+        if (sink) sink(it->second);
+        else if (!shard.whole()) res.records.push_back(std::move(it->second));
         pending.erase(it);
         ++merged;
         if (progress) progress(merged, N);

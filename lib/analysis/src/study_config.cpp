@@ -80,7 +80,9 @@ std::string resolveModelSpec(const Ctx& c, const std::string& spec) {
 
 }  // namespace
 
-StudyConfig loadStudyConfig(const std::string& path) {
+StudyConfig loadStudyConfig(const std::string& path) { return loadStudyConfig(path, {}); }
+
+StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::string>& extra_keys) {
   InputScope scope(path);
   StudyConfig cfg;
   cfg.config_file = path;
@@ -92,9 +94,10 @@ StudyConfig loadStudyConfig(const std::string& path) {
   } catch (const YAML::Exception& e) {
     throw fileError(path, e.mark.line + 1, std::string("YAML: ") + e.msg);
   }
-  checkKeys(root, c, "",
-            {"trajectory", "smoothing", "imu", "truth", "candidates", "sets", "gnss", "baro", "outages",
-             "monte_carlo", "filter", "record", "report"});
+  std::set<std::string> top{"trajectory", "smoothing", "imu",         "truth",  "candidates", "sets",  "gnss",
+                            "baro",       "outages",   "monte_carlo", "filter", "record",     "report"};
+  top.insert(extra_keys.begin(), extra_keys.end());
+  checkKeys(root, c, "", top);
 
   // trajectory
   const YAML::Node tr = root["trajectory"];

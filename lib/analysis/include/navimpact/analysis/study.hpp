@@ -92,6 +92,7 @@ struct StudyConfig {
   emulation::GnssOptions gnss;             ///< seed ignored: per run from the study seed
   emulation::BaroOptions baro;             ///< seed ignored
   bool baro_in_outage = true;
+  bool use_baro = true;                    ///< false: the filter gets no barometer at all (sweep axis)
   /// Outages relative to the first trajectory time [s] (start, end]; default (200, 260].
   std::vector<OutageWindow> outages;
   std::size_t runs = 100;                  ///< Monte Carlo runs, >= 1
@@ -116,6 +117,9 @@ struct StudyConfig {
  * wrong types, missing keys, invalid values, unknown candidate labels in a set.
  */
 StudyConfig loadStudyConfig(const std::string& path);
+/// As above, accepting (and ignoring) the extra top-level keys @p extra_keys,
+/// which a caller reads itself from the same file (`navimpact sweep`).
+StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::string>& extra_keys);
 
 /// Runs i with i % n == k - 1 (k in 1..n); 1/1 = all.
 struct Shard {
@@ -139,6 +143,10 @@ struct StudyResults;
  */
 std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std::string& version);
 
+struct StudyMeta;
+/// The description of a prepared study (labels, states, epochs, outages, notices).
+const StudyMeta& studyMeta(const StudyPlan& plan);
+
 /// Called from worker threads (serialised) with runs done and runs to do.
 using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
 
@@ -149,8 +157,19 @@ using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
  * @param[in] threads   worker threads, >= 1.
  * @param[in] progress  may be empty.
  */
+struct RunRecord;
+/// Receives every run record in run-index order (serialised).
+using RunSink = std::function<void(const RunRecord&)>;
+
 StudyResults runStudy(const std::shared_ptr<const StudyPlan>& plan, const Shard& shard, unsigned threads,
                       const ProgressFn& progress = {});
+/**
+ * As above, handing every run record to @p sink (in run-index order) instead
+ * of keeping it in StudyResults::records: callers that need a few values per
+ * run keep only those (`navimpact sweep`).
+ */
+StudyResults runStudy(const std::shared_ptr<const StudyPlan>& plan, const Shard& shard, unsigned threads,
+                      const ProgressFn& progress, const RunSink& sink);
 
 /// Per-run record of every model (errors, sigmas, NEES at every epoch; outage drifts; cost).
 struct RunRecord {

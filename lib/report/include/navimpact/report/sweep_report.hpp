@@ -1,0 +1,23 @@
+/**
+ * @file sweep_report.hpp
+ * @brief What `navimpact sweep` / `sweep-merge` write: sweep.json, report.md
+ *        and one heat map per column (map_<k>.png), from analysis::SweepResults.
+ *        No timings: identical inputs give byte-identical files (the cost
+ *        figures go to timing.json, written by the command).
+ */
+#pragma once
+
+#include <string>
+
+#include "navimpact/analysis/sweep.hpp"
+#include "navimpact/core/output.hpp"
+
+namespace navimpact::report {
+
+/// sweep.json text (see README "Model-sufficiency sweep").
+std::string sweepJson(const analysis::SweepResults& r);
+
+/// Write sweep.json, report.md and map_<k>.png (k = column number from 1).
+void writeSweepOutputs(const analysis::SweepResults& r, OutputSet& out);
+
+}  // namespace navimpact::report
