@@ -17,4 +17,4 @@ _sweep_bad(no_sweep_block "sweep|--config|${CMAKE_SOURCE_DIR}/config/paper/study
            "outages.: not used by a sweep")
 _sweep_bad(one_run "sweep|--config|${_swcfg}|--out|${_swdir}/bad_one_run|--runs|1" "--runs must be >= 2")
 _sweep_bad(merge_nothing "sweep-merge|${_swdir}/no_such_shard|--out|${_swdir}/bad_merge_nothing"
-           "no_such_shard/sweep_shard.json")
+           "1 of 1 folders hold no shard.*no_such_shard")

@@ -391,6 +391,19 @@ SweepRuns mergeSweepShards(const std::vector<std::string>& dirs, const std::stri
   std::vector<In> ins;
   SweepRuns res;
   json first;
+  {
+    // Folders without a shard (a task that failed or never ran): name them all.
+    std::vector<std::string> absent;
+    for (const auto& d : dirs)
+      if (!std::ifstream(d + "/sweep_shard.json")) absent.push_back(d);
+    if (!absent.empty()) {
+      std::string list;
+      for (std::size_t i = 0; i < absent.size() && i < 10; ++i) list += (i ? ", " : "") + absent[i];
+      if (absent.size() > 10) list += ", ...";
+      throw Error("sweep-merge: " + std::to_string(absent.size()) + " of " + std::to_string(dirs.size()) +
+                  " folders hold no shard (no sweep_shard.json: the task failed or has not run): " + list);
+    }
+  }
   for (const auto& d : dirs) {
     const std::string sj = d + "/sweep_shard.json";
     std::ifstream fj(sj);
