@@ -4,17 +4,17 @@
 # behind by a failing command.
 set(_swdir ${CMAKE_CURRENT_BINARY_DIR}/sweep)
 set(_swcfg ${CMAKE_SOURCE_DIR}/tests/data/sweep_small.yaml)
-add_test(NAME cli_sweep_small_shards_and_merge
-         COMMAND ${CMAKE_COMMAND} -DNI=${NI} -DCONFIG=${_swcfg} -DD=${_swdir}
-                 -P ${CMAKE_CURRENT_SOURCE_DIR}/sweep_check.cmake)
-
-function(_sweep_bad name args regex)
-  add_test(NAME cli_sweep_bad_${name}
-           COMMAND ${CMAKE_COMMAND} -DNI=${NI} "-DARGS=${args}" "-DREGEX=${regex}"
-                   -DOUTDIR=${_swdir}/bad_${name} -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_fail.cmake)
-endfunction()
-_sweep_bad(no_sweep_block "sweep|--config|${CMAKE_SOURCE_DIR}/config/paper/study_navchip_uav.yaml|--out|${_swdir}/bad_no_sweep_block"
-           "outages.: not used by a sweep")
-_sweep_bad(one_run "sweep|--config|${_swcfg}|--out|${_swdir}/bad_one_run|--runs|1" "--runs must be >= 2")
-_sweep_bad(merge_nothing "sweep-merge|${_swdir}/no_such_shard|--out|${_swdir}/bad_merge_nothing"
-           "1 of 1 folders hold no shard.*no_such_shard")
+navimpact_cli_check(cli_sweep_small_shards_and_merge CHECK sweep_shards DEFINES CONFIG=${_swcfg} D=${_swdir}/run)
+navimpact_cli_fail(cli_sweep_bad_no_sweep_block
+  ARGS sweep --config ${CMAKE_SOURCE_DIR}/config/paper/study_navchip_uav.yaml --out ${_swdir}/bad_no_sweep_block
+  REGEX "outages.: not used by a sweep" NOOUT ${_swdir}/bad_no_sweep_block)
+navimpact_cli_fail(cli_sweep_bad_one_run ARGS sweep --config ${_swcfg} --out ${_swdir}/bad_one_run --runs 1
+  REGEX "--runs must be >= 2" NOOUT ${_swdir}/bad_one_run)
+navimpact_cli_fail(cli_sweep_bad_merge_nothing ARGS sweep-merge ${_swdir}/no_such_shard --out ${_swdir}/bad_merge
+  REGEX "1 of 1 folders hold no shard.*no_such_shard" NOOUT ${_swdir}/bad_merge)
+navimpact_cli_fail(cli_sweep_bad_emit_and_out
+  ARGS sweep --config ${_swcfg} --out ${_swdir}/bad_emit --emit-slurm ${_swdir}/bad_emit_slurm --shards 2
+  REGEX "either --out .* or --emit-slurm" NOOUT ${_swdir}/bad_emit_slurm)
+navimpact_cli_fail(cli_sweep_bad_too_many_shards
+  ARGS sweep --config ${_swcfg} --emit-slurm ${_swdir}/bad_shards --shards 9
+  REGEX "--shards 9 is more than the 8 runs" NOOUT ${_swdir}/bad_shards)
