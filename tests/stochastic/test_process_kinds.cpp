@@ -1,6 +1,7 @@
 // One property battery for every process kind (in the style of manif's
 // common tester): each kind's theoretical Haar WV against simulation, its
-// state-space form against its WV, its PSD against its WV (the Haar WV is the
+// state-space form against its WV, its exact sampled form (sampledArma, the
+// basis of the block-mean likelihood) against its WV, its PSD against its WV (the Haar WV is the
 // PSD integrated against the Haar filter's squared gain) and against simulated
 // periodograms, its rate conversion, its text round trip, its validation and
 // its datasheet figure. Parameters are drawn at random (seeded; the seed and
@@ -24,6 +25,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/stochastic/block_likelihood.hpp"
 #include "navimpact/stochastic/datasheet.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/process_kind.hpp"
@@ -584,6 +586,60 @@ TEST_P(Kinds, DatasheetFigure) {
       const std::vector<double> x = simulate(m, 1000, 1);
       EXPECT_LE(relErr((x[999] - x[0]) * m.rate_hz / 999.0, *f.drift_rate), 1e-12);
     }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Sampled form: x_k = z_k - mu z_{k-1}, z_k = phi z_{k-1} + e_k (random kinds
+// only). The covariance of x it implies, built exactly from the innovations,
+// gives the Haar WV of the kind (to 1e-9 at tau = 2 .. 64, at a position far
+// from the start: the RW's increments are stationary, its level is not), and
+// the simulation's start (z_{-1} ~ N(0, p0)) reproduces the variance of the
+// simulated first sample. Deterministic kinds (a trend, a line) have none.
+TEST_P(Kinds, SampledFormAgainstWv) {
+  auto g = stream("SampledFormAgainstWv", kind());
+  for (int r = 0; r < 6; ++r) {
+    const Model m = draw(kind(), g, 1 << 16);
+    const Process& p = m.terms[0];
+    const auto a = sampledArma(p, m.rate_hz);
+    if (form() != SpectralForm::Density) {
+      EXPECT_FALSE(a.has_value()) << describe(m);
+      continue;
+    }
+    ASSERT_TRUE(a.has_value()) << describe(m);
+    // x = C [z_{-1}, e_0 .. e_{n-1}]', Cov x = C diag(p0, q, ..., q) C'.
+    const int n = 200;
+    Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(n + 1, n + 1);  // row t+1: z_t; row 0: z_{-1}
+    Z(0, 0) = 1.0;
+    for (int t = 0; t < n; ++t) {
+      Z.row(t + 1) = a->phi * Z.row(t);
+      Z(t + 1, t + 1) += 1.0;
+    }
+    Eigen::MatrixXd C(n, n + 1);
+    for (int t = 0; t < n; ++t) C.row(t) = Z.row(t + 1) - a->mu * Z.row(t);
+    Eigen::VectorXd D = Eigen::VectorXd::Constant(n + 1, a->q);
+    D(0) = a->p0;
+    const Eigen::MatrixXd cov = C * D.asDiagonal() * C.transpose();
+    for (int half = 1; half <= 32; half *= 2) {
+      // W_t = (mean x[t, t+m) - mean x[t-m, t)) / 2 at t = 100.
+      Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
+      for (int i = 0; i < half; ++i) {
+        w(100 + i) += 0.5 / half;
+        w(100 - 1 - i) -= 0.5 / half;
+      }
+      const double v = w.dot(cov * w), th = haarWv(p, m.rate_hz, 2.0 * half);
+      EXPECT_LE(relErr(v, th), 1e-9) << describe(m) << " tau " << 2 * half;
+    }
+    // First sample's variance as simulated (many seeds).
+    const int S = 4000;
+    double s2 = 0;
+    for (int s = 0; s < S; ++s) {
+      const auto x = simulate(m, 1, deriveSeed(777, static_cast<std::uint64_t>(s)));
+      s2 += x[0] * x[0];
+    }
+    s2 /= S;
+    const double v0 = cov(0, 0);
+    EXPECT_NEAR(s2 / v0, 1.0, 5.0 * std::sqrt(2.0 / S)) << describe(m);
   }
 }
 

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "navimpact/stochastic/block_likelihood.hpp"
 #include "navimpact/stochastic/datasheet.hpp"
 #include "navimpact/stochastic/process_kind.hpp"
 #include "navimpact/stochastic/spectrum.hpp"
@@ -72,6 +73,13 @@ class KindDef {
   }
   /// Line kinds: the line.
   virtual std::optional<SpectralLine> line(const Process& p) const { return std::nullopt; }
+
+  /// Random kinds: the exact per-sample form x_k = z_k - mu z_{k-1},
+  /// z_k = phi z_{k-1} + e_k (see block_likelihood.hpp); deterministic kinds
+  /// (a trend, a line) have none.
+  virtual std::optional<SampledArma> sampledArma(const Process& p, double rate_hz) const {
+    return std::nullopt;
+  }
 
   /// Add the kind's contribution to the datasheet figures (continuous-time
   /// figures of independent terms add in variance, drift rates add).

@@ -180,6 +180,13 @@ class GaussMarkov final : public KindDef {
     }
   }
 
+  std::optional<SampledArma> sampledArma(const Process& p, double rate_hz) const override {
+    // AR(1), phi = exp(-dt/T), innovation variance sigma^2 (1 - phi^2), stationary start.
+    const double L = 1.0 / (rate_hz * p.T);
+    const double s2 = p.sigma * p.sigma;
+    return SampledArma{std::exp(-L), 0.0, s2 * -std::expm1(-2.0 * L), s2};
+  }
+
   int stateCount() const override { return 1; }
   void stateSpace(const Process& p, double, StateSpaceBlock& b) const override {
     // x' = -x/T + w with Qc = 2 sigma^2 / T keeps var(x) = sigma^2 in steady state

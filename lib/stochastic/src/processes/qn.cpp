@@ -42,6 +42,11 @@ class QuantizationNoise final : public KindDef {
     }
   }
 
+  std::optional<SampledArma> sampledArma(const Process& p, double) const override {
+    // x_k = e_k - e_{k-1}, e_k = sqrt(12) Q u_k of variance Q^2 (as simulated).
+    return SampledArma{0.0, 1.0, p.Q * p.Q, p.Q * p.Q};
+  }
+
   int stateCount() const override { return 0; }
   void stateSpace(const Process& p, double rate_hz, StateSpaceBlock& b) const override {
     const double dt = 1.0 / rate_hz;

@@ -46,6 +46,10 @@ class RandomWalk final : public KindDef {
     }
   }
 
+  std::optional<SampledArma> sampledArma(const Process& p, double) const override {
+    return SampledArma{1.0, 0.0, p.gamma * p.gamma, 0.0};  // starts at 0, as simulated
+  }
+
   int stateCount() const override { return 1; }
   void stateSpace(const Process& p, double rate_hz, StateSpaceBlock& b) const override {
     // x' = w, Qc = K^2 = gamma^2 / dt; P0 = 0.

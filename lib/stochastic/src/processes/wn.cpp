@@ -34,6 +34,10 @@ class WhiteNoise final : public KindDef {
     for (std::size_t k = 0; k < n; ++k) out[k] += p.sigma * rng.normal();
   }
 
+  std::optional<SampledArma> sampledArma(const Process& p, double) const override {
+    return SampledArma{0.0, 0.0, p.sigma * p.sigma, p.sigma * p.sigma};  // x_k = e_k
+  }
+
   int stateCount() const override { return 0; }
   void stateSpace(const Process& p, double rate_hz, StateSpaceBlock& b) const override {
     const double dt = 1.0 / rate_hz;

@@ -1,0 +1,165 @@
+// Exact Gaussian likelihood of block means (see block_likelihood.hpp).
+#include "navimpact/stochastic/block_likelihood.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "kind.hpp"
+#include "navimpact/core/error.hpp"
+
+namespace navimpact::stochastic {
+
+std::optional<SampledArma> sampledArma(const Process& p, double rate_hz) {
+  return detail::kindDef(p.kind).sampledArma(p, rate_hz);
+}
+
+std::vector<double> blockMeans(const double* x, std::size_t n, std::size_t block) {
+  if (block == 0) throw Error("blockMeans: block must be >= 1 sample");
+  const std::size_t nb = n / block;
+  std::vector<double> y(nb);
+  for (std::size_t k = 0; k < nb; ++k) {
+    double s = 0;
+    for (std::size_t i = 0; i < block; ++i) s += x[k * block + i];
+    y[k] = s / static_cast<double>(block);
+  }
+  return y;
+}
+
+namespace {
+
+constexpr double kLn2Pi = 1.8378770664093453;
+
+/// One term over a block of b samples: state s_k = z_{kb-1}; block mean =
+/// H s_k + w_k, s_{k+1} = F s_k + v_k; var w = R, var v = Q, cov(v, w) = M.
+struct TermBlock {
+  double F = 0, H = 0, Q = 0, M = 0, R = 0, P0 = 0;
+};
+
+TermBlock blockForm(const SampledArma& a, std::size_t b) {
+  // Sums over j = b-1 down to 0, i.e. m = b - j = 1..b samples to the block end:
+  // G(m) = 1 + phi G(m-1), d_j = G(m) - mu G(m-1), c_j = phi^(m-1).
+  double G_prev = 0, c = 1, sdd = 0, scc = 0, scd = 0;
+  for (std::size_t m = 1; m <= b; ++m) {
+    const double G = 1.0 + a.phi * G_prev;
+    const double d = G - a.mu * G_prev;
+    sdd += d * d;
+    scc += c * c;
+    scd += c * d;
+    G_prev = G;
+    if (m < b) c *= a.phi;
+  }
+  const double bd = static_cast<double>(b);
+  TermBlock t;
+  t.H = (a.phi - a.mu) * G_prev / bd;  // G_prev = G(b)
+  t.F = c * a.phi;                      // phi^b
+  t.R = a.q * sdd / (bd * bd);
+  t.Q = a.q * scc;
+  t.M = a.q * scd / bd;
+  t.P0 = a.p0;
+  return t;
+}
+
+}  // namespace
+
+BlockLikelihood blockLogLikelihood(const Model& m, const std::vector<double>& y, std::size_t block,
+                                   const Eigen::MatrixXd& X, const std::vector<int>& columns) {
+  const std::size_t nb = y.size();
+  if (nb < 2) throw Error("blockLogLikelihood: need at least 2 block means");
+  if (block == 0) throw Error("blockLogLikelihood: block must be >= 1 sample");
+  if (!(m.rate_hz > 0)) throw Error("blockLogLikelihood: the model needs a rate");
+  if (X.cols() > 0 && static_cast<std::size_t>(X.rows()) != nb)
+    throw Error("blockLogLikelihood: regressors have " + std::to_string(X.rows()) + " rows for " +
+                std::to_string(nb) + " block means");
+  std::vector<int> cols = columns;
+  if (cols.empty())
+    for (int j = 0; j < X.cols(); ++j) cols.push_back(j);
+  for (int j : cols)
+    if (j < 0 || j >= X.cols()) throw Error("blockLogLikelihood: no regressor column " + std::to_string(j));
+
+  // Terms: white ones (H = 0) only add to R; the others carry a state.
+  double R = 0;
+  std::vector<TermBlock> st;
+  for (const auto& p : m.terms) {
+    const auto a = sampledArma(p, m.rate_hz);
+    if (!a) continue;
+    const TermBlock t = blockForm(*a, block);
+    R += t.R;
+    if (t.H != 0.0) st.push_back(t);
+  }
+  const int d = static_cast<int>(st.size());
+  if (!(R > 0) && d == 0) throw Error("blockLogLikelihood: the model has no random term");
+
+  const int nc = 1 + static_cast<int>(cols.size());  // y and the regressors
+  std::vector<double> P(static_cast<std::size_t>(d * d), 0.0), Pn(P.size()), PH(d), K(d);
+  for (int i = 0; i < d; ++i) P[i * d + i] = st[i].P0;
+  std::vector<double> Xh(static_cast<std::size_t>(d * nc), 0.0), nu(nc);
+  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(nc, nc);  // sum nu nu' / S
+  double sum_log_s = 0, S = R;
+  bool steady = false;
+  for (std::size_t k = 0; k < nb; ++k) {
+    if (!steady) {
+      S = R;
+      for (int i = 0; i < d; ++i) {
+        double v = 0;
+        for (int j = 0; j < d; ++j) v += P[i * d + j] * st[j].H;
+        PH[i] = v;
+        S += st[i].H * v;
+      }
+      if (!(S > 0)) throw Error("blockLogLikelihood: innovation variance not positive");
+      for (int i = 0; i < d; ++i) K[i] = (st[i].F * PH[i] + st[i].M) / S;
+    }
+    // Innovations of y and of every regressor (same filter).
+    for (int c = 0; c < nc; ++c) {
+      double pred = 0;
+      for (int i = 0; i < d; ++i) pred += st[i].H * Xh[i * nc + c];
+      const double obs = c == 0 ? y[k] : X(static_cast<Eigen::Index>(k), cols[c - 1]);
+      nu[c] = obs - pred;
+    }
+    for (int i = 0; i < d; ++i)
+      for (int c = 0; c < nc; ++c) Xh[i * nc + c] = st[i].F * Xh[i * nc + c] + K[i] * nu[c];
+    sum_log_s += std::log(S);
+    const double is = 1.0 / S;
+    for (int a = 0; a < nc; ++a)
+      for (int b = 0; b <= a; ++b) W(a, b) += nu[a] * nu[b] * is;
+    if (!steady && d > 0) {
+      // P <- F P F' + Q - K S K'
+      double change = 0, scale = 0;
+      for (int i = 0; i < d; ++i)
+        for (int j = 0; j < d; ++j) {
+          double v = st[i].F * P[i * d + j] * st[j].F - K[i] * S * K[j];
+          if (i == j) v += st[i].Q;
+          Pn[i * d + j] = v;
+          change = std::max(change, std::abs(v - P[i * d + j]));
+          scale = std::max(scale, std::abs(v));
+        }
+      P.swap(Pn);
+      // Converged to the steady state: gains and S no longer change.
+      if (k > 4 && change <= 1e-13 * scale) steady = true;
+    } else if (d == 0) {
+      steady = true;
+    }
+  }
+  for (int a = 0; a < nc; ++a)
+    for (int b = a + 1; b < nc; ++b) W(a, b) = W(b, a);
+  BlockLikelihood out;
+  double quad = W(0, 0);
+  const int p = nc - 1;
+  if (p > 0) {
+    const Eigen::MatrixXd G = W.bottomRightCorner(p, p);
+    const Eigen::VectorXd g = W.bottomLeftCorner(p, 1);
+    Eigen::LDLT<Eigen::MatrixXd> ldlt(G);
+    const double dmax = G.diagonal().maxCoeff();
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-12 * dmax))
+      throw Error("blockLogLikelihood: the regressors are (nearly) collinear");
+    out.beta = ldlt.solve(g);
+    out.beta_cov = ldlt.solve(Eigen::MatrixXd::Identity(p, p));
+    quad -= g.dot(out.beta);
+  }
+  out.loglik = -0.5 * (static_cast<double>(nb) * kLn2Pi + sum_log_s + quad);
+  return out;
+}
+
+}  // namespace navimpact::stochastic

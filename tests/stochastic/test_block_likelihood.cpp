@@ -1,0 +1,126 @@
+// The exact likelihood of block means (block_likelihood.hpp) against the
+// dense Gaussian likelihood written out from its definition: the covariance
+// of the samples built from every term's sampled form, averaged over blocks
+// (Sigma_y = A Sigma_x A'), and the regression coefficients by GLS. Models,
+// block sizes, regressors and data are drawn at random (seeded, printed).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <random>
+
+#include <Eigen/Dense>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/stochastic/block_likelihood.hpp"
+#include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/stochastic/simulate.hpp"
+
+using namespace navimpact::stochastic;
+
+namespace {
+
+constexpr double kLn2Pi = 1.8378770664093453;
+
+/// Covariance of n samples of the random terms of @p m (from sampledArma).
+Eigen::MatrixXd sampleCovariance(const Model& m, int n) {
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
+  for (const auto& p : m.terms) {
+    const auto a = sampledArma(p, m.rate_hz);
+    if (!a) continue;
+    Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(n + 1, n + 1);
+    Z(0, 0) = 1.0;
+    for (int t = 0; t < n; ++t) {
+      Z.row(t + 1) = a->phi * Z.row(t);
+      Z(t + 1, t + 1) += 1.0;
+    }
+    Eigen::MatrixXd C(n, n + 1);
+    for (int t = 0; t < n; ++t) C.row(t) = Z.row(t + 1) - a->mu * Z.row(t);
+    Eigen::VectorXd D = Eigen::VectorXd::Constant(n + 1, a->q);
+    D(0) = a->p0;
+    cov += C * D.asDiagonal() * C.transpose();
+  }
+  return cov;
+}
+
+/// Dense ML log-likelihood of y ~ N(X beta, Sigma), beta by GLS.
+double denseLogLik(const Eigen::VectorXd& y, const Eigen::MatrixXd& X, const Eigen::MatrixXd& Sigma,
+                   Eigen::VectorXd* beta) {
+  Eigen::LLT<Eigen::MatrixXd> llt(Sigma);
+  const Eigen::VectorXd Siy = llt.solve(y);
+  double quad = y.dot(Siy);
+  if (X.cols() > 0) {
+    const Eigen::MatrixXd SiX = llt.solve(X);
+    const Eigen::MatrixXd G = X.transpose() * SiX;
+    *beta = G.ldlt().solve(X.transpose() * Siy);
+    const Eigen::VectorXd r = y - X * *beta;
+    quad = r.dot(llt.solve(r));
+  }
+  const Eigen::MatrixXd L = llt.matrixL();
+  return -0.5 * (static_cast<double>(y.size()) * kLn2Pi + 2.0 * L.diagonal().array().log().sum() + quad);
+}
+
+double logU(std::mt19937_64& g, double a, double b) {
+  return a * std::pow(b / a, std::uniform_real_distribution<double>(0, 1)(g));
+}
+
+}  // namespace
+
+TEST(BlockLikelihood, EqualsTheDenseGaussianLikelihoodOfBlockMeans) {
+  const std::uint64_t seed = 20261201;
+  std::cout << "[ block    ] seed " << seed << "\n";
+  std::mt19937_64 g(seed);
+  for (int r = 0; r < 24; ++r) {
+    const int block = 1 + static_cast<int>(g() % 12);
+    const int nb = 8 + static_cast<int>(g() % 40);
+    const int n = block * nb;
+    Model m;
+    m.rate_hz = logU(g, 50, 1000);
+    const double dur = n / m.rate_hz;
+    // A random subset of WN, QN, RW and one or two GMs (T from one sample to 10 records).
+    if (g() % 4 != 0) m.terms.push_back(Process::wn(logU(g, 1e-3, 1.0)));
+    if (g() % 3 == 0) m.terms.push_back(Process::qn(logU(g, 1e-3, 1.0)));
+    if (g() % 2 == 0) m.terms.push_back(Process::rw(logU(g, 1e-4, 0.1)));
+    for (int q = 0; q < 1 + static_cast<int>(g() % 2); ++q)
+      m.terms.push_back(Process::gm(logU(g, 1e-3, 1.0), logU(g, 0.5 / m.rate_hz, 10 * dur)));
+    // Regressors: none, the mean, the mean and a trend, a step inside a block.
+    Eigen::MatrixXd Xs(n, 3);
+    const int c = 1 + static_cast<int>(g() % (n - 1));
+    for (int t = 0; t < n; ++t) {
+      Xs(t, 0) = 1.0;
+      Xs(t, 1) = (t - 0.5 * n) / n;
+      Xs(t, 2) = t >= c ? 1.0 : 0.0;
+    }
+    const int p = static_cast<int>(g() % 4);
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nb, n);
+    for (int k = 0; k < nb; ++k) A.block(k, k * block, 1, block).setConstant(1.0 / block);
+    const Eigen::MatrixXd Xb = A * Xs.leftCols(p);
+    const auto x = simulate(m, static_cast<std::size_t>(n), g());
+    std::vector<double> y = blockMeans(x.data(), x.size(), static_cast<std::size_t>(block));
+    for (int k = 0; k < nb; ++k) y[k] += 0.3 * (p > 0 ? Xb(k, 0) : 0.0);
+    Eigen::VectorXd yv = Eigen::Map<Eigen::VectorXd>(y.data(), nb);
+    const Eigen::MatrixXd Sy = A * sampleCovariance(m, n) * A.transpose();
+    Eigen::VectorXd beta_dense;
+    const double dense = denseLogLik(yv, Xb, Sy, &beta_dense);
+    const auto kf = blockLogLikelihood(m, y, static_cast<std::size_t>(block), Xb);
+    const std::string what = formatTerms(m.terms, 4) + " at " + std::to_string(m.rate_hz) + " Hz, block " +
+                             std::to_string(block) + " x " + std::to_string(nb) + ", " + std::to_string(p) +
+                             " regressor(s)";
+    EXPECT_NEAR(kf.loglik, dense, 1e-8 * std::abs(dense) + 1e-8) << what;
+    for (int j = 0; j < p; ++j)
+      EXPECT_NEAR(kf.beta(j), beta_dense(j), 1e-6 * (std::abs(beta_dense(j)) + std::sqrt(Sy.diagonal().mean())))
+          << what;
+  }
+}
+
+TEST(BlockLikelihood, BadInputIsAnError) {
+  Model m;
+  m.rate_hz = 100;
+  std::vector<double> y = {1, 2, 3};
+  EXPECT_THROW(blockLogLikelihood(m, y, 4, Eigen::MatrixXd()), navimpact::Error);  // no random term
+  m.terms = {Process::wn(1.0)};
+  EXPECT_THROW(blockLogLikelihood(m, {1.0}, 4, Eigen::MatrixXd()), navimpact::Error);
+  EXPECT_THROW(blockLogLikelihood(m, y, 4, Eigen::MatrixXd::Ones(2, 1)), navimpact::Error);
+  EXPECT_THROW(blockLogLikelihood(m, y, 4, Eigen::MatrixXd::Ones(3, 2)), navimpact::Error);  // collinear
+  EXPECT_THROW(blockMeans(y.data(), y.size(), 0), navimpact::Error);
+}
