@@ -10,8 +10,10 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/gmwm/channels.hpp"
+#include "navimpact/stochastic/datasheet.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
+#include "navimpact/stochastic/theoretical_wv.hpp"
 
 using namespace navimpact;
 using stochastic::Process;
@@ -103,6 +105,96 @@ TEST(RecordingFit, AutoRanksWithRWeightsAndRecordsTheReason) {
   const gmwm::RecordingFit fm = gmwm::fitRecording(s, o);
   EXPECT_EQ(fm.channels[0].fit.weighting, gmwm::Weighting::ModelBased);
   EXPECT_NE(fm.channels[0].why.find("refit with --weights model"), std::string::npos) << fm.channels[0].why;
+}
+
+// The chance that k of J marginal 95 % intervals miss a correct model is the
+// binomial tail: 1 for k = 0, 1 - 0.95^J for k = 1, 0.05^J for k = J,
+// falling with k.
+TEST(OutsideCi, ChanceIsTheBinomialTail) {
+  for (int J : {1, 5, 18, 27}) {
+    EXPECT_EQ(gmwm::outsideCiChance(0, J), 1.0);
+    EXPECT_NEAR(gmwm::outsideCiChance(1, J), 1.0 - std::pow(0.95, J), 1e-12);
+    EXPECT_NEAR(gmwm::outsideCiChance(J, J), std::pow(0.05, J), 1e-12 * std::pow(0.05, J) + 1e-15);
+    EXPECT_EQ(gmwm::outsideCiChance(J + 1, J), 0.0);
+    for (int k = 1; k <= J; ++k) EXPECT_LT(gmwm::outsideCiChance(k, J), gmwm::outsideCiChance(k - 1, J));
+  }
+  // P(X >= 2), J = 18: 1 - 0.95^18 - 18 * 0.05 * 0.95^17.
+  EXPECT_NEAR(gmwm::outsideCiChance(2, 18), 1.0 - std::pow(0.95, 18) - 18 * 0.05 * std::pow(0.95, 17), 1e-12);
+}
+
+// scalesOutsideCi lists exactly the scales where the model WV leaves the CI.
+// The true model of a simulated record misses beyond chance (outsideCiChance
+// < 0.05) in about 5 % of records; a model without the record's GM misses
+// beyond chance on every record. Parameters drawn log-uniformly (seeded, printed):
+// WN sigma in [1e-4, 1e-2], GM sigma / WN sigma in [0.3, 3], T in [20, 400] samples.
+TEST(OutsideCi, TrueModelWithinChanceModelWithoutItsGmBeyond) {
+  const std::uint64_t seed = 8128;
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto logU = [&](double lo, double hi) { return lo * std::pow(hi / lo, u(g)); };
+  const int records = 60;
+  const double rate = 100.0;
+  int true_beyond = 0;
+  for (int r = 0; r < records; ++r) {
+    stochastic::Model m;
+    m.rate_hz = rate;
+    const double sw = logU(1e-4, 1e-2);
+    m.terms = {Process::wn(sw), Process::gm(sw * logU(0.3, 3.0), logU(20.0, 400.0) / rate)};
+    const std::vector<double> x = stochastic::simulate(m, 1u << 15, stochastic::deriveSeed(seed, r));
+    const gmwm::WaveletVariance wv = gmwm::waveletVariance(x.data(), x.size(), rate);
+    const std::vector<int> out = gmwm::scalesOutsideCi(m, wv);
+    const Eigen::VectorXd nu = stochastic::haarWv(m, wv.tau);
+    std::vector<int> direct;
+    for (int j = 0; j < wv.scales(); ++j)
+      if (nu[j] < wv.ci_low[j] || nu[j] > wv.ci_high[j]) direct.push_back(j);
+    EXPECT_EQ(out, direct);
+    const double chance = gmwm::outsideCiChance(static_cast<int>(out.size()), wv.scales());
+    true_beyond += chance < 0.05;
+    stochastic::Model wn_only = m;
+    wn_only.terms.pop_back();
+    const std::vector<int> out_wn = gmwm::scalesOutsideCi(wn_only, wv);
+    const double chance_wn = gmwm::outsideCiChance(static_cast<int>(out_wn.size()), wv.scales());
+    EXPECT_LT(chance_wn, 0.05) << "seed " << seed << " record " << r << ": " << stochastic::formatTerms(m.terms);
+    std::printf("seed %llu record %d: %s: true model outside at %zu of %d (chance %.3g), without GM at %zu (chance %.3g)\n",
+                static_cast<unsigned long long>(seed), r, stochastic::formatTerms(m.terms).c_str(), out.size(),
+                wv.scales(), chance, out_wn.size(), chance_wn);
+  }
+  // 5 % of 60 is 3; P(Binomial(60, 0.05) > 8) < 0.005.
+  std::printf("true model beyond chance on %d of %d records\n", true_beyond, records);
+  EXPECT_LE(true_beyond, 8);
+}
+
+// whiteNoiseNote names each GM below kWhiteGmMaxSamples samples with T in s and
+// samples and its lag-1 correlation, and says when the WN term vanished; a
+// model without such a GM has no note. T drawn uniformly in samples (seeded).
+TEST(WhiteNoiseNote, NamesShortGmsAndAVanishedWn) {
+  std::mt19937_64 g(3141);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int r = 0; r < 20; ++r) {
+    stochastic::Model m;
+    m.rate_hz = 50.0 + 950.0 * u(g);
+    const double samples = 0.05 + (stochastic::kWhiteGmMaxSamples - 0.05) * u(g);
+    const double long_samples = stochastic::kWhiteGmMaxSamples * (1.0 + 1000.0 * u(g));
+    m.terms = {Process::wn(1e-3), Process::gm(2e-3, long_samples / m.rate_hz),
+               Process::gm(5e-3, samples / m.rate_hz)};
+    std::printf("record %d: %s at %.1f Hz (%.3g samples)\n", r, stochastic::formatTerms(m.terms).c_str(), m.rate_hz,
+                samples);
+    const std::string kept = gmwm::whiteNoiseNote(m, {false, false, false});
+    EXPECT_NE(kept.find("GM 2 (T = "), std::string::npos) << kept;
+    EXPECT_EQ(kept.find("GM 1 "), std::string::npos) << kept;
+    char lag[64];
+    std::snprintf(lag, sizeof lag, "lag-1 correlation %.3g", std::exp(-1.0 / samples));
+    EXPECT_NE(kept.find(lag), std::string::npos) << kept << " / " << lag;
+    EXPECT_EQ(kept.find("negligible"), std::string::npos) << kept;
+    const std::string gone = gmwm::whiteNoiseNote(m, {true, false, false});
+    EXPECT_NE(gone.find("the WN term is negligible"), std::string::npos) << gone;
+    m.terms.pop_back();
+    EXPECT_EQ(gmwm::whiteNoiseNote(m, {false, false}), "");
+  }
+  stochastic::Model m;
+  m.rate_hz = 100.0;
+  m.terms = {Process::gm(1.0, 0.01)};
+  EXPECT_THROW(gmwm::whiteNoiseNote(m, {}), Error);
 }
 
 TEST(RecordingFit, BadOptionsAreRefusedBeforeAnyData) {

@@ -103,6 +103,42 @@ TEST(FitReport, ModelFileAndJsonHoldTheFit) {
     EXPECT_NE(sum.find(c.name + ": " + stochastic::formatTerms(c.fit.model.terms)), std::string::npos) << sum;
 }
 
+// A model that misses the data (WN only on the real ADIS excerpt) is warned
+// about on the console and in fit.json, with the scales it leaves the CI at.
+TEST(FitReport, ModelOutsideTheCiIsWarnedAbout) {
+  const ImuSeries s = adisExcerpt(1u << 16);
+  gmwm::RecordingFitOptions o;
+  o.structure = "WN";
+  o.intervals = "asymptotic";
+  o.channels = {"gyro_x", "acc_y"};
+  const gmwm::RecordingFit f = gmwm::fitRecording(s, o);
+  const auto dir = test::tempDir() / "fit";
+  OutputSet out(dir);
+  report::writeFitOutputs(f, "{}", "v", out);
+  out.commit();
+  std::ifstream js(dir / "fit.json");
+  const nlohmann::json j = nlohmann::json::parse(js);
+  const std::string sum = report::fitSummary(f);
+  for (std::size_t i = 0; i < f.channels.size(); ++i) {
+    const auto& c = f.channels[i];
+    const auto& jc = j["channels"][i];
+    EXPECT_EQ(c.outside_ci, gmwm::scalesOutsideCi(c.fit.model, c.wv));
+    ASSERT_GT(c.outside_ci.size(), 3u) << c.name;
+    ASSERT_EQ(jc["scales_outside_ci"].size(), c.outside_ci.size());
+    for (std::size_t k = 0; k < c.outside_ci.size(); ++k)
+      EXPECT_EQ(jc["scales_outside_ci"][k]["tau_s"].get<double>(), c.wv.tau[c.outside_ci[k]] / c.wv.rate_hz);
+    EXPECT_LT(jc["scales_outside_ci_chance"].get<double>(), 0.05);
+    ASSERT_GE(jc["warnings"].size(), 1u);
+    EXPECT_NE(jc["warnings"][0].get<std::string>().find("does not describe the data"), std::string::npos);
+    EXPECT_TRUE(c.white_noise_note.empty());  // no GM
+  }
+  std::size_t warnings = 0;
+  for (std::size_t p = sum.find("warning: model WV outside the 95 % CI"); p != std::string::npos;
+       p = sum.find("warning: model WV outside the 95 % CI", p + 1))
+    ++warnings;
+  EXPECT_EQ(warnings, 2u) << sum;
+}
+
 TEST(FitReport, OneSensorGivesOneFigure) {
   const ImuSeries s = adisExcerpt(1u << 12);
   gmwm::RecordingFitOptions o;

@@ -2,8 +2,10 @@
 #include "navimpact/gmwm/channels.hpp"
 
 #include <cmath>
+#include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/stochastic/datasheet.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 
@@ -64,6 +66,37 @@ std::vector<stochastic::ProcessKind> kindsOf(const stochastic::Model& m) {
 }
 
 }  // namespace
+
+std::string whiteNoiseNote(const stochastic::Model& m, const std::vector<bool>& negligible) {
+  if (negligible.size() != m.terms.size())
+    throw Error("whiteNoiseNote: " + std::to_string(negligible.size()) + " flags for " +
+                std::to_string(m.terms.size()) + " terms");
+  const stochastic::DatasheetFigures d = stochastic::datasheetFigures(m);
+  if (d.noise_density_gms == 0) return "";
+  std::ostringstream os;
+  os.precision(3);
+  os << "white noise carried by ";
+  int k = 0, gm = 0;
+  bool wn_gone = true, has_wn = false;
+  for (std::size_t i = 0; i < m.terms.size(); ++i) {
+    const auto& t = m.terms[i];
+    if (t.kind == stochastic::ProcessKind::WN) {
+      has_wn = true;
+      wn_gone = wn_gone && negligible[i];
+    }
+    if (t.kind != stochastic::ProcessKind::GM) continue;
+    ++gm;
+    const double samples = t.T * m.rate_hz;
+    if (!(samples < stochastic::kWhiteGmMaxSamples)) continue;
+    os << (k++ ? ", " : "") << "GM " << gm << " (T = " << t.T << " s = " << samples
+       << " samples, lag-1 correlation " << std::exp(-1.0 / samples) << ")";
+  }
+  os << ": " << std::lround(100.0 * d.noise_density_gm_share) << " % of the noise density N^2";
+  if (has_wn && wn_gone) os << ", the WN term is negligible";
+  os << "; the ARW/VRW includes it, and a filter whose covariance step is longer than its T enters it as "
+        "white noise of its long-run variance";
+  return os.str();
+}
 
 void checkRecordingFitOptions(const RecordingFitOptions& opt) {
   if (opt.structure != "auto") stochastic::parseStructure(opt.structure);
@@ -132,6 +165,8 @@ RecordingFit fitRecording(const ImuSeries& s, const RecordingFitOptions& opt,
       throw Error(s.source + ": channel " + c.name + ": " + e.what());
     }
     c.negligible = negligibleTerms(c.fit.model, c.wv);
+    c.outside_ci = scalesOutsideCi(c.fit.model, c.wv);
+    c.white_noise_note = whiteNoiseNote(c.fit.model, c.negligible);
     if (progress) progress(i + 1, chans.size());
   }
 

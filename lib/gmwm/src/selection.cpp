@@ -116,6 +116,26 @@ std::vector<bool> negligibleTerms(const Model& m, const WaveletVariance& wv, dou
   return out;
 }
 
+std::vector<int> scalesOutsideCi(const Model& m, const WaveletVariance& wv) {
+  const Eigen::VectorXd nu = stochastic::haarWv(m, wv.tau);
+  std::vector<int> out;
+  for (int j = 0; j < wv.scales(); ++j)
+    if (nu[j] < wv.ci_low[j] || nu[j] > wv.ci_high[j]) out.push_back(j);
+  return out;
+}
+
+double outsideCiChance(int outside, int scales) {
+  if (outside <= 0) return 1.0;
+  if (outside > scales) return 0.0;
+  // sum_{i >= outside} C(J, i) p^i (1-p)^(J-i), summed directly (no 1 - x cancellation), terms in logs.
+  const double p = 0.05;
+  double tail = 0.0;
+  for (int i = scales; i >= outside; --i)
+    tail += std::exp(std::lgamma(scales + 1.0) - std::lgamma(i + 1.0) - std::lgamma(scales - i + 1.0) +
+                     i * std::log(p) + (scales - i) * std::log1p(-p));
+  return std::min(1.0, tail);
+}
+
 std::vector<std::vector<ProcessKind>> defaultCandidates(int max_gm) {
   std::vector<std::vector<ProcessKind>> out;
   for (int g = 0; g <= max_gm; ++g)

@@ -58,7 +58,42 @@ json datasheetJson(const st::DatasheetFigures& f) {
   put("random_walk", f.random_walk);
   put("quantization", f.quantization);
   put("drift_rate", f.drift_rate);
+  if (f.noise_density_gms > 0) {
+    d["noise_density_gms"] = f.noise_density_gms;
+    d["noise_density_gm_share"] = f.noise_density_gm_share;
+  }
+  if (!f.bias_instability_warning.empty()) d["bias_instability_warning"] = f.bias_instability_warning;
   return d;
+}
+
+/// Datasheet figures of a channel's model, the bias-instability search up to
+/// the longest averaging time its record supports (half the largest WV scale).
+st::DatasheetFigures channelDatasheet(const gm::ChannelFit& c) {
+  const double max_s = c.wv.scales() > 0 ? 0.5 * c.wv.tau[c.wv.scales() - 1] / c.wv.rate_hz : 0.0;
+  return st::datasheetFigures(c.fit.model, max_s);
+}
+
+/// Misses of the model WV beyond what chance gives (gmwm::outsideCiChance < 0.05).
+bool outsideCiBeyondChance(const gm::ChannelFit& c) {
+  return gm::outsideCiChance(static_cast<int>(c.outside_ci.size()), c.wv.scales()) < 0.05;
+}
+
+/// "model WV outside the 95 % CI at 3 of 19 scales (tau = 0.02, 0.04, 1311 s; ...)".
+std::string outsideCiText(const gm::ChannelFit& c) {
+  if (c.outside_ci.empty()) return "";
+  std::ostringstream os;
+  os.precision(3);
+  os << "model WV outside the 95 % CI at " << c.outside_ci.size() << " of " << c.wv.scales()
+     << " scales (tau =";
+  for (std::size_t k = 0; k < c.outside_ci.size(); ++k)
+    os << (k ? ", " : " ") << c.wv.tau[c.outside_ci[k]] / c.wv.rate_hz;
+  const double chance = gm::outsideCiChance(static_cast<int>(c.outside_ci.size()), c.wv.scales());
+  os << " s); a correct model misses that many with probability " << chance;
+  if (outsideCiBeyondChance(c))
+    os << ": the model does not describe the data there (navimpact diagnose names what is missing)";
+  else
+    os << ": consistent with chance";
+  return os.str();
 }
 
 std::string fitJson(const gm::RecordingFit& f, const std::string& input_json) {
@@ -99,7 +134,20 @@ std::string fitJson(const gm::RecordingFit& f, const std::string& input_json) {
       terms.push_back(t);
     }
     cj["terms"] = terms;
-    cj["datasheet"] = datasheetJson(st::datasheetFigures(c.fit.model));
+    cj["datasheet"] = datasheetJson(channelDatasheet(c));
+    json out_ci = json::array();
+    for (int j : c.outside_ci)
+      out_ci.push_back({{"tau_s", c.wv.tau[j] / c.wv.rate_hz},
+                        {"wv", c.wv.wv[j]},
+                        {"model_wv", st::haarWv(c.fit.model, c.wv.tau.segment(j, 1))[0]},
+                        {"ci_low", c.wv.ci_low[j]},
+                        {"ci_high", c.wv.ci_high[j]}});
+    cj["scales_outside_ci"] = out_ci;
+    cj["scales_outside_ci_chance"] = gm::outsideCiChance(static_cast<int>(c.outside_ci.size()), c.wv.scales());
+    json warnings = json::array();
+    if (outsideCiBeyondChance(c)) warnings.push_back(outsideCiText(c));
+    if (!c.white_noise_note.empty()) warnings.push_back(c.white_noise_note);
+    cj["warnings"] = warnings;
     if (autoSel) {
       json sel = json::array();
       for (const auto& r : c.ranking) {
@@ -202,7 +250,10 @@ std::string fitSummary(const gm::RecordingFit& f) {
            << " of the WV's 95 % CI width at every scale: the data cannot tell it from its absence;"
            << (autoSel ? " kept: no ranked candidate lacks it)\n" : " kept: the requested structure has it)\n");
     if (autoSel) os << "    " << c.why << "\n";
-    std::istringstream lines(st::formatDatasheet(st::datasheetFigures(c.fit.model), c.quantity));
+    if (!c.outside_ci.empty())
+      os << "    " << (outsideCiBeyondChance(c) ? "warning: " : "note: ") << outsideCiText(c) << "\n";
+    if (!c.white_noise_note.empty()) os << "    note: " << c.white_noise_note << "\n";
+    std::istringstream lines(st::formatDatasheet(channelDatasheet(c), c.quantity));
     std::string l;
     while (std::getline(lines, l)) os << "    " << l << "\n";
   }

@@ -72,9 +72,26 @@ struct ChannelFit {
   WaveletVariance wv;                ///< the empirical WV the model was fitted to
   FitResult fit;
   std::vector<bool> negligible;      ///< per term of fit.model (negligibleTerms)
+  /// Scales (indices into wv) where the model WV lies outside the WV's 95 % CI (scalesOutsideCi).
+  std::vector<int> outside_ci;
+  /// Non-empty when GMs with T below stochastic::kWhiteGmMaxSamples samples
+  /// carry white noise: which, their lag-1 correlation, their share of the
+  /// noise density, and whether the WN term vanished.
+  std::string white_noise_note;
   std::vector<RankedModel> ranking;  ///< auto: every candidate, best first
   std::string why;                   ///< auto: why the pick was chosen
 };
+
+/**
+ * What a fitted model does with the white noise of the data when GMs with T
+ * below stochastic::kWhiteGmMaxSamples samples carry it (their PSD is flat up
+ * to Nyquist): which GMs, T in seconds and samples, lag-1 correlation phi,
+ * their share of the noise density N^2 (stochastic::datasheetFigures) and
+ * whether the model's WN term is negligible (@p negligible, one flag per term,
+ * from negligibleTerms). Empty when no such GM exists.
+ * @throws navimpact::Error when @p negligible does not have one flag per term.
+ */
+std::string whiteNoiseNote(const stochastic::Model& m, const std::vector<bool>& negligible);
 
 /// The fits of a recording.
 struct RecordingFit {

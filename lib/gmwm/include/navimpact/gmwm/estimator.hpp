@@ -164,6 +164,23 @@ constexpr double kNegligibleFraction = 0.1;
 std::vector<bool> negligibleTerms(const stochastic::Model& m, const WaveletVariance& wv,
                                   double fraction = kNegligibleFraction);
 
+/**
+ * Scales where the model's Haar WV lies outside the empirical WV's confidence
+ * interval (ci_low, ci_high), i.e. what the model does not describe. With
+ * marginal 95 % intervals about 5 % of the scales fall outside by chance.
+ * @return indices into @p wv's scales, ascending.
+ */
+std::vector<int> scalesOutsideCi(const stochastic::Model& m, const WaveletVariance& wv);
+
+/**
+ * Chance that at least @p outside of @p scales marginal 95 % intervals miss a
+ * correct model: the binomial tail P(X >= outside), X ~ Binomial(scales, 0.05)
+ * (scales treated as independent; neighbouring Haar scales are nearly so).
+ * Below 0.05 the misses are more than chance gives: the model does not
+ * describe the data there.
+ */
+double outsideCiChance(int outside, int scales);
+
 /// Two GMs whose correlation times are within this factor are one term
 /// (their WV peaks are less than an octave apart, one Haar scale step).
 constexpr double kDuplicateTFactor = 2.0;
