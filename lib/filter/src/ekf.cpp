@@ -538,15 +538,17 @@ void ErrorStateEkf::predictCovariance(const ins::NavState& nominal, const Vector
   accumulate(c.T);
 }
 
-MatrixXd ErrorStateEkf::H_gnssPosition(const Vector3d& lever_B) const {
+MatrixXd ErrorStateEkf::H_gnssPosition(const Vector3d& lever_B, double dt_meas) const {
   MatrixXd H = MatrixXd::Zero(3, size());
   H.block<3, 3>(0, kPos).setIdentity();
   // p_ant = p + C l: d(C l) = psi x (C l) = -[(C l) x] psi (Groves 14.110 with our signs)
   H.block<3, 3>(0, kAtt) = -skew(state().C_BtoN() * lever_B);
+  // carried to the measurement epoch: p_ant + v_ant dt_meas
+  if (dt_meas != 0.0) H += dt_meas * H_gnssVelocity(lever_B);
   return H;
 }
 
-MatrixXd ErrorStateEkf::H_gnssVelocity(const Vector3d& lever_B) const {
+MatrixXd ErrorStateEkf::H_gnssVelocity(const Vector3d& lever_B, double dt_meas) const {
   MatrixXd H = MatrixXd::Zero(3, size());
   const Eigen::Matrix3d C = state().C_BtoN();
   const Vector3d w_ie = earth::w_IE_N(state().lat);
@@ -559,7 +561,34 @@ MatrixXd ErrorStateEkf::H_gnssVelocity(const Vector3d& lever_B) const {
     for (int c = 0; c < 3; ++c) Hg.row(c) = layout_.sensorRow(c);
     H.rightCols(layout_.imuSize()) = C * skew(lever_B) * Hg;
   }
+  // carried to the measurement epoch with dv/dt, whose linearisation is the
+  // velocity rows of F (Groves 14.65-14.69 and the accelerometer coupling)
+  if (dt_meas != 0.0) H += dt_meas * F().middleRows(kVel, 3);
   return H;
+}
+
+MatrixXd ErrorStateEkf::H_zeroVelocity() const {
+  MatrixXd H = MatrixXd::Zero(3, size());
+  H.block<3, 3>(0, kVel).setIdentity();
+  return H;
+}
+
+MatrixXd ErrorStateEkf::H_nonHolonomic(const Vector3d& point_B) const {
+  // v_P_B = C' v_N + (w_IB_B - C' w_IE_N) x l with C = C_BtoN. With
+  // C_est = (I + [psi x]) C: C_est' = C' (I - [psi x]), so
+  //   d(C' v) = C' dv + C' [v x] psi,   d(-(C' w_ie) x l) = [l x] C' [w_ie x] psi,
+  // and the corrected gyro error dw = -Hg dx_imu enters as dw x l = [l x] Hg dx_imu.
+  MatrixXd H3 = MatrixXd::Zero(3, size());
+  const Eigen::Matrix3d Ct = state().C_BtoN().transpose();
+  const Vector3d w_ie = earth::w_IE_N(state().lat);
+  H3.block<3, 3>(0, kVel) = Ct;
+  H3.block<3, 3>(0, kAtt) = Ct * skew(state().v_N) + skew(point_B) * Ct * skew(w_ie);
+  if (layout_.imuSize() > 0 && point_B.squaredNorm() > 0.0) {
+    MatrixXd Hg(3, layout_.imuSize());
+    for (int c = 0; c < 3; ++c) Hg.row(c) = layout_.sensorRow(c);
+    H3.rightCols(layout_.imuSize()) = skew(point_B) * Hg;
+  }
+  return H3.bottomRows(2);
 }
 
 MatrixXd ErrorStateEkf::H_baro() const {
@@ -586,7 +615,8 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
   res.nis = dz.dot(llt.solve(dz));
   if (cfg_.gate_probability > 0.0) {
     const boost::math::chi_squared chi2(mz);
-    if (res.nis > boost::math::quantile(chi2, cfg_.gate_probability)) {
+    res.gate = boost::math::quantile(chi2, cfg_.gate_probability);
+    if (res.nis > res.gate) {
       res.accepted = false;
       ++rejections_;
       last_ = res;
@@ -629,42 +659,79 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
   return res;
 }
 
-VectorXd ErrorStateEkf::residualGnssPosition(const earth::Geodetic& z,
-                                             const Vector3d& lever_B) const {
+VectorXd ErrorStateEkf::residualGnssPosition(const earth::Geodetic& z, const Vector3d& lever_B,
+                                             double dt_meas) const {
   const ins::NavState& x = state();
   const earth::Radii r = earth::radii(x.lat);
   const Vector3d l_N = x.C_BtoN() * lever_B;
   const earth::Geodetic ant{x.lat + l_N.x() / (r.R_N + x.h),
                             x.lon + l_N.y() / ((r.R_E + x.h) * std::cos(x.lat)), x.h - l_N.z()};
-  return earth::curvilinearDiffNed(ant, z);
+  VectorXd dz = earth::curvilinearDiffNed(ant, z);
+  if (dt_meas != 0.0) dz += dt_meas * residualGnssVelocity(Vector3d::Zero(), lever_B);
+  return dz;
 }
 
 UpdateResult ErrorStateEkf::updateGnssPosition(const earth::Geodetic& z, const Vector3d& sigma,
-                                               const Vector3d& lever_B) {
+                                               const Vector3d& lever_B, double dt_meas) {
   if (!(sigma.array() > 0.0).all() || !sigma.allFinite())
     throw Error("GNSS position sigma must be > 0 at t = " + tstr(state().t) + " s");
   flushPropagation();
-  const VectorXd dz = residualGnssPosition(z, lever_B);
+  const VectorXd dz = residualGnssPosition(z, lever_B, dt_meas);
   const MatrixXd R = sigma.cwiseAbs2().asDiagonal();
-  return update(dz, H_gnssPosition(lever_B), R);
+  return update(dz, H_gnssPosition(lever_B, dt_meas), R);
 }
 
-VectorXd ErrorStateEkf::residualGnssVelocity(const Vector3d& z_N, const Vector3d& lever_B) const {
+VectorXd ErrorStateEkf::residualGnssVelocity(const Vector3d& z_N, const Vector3d& lever_B,
+                                             double dt_meas) const {
   const ins::NavState& x = state();
   const Eigen::Matrix3d C = x.C_BtoN();
-  const Vector3d v_ant =
-      x.v_N + C * w_IB_B_.cross(lever_B) - earth::w_IE_N(x.lat).cross(C * lever_B);
+  const Vector3d w_ie = earth::w_IE_N(x.lat);
+  Vector3d v_ant = x.v_N + C * w_IB_B_.cross(lever_B) - w_ie.cross(C * lever_B);
+  if (dt_meas != 0.0) {
+    // dv/dt = C f_B + g_N - (2 w_IE_N + w_EN_N) x v_N (Groves 5.54)
+    const Vector3d a_N = C * f_B_ + earth::gravity_N(x.lat, x.h) -
+                         (2.0 * w_ie + earth::w_EN_N(x.lat, x.h, x.v_N)).cross(x.v_N);
+    v_ant += a_N * dt_meas;
+  }
   return v_ant - z_N;
 }
 
 UpdateResult ErrorStateEkf::updateGnssVelocity(const Vector3d& z_N, const Vector3d& sigma,
-                                               const Vector3d& lever_B) {
+                                               const Vector3d& lever_B, double dt_meas) {
   if (!(sigma.array() > 0.0).all() || !sigma.allFinite())
     throw Error("GNSS velocity sigma must be > 0 at t = " + tstr(state().t) + " s");
   flushPropagation();
-  const VectorXd dz = residualGnssVelocity(z_N, lever_B);
+  const VectorXd dz = residualGnssVelocity(z_N, lever_B, dt_meas);
   const MatrixXd R = sigma.cwiseAbs2().asDiagonal();
-  return update(dz, H_gnssVelocity(lever_B), R);
+  return update(dz, H_gnssVelocity(lever_B, dt_meas), R);
+}
+
+UpdateResult ErrorStateEkf::updateZeroVelocity(double sigma) {
+  if (!(sigma > 0.0) || !std::isfinite(sigma))
+    throw Error("zero-velocity update sigma must be > 0 at t = " + tstr(state().t) + " s");
+  flushPropagation();
+  const VectorXd dz = state().v_N;
+  return update(dz, H_zeroVelocity(), MatrixXd::Identity(3, 3) * (sigma * sigma));
+}
+
+Eigen::Vector2d ErrorStateEkf::residualNonHolonomic(const Vector3d& point_B) const {
+  const Eigen::Matrix3d Ct = state().C_BtoN().transpose();
+  const Vector3d w_EB_B = w_IB_B_ - Ct * earth::w_IE_N(state().lat);
+  const Vector3d v_P = Ct * state().v_N + w_EB_B.cross(point_B);
+  return v_P.tail<2>();
+}
+
+UpdateResult ErrorStateEkf::updateNonHolonomic(double sigma_lat, double sigma_vert,
+                                               const Vector3d& point_B) {
+  if (!(sigma_lat > 0.0) || !std::isfinite(sigma_lat) || !(sigma_vert > 0.0) ||
+      !std::isfinite(sigma_vert))
+    throw Error("non-holonomic constraint sigmas must be > 0 at t = " + tstr(state().t) + " s");
+  flushPropagation();
+  const VectorXd dz = residualNonHolonomic(point_B);
+  MatrixXd R = MatrixXd::Zero(2, 2);
+  R(0, 0) = sigma_lat * sigma_lat;
+  R(1, 1) = sigma_vert * sigma_vert;
+  return update(dz, H_nonHolonomic(point_B), R);
 }
 
 UpdateResult ErrorStateEkf::updateBaro(double h_meas, double sigma) {

@@ -85,6 +85,7 @@ struct UpdateResult {
   Eigen::VectorXd innovation;   ///< dz = h(x_est) - z (metres NED / m/s / m)
   Eigen::MatrixXd S;            ///< innovation covariance H P H' + R
   double nis = 0.0;             ///< dz' S^-1 dz
+  double gate = 0.0;            ///< NIS threshold of the chi-square gate (0: gate off)
   double t = 0.0;               ///< filter time [s]
 };
 
@@ -129,17 +130,46 @@ class ErrorStateEkf {
    * @param[in] z          measured antenna position (geodetic).
    * @param[in] sigma_NED  1-sigma noise along N, E, D [m], > 0.
    * @param[in] lever_B    antenna position w.r.t. the IMU in body axes [m].
+   * @param[in] dt_meas    measurement epoch minus filter time state().t [s]: a fix
+   *                       between IMU samples is compared with the predicted antenna
+   *                       position carried to its epoch with the antenna velocity,
+   *                       p_ant + v_ant dt_meas (first order; |dt_meas| is at most
+   *                       an IMU interval in practice). H = H_pos + dt_meas H_vel.
    */
   UpdateResult updateGnssPosition(const earth::Geodetic& z, const Eigen::Vector3d& sigma_NED,
-                                  const Eigen::Vector3d& lever_B = Eigen::Vector3d::Zero());
+                                  const Eigen::Vector3d& lever_B = Eigen::Vector3d::Zero(),
+                                  double dt_meas = 0.0);
   /**
    * GNSS velocity of the antenna in NED (lever arm: v + C (w_IB_B x l) - w_IE_N x (C l), Groves 14.111).
    * @param[in] z_N        measured velocity [m/s].
    * @param[in] sigma_NED  1-sigma noise [m/s], > 0.
    * @param[in] lever_B    lever arm [m].
+   * @param[in] dt_meas    measurement epoch minus filter time [s]: the predicted
+   *                       velocity is carried with the IMU acceleration
+   *                       dv/dt = C f_B + g_N - (2 w_IE_N + w_EN_N) x v_N (Groves 5.54);
+   *                       H = H_vel + dt_meas F_vel (the velocity rows of F).
    */
   UpdateResult updateGnssVelocity(const Eigen::Vector3d& z_N, const Eigen::Vector3d& sigma_NED,
-                                  const Eigen::Vector3d& lever_B = Eigen::Vector3d::Zero());
+                                  const Eigen::Vector3d& lever_B = Eigen::Vector3d::Zero(),
+                                  double dt_meas = 0.0);
+  /**
+   * Zero-velocity update (ZUPT): the IMU is at rest w.r.t. the Earth, z = 0,
+   * dz = v_N_est, H = [0 I 0 ...] (Groves 2013 §15.3.1).
+   * @param[in] sigma_mps  1-sigma of the pseudo-measurement per axis [m/s], > 0.
+   */
+  UpdateResult updateZeroVelocity(double sigma_mps);
+  /**
+   * Non-holonomic constraint of a ground vehicle (Groves 2013 §15.4.1; Dissanayake
+   * et al. 2001): the point P at @p point_B (body FRD, from the IMU) moves neither
+   * sideways nor vertically in the body frame, z = [0, 0] for
+   * v_P_B = C_NtoB v_N + w_EB_B x l,  w_EB_B = w_IB_B - C_NtoB w_IE_N,
+   * components right (y) and down (z).
+   * @param[in] sigma_lateral_mps   1-sigma of the lateral component [m/s], > 0.
+   * @param[in] sigma_vertical_mps  1-sigma of the vertical component [m/s], > 0.
+   * @param[in] point_B             P w.r.t. the IMU in body axes [m] (e.g. the rear axle).
+   */
+  UpdateResult updateNonHolonomic(double sigma_lateral_mps, double sigma_vertical_mps,
+                                  const Eigen::Vector3d& point_B = Eigen::Vector3d::Zero());
   /**
    * Barometric altitude, taken as ellipsoidal height of the IMU.
    * @param[in] h_meas  measured height [m].
@@ -159,17 +189,22 @@ class ErrorStateEkf {
                       const Eigen::MatrixXd& R, bool feedback = true);
 
   // ---- residuals dz = h(x_est) - z at the current state (public for tests) --
-  /// GNSS position residual in metres N, E, D (antenna, lever arm @p lever_B [m]).
-  Eigen::VectorXd residualGnssPosition(const earth::Geodetic& z,
-                                       const Eigen::Vector3d& lever_B) const;
-  /// GNSS velocity residual [m/s] (antenna, lever arm @p lever_B [m]).
-  Eigen::VectorXd residualGnssVelocity(const Eigen::Vector3d& z_N,
-                                       const Eigen::Vector3d& lever_B) const;
+  /// GNSS position residual in metres N, E, D (antenna, lever arm @p lever_B [m],
+  /// measurement epoch dt_meas [s] after the filter time).
+  Eigen::VectorXd residualGnssPosition(const earth::Geodetic& z, const Eigen::Vector3d& lever_B,
+                                       double dt_meas = 0.0) const;
+  /// GNSS velocity residual [m/s] (antenna, lever arm @p lever_B [m], epoch dt_meas [s]).
+  Eigen::VectorXd residualGnssVelocity(const Eigen::Vector3d& z_N, const Eigen::Vector3d& lever_B,
+                                       double dt_meas = 0.0) const;
+  /// Non-holonomic residual [m/s]: right and down components of v_P_B (see updateNonHolonomic).
+  Eigen::Vector2d residualNonHolonomic(const Eigen::Vector3d& point_B) const;
 
   // ---- Jacobians (public for tests and covariance-only analysis) --------
-  Eigen::MatrixXd H_gnssPosition(const Eigen::Vector3d& lever_B) const;  ///< 3 x size()
-  Eigen::MatrixXd H_gnssVelocity(const Eigen::Vector3d& lever_B) const;  ///< 3 x size()
+  Eigen::MatrixXd H_gnssPosition(const Eigen::Vector3d& lever_B, double dt_meas = 0.0) const;  ///< 3 x size()
+  Eigen::MatrixXd H_gnssVelocity(const Eigen::Vector3d& lever_B, double dt_meas = 0.0) const;  ///< 3 x size()
   Eigen::MatrixXd H_baro() const;                                        ///< 1 x size()
+  Eigen::MatrixXd H_zeroVelocity() const;                                ///< 3 x size()
+  Eigen::MatrixXd H_nonHolonomic(const Eigen::Vector3d& point_B) const;  ///< 2 x size()
   /// Continuous F (size() square) at the current state and last f_B.
   Eigen::MatrixXd F() const;
   /// Continuous driving-noise PSD matrix (size() square) at the current state.
