@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <fstream>
+#include <random>
+#include <sstream>
 
 #include "navimpact/core/csv_reader.hpp"
 #include "navimpact/core/error.hpp"
@@ -124,4 +126,32 @@ TEST(CsvReader, ReadsTheFullStaticRecording) {
   // First row of the file: -0.05,-0.3,0.7,-0.00666,0,-1.01565
   EXPECT_DOUBLE_EQ(s.channel("gyro_x").x[0], -0.05 * units::kDeg);
   EXPECT_DOUBLE_EQ(s.channel("acc_z").x[0], -1.01565 * units::kG0);
+}
+
+// A value beyond any IMU (garbage, or a unit wrong by orders of magnitude) is an
+// error at its line, never a sample: drawn at a random row, column and
+// magnitude between the limit and 1e300 (seed logged).
+TEST(CsvReader, ValuesBeyondAnyImuAreErrorsAtTheirLine) {
+  const std::uint64_t seed = 20261124;
+  std::mt19937_64 rng(seed);
+  CsvImuOptions o;
+  o.rate_hz = 100.0;
+  o.gyro_unit = "rad/s";
+  o.acc_unit = "m/s2";
+  for (int k = 0; k < 8; ++k) {
+    const int rows = 20 + int(rng() % 200), bad = int(rng() % rows), col = int(rng() % 6);
+    const double limit = col < 3 ? 1.0e3 : 1.0e5;
+    const double v = (rng() % 2 ? -1.0 : 1.0) * limit * std::pow(10.0, 0.01 + 297.0 * std::uniform_real_distribution<>(0, 1)(rng));
+    std::ostringstream text;
+    text << "gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n";
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < 6; ++c) text << (r == bad && c == col ? v : 0.5 * c) << (c == 5 ? '\n' : ',');
+    SCOPED_TRACE("seed " + std::to_string(seed) + " case " + std::to_string(k) + ": row " + std::to_string(bad) +
+                 " column " + std::to_string(col + 1) + " value " + std::to_string(v));
+    const auto m = errorOf(writeFile("big.csv", text.str()), o);
+    EXPECT_NE(m.find("big.csv:" + std::to_string(bad + 2) + ": column " + std::to_string(col + 1)), std::string::npos) << m;
+    EXPECT_NE(m.find("beyond any IMU"), std::string::npos) << m;
+  }
+  // The limit itself is a value (57,000 deg/s; 10,000 g).
+  EXPECT_EQ(errorOf(writeFile("edge.csv", "gyro_x,acc_x\n1000,100000\n-1000,-100000\n"), o), "");
 }

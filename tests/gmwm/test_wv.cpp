@@ -260,3 +260,31 @@ TEST(Wv, BatchNamesSourceAndChannel) {
   ASSERT_EQ(w.size(), 6u);
   EXPECT_EQ(w[5].wv, w[0].wv);
 }
+
+// A result that is not finite (a sample so large that its square overflows) is
+// an error naming the file, the channel and the cause, never inf in wv.csv.
+TEST(Wv, NonFiniteResultIsAnErrorNamingTheCause) {
+  const std::uint64_t seed = 77;
+  std::mt19937_64 rng(seed);
+  ImuSeries s;
+  s.source = "big_sample.csv";
+  s.rate_hz = 100;
+  const int n = 512 + int(rng() % 512), at = int(rng() % n);
+  const double big = std::pow(10.0, 160.0 + 140.0 * std::uniform_real_distribution<>(0, 1)(rng));
+  SCOPED_TRACE("seed 77: n " + std::to_string(n) + " sample " + std::to_string(at) + " = " + std::to_string(big));
+  ImuChannel ch;
+  ch.name = "gyro_z";
+  ch.quantity = channelQuantity(ch.name);
+  std::normal_distribution<> g(0, 1e-3);
+  for (int i = 0; i < n; ++i) ch.x.push_back(g(rng));
+  ch.x[at] = big;
+  s.channels.push_back(ch);
+  try {
+    gmwm::waveletVariances(s);
+    FAIL() << "accepted a non-finite wavelet variance";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("big_sample.csv: channel gyro_z: wavelet variance at tau"), std::string::npos) << m;
+    EXPECT_NE(m.find("is not finite"), std::string::npos) << m;
+  }
+}

@@ -148,7 +148,7 @@ TEST(RawlogImuReader, TruncatedGzipIsAnError) {
   const auto p = (test::tempDir() / "cut.rawlog.gz").string();
   writeObsOnly(p, 3000, true);
   fs::resize_file(p, fs::file_size(p) / 2);
-  expectError([&] { rawlog::readImuRawlog(p); }, {p, "entry", "truncated or malformed"});
+  expectError([&] { rawlog::readImuRawlog(p); }, {p, "entry", "truncated gzip data"});
 }
 
 TEST(RawlogImuReader, BackwardsAndGappyTimestamps) {

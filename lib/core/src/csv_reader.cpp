@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/gz_input.hpp"
 #include "navimpact/core/text_io.hpp"
 
 namespace navimpact {
@@ -44,12 +45,22 @@ struct Column {
 
 ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
   InputScope scope(path);
-  const std::string text = readFileMaybeGz(path);
-  if (trim(text).empty()) throw fileError(path, 0, "file is empty");
+  // Streamed line by line (bounded memory: one buffer plus the samples), each
+  // line at most LineReader::kDefaultMaxLine bytes.
+  LineReader lines(path);
+  std::string_view first;
+  bool any = false;
+  while (lines.next(first))
+    if (!trim(first).empty()) {
+      any = true;
+      break;
+    }
+  if (!any) throw fileError(path, 0, "file is empty");
+  if (lines.lineNo() != 1) throw fileError(path, lines.lineNo(), "the header must be the first line");
 
   // --- header --------------------------------------------------------------
-  std::size_t pos = text.find('\n');
-  std::string_view header(text.data(), pos == std::string::npos ? text.size() : pos);
+  const std::string headerText(first);
+  std::string_view header(headerText);
   std::size_t lineNo = 1;
   const auto names = splitView(header, ',');
   std::vector<Column> cols(names.size());
@@ -100,22 +111,18 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
 
   // --- rows ----------------------------------------------------------------
   std::vector<std::vector<double>> data(6);
-  const std::size_t approxRows = std::count(text.begin(), text.end(), '\n') + 1;
+  // Capacity from the size the file states and the header's length (a guess; vectors still grow).
+  const std::size_t approxRows = static_cast<std::size_t>(std::min<std::uint64_t>(
+      lines.input().statedSize() / std::max<std::size_t>(header.size(), 8) + 16, std::uint64_t(1) << 26));
   for (int i = 0; i < 6; ++i)
     if (present[i] >= 0) data[i].reserve(approxRows);
   std::vector<double> times;
   if (timeCol >= 0) times.reserve(approxRows);
 
-  const char* p = text.data() + (pos == std::string::npos ? text.size() : pos + 1);
-  const char* end = text.data() + text.size();
   const std::size_t ncol = cols.size();
-  while (p < end) {
-    ++lineNo;
-    const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
-    if (!eol) eol = end;
-    std::string_view line(p, static_cast<std::size_t>(eol - p));
-    p = eol + 1;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  std::string_view line;
+  while (lines.next(line)) {
+    lineNo = lines.lineNo();
     if (trim(line).empty()) continue;
     std::size_t c = 0, start = 0;
     for (;; ++c) {
@@ -135,10 +142,18 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
           throw fileError(path, lineNo, "column " + std::to_string(c + 1) + " ('" +
                                             printable(trim(names[c])) + "'): value is " +
                                             printable(trim(field)));
-        if (cols[c].channel == -2)
+        if (cols[c].channel == -2) {
           times.push_back(v);
-        else
-          data[cols[c].channel].push_back(v * cols[c].factor);
+        } else {
+          const double si = v * cols[c].factor;
+          const double lim = maxAbsSample(channelQuantity(kChannelNames[cols[c].channel]));
+          if (!(std::abs(si) <= lim))
+            throw fileError(path, lineNo, "column " + std::to_string(c + 1) + " ('" + printable(trim(names[c])) +
+                                              "'): " + printable(trim(field)) + " is beyond any IMU (|value| <= " +
+                                              (lim == kMaxAbsAngularRate ? "1000 rad/s" : "1e5 m/s^2") +
+                                              " in SI); check the data and the unit");
+          data[cols[c].channel].push_back(si);
+        }
       }
       if (last) break;
       start = comma + 1;

@@ -7,36 +7,24 @@
 #include <memory>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/gz_input.hpp"
 
 namespace navimpact {
 
-std::string readFileMaybeGz(const std::string& path) {
-  // gzopen reads plain files unchanged and gzip files decompressed.
-  gzFile f = gzopen(path.c_str(), "rb");
-  if (!f) throw Error(path + ": cannot open file");
-  gzbuffer(f, 1 << 20);
+std::string readFileMaybeGz(const std::string& path, std::size_t max_bytes) {
+  GzInput in(path);  // plain or gzip, strict (corrupt, truncated, trailing garbage)
   std::string out;
-  std::size_t chunk = 1 << 22;
+  std::size_t chunk = std::size_t(1) << 16;
   for (;;) {
     const std::size_t old = out.size();
+    if (old > max_bytes)
+      throw Error(path + ": larger than " + std::to_string(max_bytes) + " bytes, more than this kind of file can be");
     out.resize(old + chunk);
-    const int n = gzread(f, out.data() + old, static_cast<unsigned>(chunk));
-    if (n < 0) {
-      int err = 0;
-      const char* msg = gzerror(f, &err);
-      std::string m = msg ? msg : "read error";
-      gzclose(f);
-      throw Error(path + ": cannot read (" + m + ")");
-    }
-    out.resize(old + static_cast<std::size_t>(n));
+    const std::size_t n = in.read(out.data() + old, chunk);
+    out.resize(old + n);
     if (n == 0) break;
-    if (chunk < (std::size_t(1) << 26)) chunk *= 2;
+    if (chunk < (std::size_t(1) << 24)) chunk *= 2;
   }
-  int err = 0;
-  gzerror(f, &err);
-  gzclose(f);
-  if (err != Z_OK && err != Z_STREAM_END)
-    throw Error(path + ": truncated or corrupt compressed file");
   return out;
 }
 

@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <map>
+#include <algorithm>
 
 #include <Eigen/Geometry>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/gz_input.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/core/units.hpp"
 
@@ -49,20 +51,17 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
     throw keyError(path, "trajectory.time_unit", "'" + spec.time_unit + "' is not 's' or 'ms'");
   if (!(spec.max_gap_s > 0.0)) throw keyError(path, "trajectory.max_gap_s", "must be > 0");
 
-  const std::string text = readFileMaybeGz(path);
-  std::size_t pos = 0, lineNo = 0;
+  LineReader reader(path);  // streamed, lines of at most 1 MiB
+  std::size_t lineNo = 0;
   auto nextLine = [&](std::string_view& line) {
-    if (pos >= text.size()) return false;
-    std::size_t e = text.find('\n', pos);
-    if (e == std::string::npos) e = text.size();
-    line = std::string_view(text.data() + pos, e - pos);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    pos = e + 1;
-    ++lineNo;
+    if (!reader.next(line)) return false;
+    lineNo = reader.lineNo();
     return true;
   };
-  std::string_view header;
-  if (!nextLine(header) || trim(header).empty()) throw fileError(path, 1, "empty file, expected a header line");
+  std::string_view headerView;
+  if (!nextLine(headerView) || trim(headerView).empty()) throw fileError(path, 1, "empty file, expected a header line");
+  const std::string headerText(headerView);
+  const std::string_view header(headerText);
   const auto names = splitView(header, ',');
   std::map<std::string, int> colIndex;
   for (std::size_t i = 0; i < names.size(); ++i) colIndex[std::string(trim(names[i]))] = int(i);
@@ -82,7 +81,7 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
   SampledTrajectory out;
   out.source = path;
   std::vector<std::array<double, 7>> rows;
-  rows.reserve(text.size() / 60);
+  rows.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(reader.input().statedSize() / 60, 1u << 24)));
   std::vector<std::size_t> lines;
   std::string_view line;
   while (nextLine(line)) {
@@ -94,7 +93,7 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
     std::array<double, 7> r{};
     for (int k = 0; k < 7; ++k) {
       if (!parseDouble(trim(f[idx[k]]), r[k]))
-        throw fileError(path, lineNo, "column '" + want[k] + "': '" + std::string(f[idx[k]]) + "' is not a number");
+        throw fileError(path, lineNo, "column '" + want[k] + "': '" + printable(f[idx[k]]) + "' is not a number");
       if (!std::isfinite(r[k]))
         throw fileError(path, lineNo, "column '" + want[k] + "': value is NaN or infinite");
     }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
+#include <cstdio>
 #include <atomic>
 #include <cstdlib>
 #include <new>
@@ -348,6 +349,19 @@ std::vector<WaveletVariance> waveletVariances(const ImuSeries& s, const WvOption
       std::rethrow_exception(err[c]);
     } catch (const Error& e) {
       throw Error(s.source + ": channel " + s.channels[c].name + ": " + e.what());
+    }
+  }
+  // A non-finite result is an error naming its cause, never a file with inf/null.
+  for (std::size_t c = 0; c < nc; ++c) {
+    const auto& w = out[c];
+    for (Eigen::Index j = 0; j < w.wv.size(); ++j) {
+      if (std::isfinite(w.wv[j]) && std::isfinite(w.ci_low[j]) && std::isfinite(w.ci_high[j])) continue;
+      const auto& x = s.channels[c].x;
+      double big = 0.0;
+      for (double v : x) big = std::max(big, std::isfinite(v) ? std::abs(v) : HUGE_VAL);
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%g s is not finite (the samples reach |x| = %g)", w.tau[j] / s.rate_hz, big);
+      throw Error(s.source + ": channel " + s.channels[c].name + ": wavelet variance at tau = " + buf);
     }
   }
   return out;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <map>
@@ -17,12 +18,18 @@
 #include <sstream>
 #include <vector>
 
-#include "mrpt_errors.hpp"
+#include "entry_reader.hpp"
 #include "navimpact/core/error.hpp"
 
 namespace navimpact::rawlog {
 
 namespace {
+
+std::string fmtG(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
 
 std::string fmtTime(double t) {
   std::ostringstream os;
@@ -36,25 +43,12 @@ struct Sample {
   double v[6];
 };
 
-void openOrThrow(mrpt::io::CFileGZInputStream& f, const std::string& path) {
-  if (!std::filesystem::exists(path)) throw Error(path + ": file not found");
-  bool ok = false;
-  try {
-    ok = f.open(path);
-  } catch (const std::exception& e) {
-    throw Error(path + ": cannot open rawlog (" + detail::mrptCause(e) + ")");
-  }
-  if (!ok) throw Error(path + ": cannot open rawlog");
-}
-
 }  // namespace
 
 ImuSeries readImuRawlog(const std::string& path, const std::string& label) {
   InputScope scope(path);
-  mrpt::obs::registerAllClasses_mrpt_obs();
-  mrpt::io::CFileGZInputStream f;
-  openOrThrow(f, path);
-  auto arch = mrpt::serialization::archiveFrom(f);
+  if (!std::filesystem::exists(path)) throw Error(path + ": file not found");
+  detail::EntryReader reader(path);
 
   std::vector<Sample> samples;
   std::map<std::string, std::size_t> labelsFound;  // "label (Class)" -> count
@@ -83,21 +77,18 @@ ImuSeries readImuRawlog(const std::string& path, const std::string& label) {
       if (!std::isfinite(s.v[k]))
         throw Error(path + ": entry " + std::to_string(entry) + " (t = " + fmtTime(s.t) + " s): " +
                     names[k] + " is not finite");
+      if (std::abs(s.v[k]) > (k < 3 ? kMaxAbsAngularRate : kMaxAbsSpecificForce))
+        throw Error(path + ": entry " + std::to_string(entry) + " (t = " + fmtTime(s.t) + " s): " + names[k] +
+                    " = " + fmtG(s.v[k]) + " is beyond any IMU (|value| <= " +
+                    (k < 3 ? "1000 rad/s" : "1e5 m/s^2") + ")");
     }
     samples.push_back(s);
   };
 
-  for (;; ++entry) {
-    mrpt::serialization::CSerializable::Ptr obj;
-    try {
-      obj = arch.ReadObject();
-    } catch (const mrpt::serialization::CExceptionEOF&) {
-      break;  // clean end of file, between two objects
-    } catch (const std::exception& e) {
-      throw Error(path + ": entry " + std::to_string(entry) +
-                  ": truncated or malformed rawlog object (" + detail::mrptCause(e) + ")");
-    }
-    if (!obj) continue;
+  for (;;) {
+    const mrpt::serialization::CSerializable::Ptr obj = reader.next();
+    if (!obj) break;  // clean end of file, between two objects
+    entry = reader.entry();
     if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj)) {
       for (const auto& o : *sf) handle(o);
     } else if (auto o = std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj)) {
@@ -161,12 +152,14 @@ bool isRawlogFile(const std::string& path) {
     return p.size() >= suf.size() && p.compare(p.size() - suf.size(), suf.size(), suf) == 0;
   };
   if (endsWith(".rawlog") || endsWith(".rawlog.gz")) return true;
-  mrpt::io::CFileGZInputStream f;
-  openOrThrow(f, path);
-  unsigned char b = 0;
-  if (f.Read(&b, 1) != 1) return false;  // empty: not a rawlog (the CSV reader reports it)
+  GzInput f(path);
+  unsigned char b[3] = {0, 0, 0};
+  const std::size_t n = f.read(b, 3);
+  if (n == 0) return false;  // empty: not a rawlog (the CSV reader reports it)
+  // A UTF-8 byte-order mark starts a text (CSV) file.
+  if (n == 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF) return false;
   // Serialized MRPT objects start with a header byte >= 0x80; CSV starts with text.
-  return b >= 0x80 || (b < 0x20 && b != '\t' && b != '\n' && b != '\r');
+  return b[0] >= 0x80 || (b[0] < 0x20 && b[0] != '\t' && b[0] != '\n' && b[0] != '\r');
 }
 
 }  // namespace navimpact::rawlog

@@ -11,13 +11,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <vector>
 
-#include "mrpt_errors.hpp"
+#include "entry_reader.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/imu_series.hpp"
 
 namespace navimpact::rawlog {
 
@@ -37,52 +39,6 @@ double seconds(const mrpt::Clock::time_point& ts, long long startUnix) {
   const auto base = mrpt::Clock::fromDouble(static_cast<double>(startUnix));
   return static_cast<double>((ts - base).count()) * kTick;
 }
-
-/// Read-only stream over a gzip (or plain) file with a large read-ahead buffer.
-class BufferedGzInput : public mrpt::io::CStream {
- public:
-  mrpt::io::CFileGZInputStream gz;
-  size_t Read(void* out, size_t n) override {
-    auto* dst = static_cast<unsigned char*>(out);
-    size_t done = 0;
-    while (done < n) {
-      if (head_ == buf_.size() && !refill()) break;
-      const size_t k = std::min(n - done, buf_.size() - head_);
-      std::memcpy(dst + done, buf_.data() + head_, k);
-      head_ += k;
-      done += k;
-    }
-    pos_ += done;
-    return done;
-  }
-  size_t Write(const void*, size_t) override { throw std::runtime_error("read-only stream"); }
-  uint64_t Seek(int64_t, mrpt::io::CStream::TSeekOrigin) override { throw std::runtime_error("not seekable"); }
-  uint64_t getTotalBytesCount() const override { return 0; }
-  uint64_t getPosition() const override { return pos_; }
-  /// True when no byte is left (reads ahead if needed).
-  bool atEnd() { return head_ == buf_.size() && !refill(); }
-
- private:
-  bool refill() {
-    if (eof_) return false;
-    buf_.resize(kChunk);
-    size_t got = 0;
-    try {
-      got = gz.Read(buf_.data(), kChunk);
-    } catch (const std::exception&) {
-      got = 0;  // corrupt or truncated gzip: deserialising what came out names the entry
-    }
-    buf_.resize(got);
-    head_ = 0;
-    if (got == 0) eof_ = true;
-    return got > 0;
-  }
-  static constexpr size_t kChunk = size_t(1) << 20;
-  std::vector<unsigned char> buf_;
-  size_t head_ = 0;
-  uint64_t pos_ = 0;
-  bool eof_ = false;
-};
 
 struct Entry {
   double t;
@@ -217,11 +173,9 @@ void writeRawlog(const std::string& path, const emulation::EmulationData& d, con
 emulation::EmulationData readRawlog(const std::string& path) {
   InputScope scope(path);
   if (!std::filesystem::exists(path)) throw Error(path + ": rawlog not found");
-  // Read through a 1 MiB buffer: MRPT's archive reads every field with its own
-  // small Read() call, which on the bare gzip stream costs a gzread() each.
-  BufferedGzInput in;
-  if (!in.gz.open(path)) throw Error(path + ": cannot open the rawlog");
-  auto arch = mrpt::serialization::archiveFrom(in);
+  // Entries through one 1 MiB buffer (MRPT's archive reads every field with its
+  // own small Read() call), with the length caps and gzip checks of EntryReader.
+  detail::EntryReader reader(path);
   emulation::EmulationData d;
   bool haveComment = false, haveOrigin = false, haveBase = false;
   mrpt::Clock::time_point base{};
@@ -237,17 +191,10 @@ emulation::EmulationData readRawlog(const std::string& path) {
     if (!label.empty()) s += " (label " + printable(label, 40) + (std::isfinite(t) ? ", t = " + std::to_string(t) + " s" : "") + ")";
     return s;
   };
-  for (;; ++entry) {
-    mrpt::serialization::CSerializable::Ptr obj;
-    if (in.atEnd()) break;  // clean end between entries
-    try {
-      obj = arch.ReadObject();
-    } catch (const mrpt::serialization::CExceptionEOF&) {
-      throw Error(where("", NAN) + ": truncated entry (the file ends inside it)");
-    } catch (const std::exception& e) {
-      throw Error(where("", NAN) + ": malformed or truncated entry (" + detail::mrptCause(e) + ")");
-    }
-    if (!obj) break;
+  for (;;) {
+    const mrpt::serialization::CSerializable::Ptr obj = reader.next();
+    if (!obj) break;  // clean end between entries
+    entry = reader.entry();
     if (auto c = std::dynamic_pointer_cast<mrpt::obs::CObservationComment>(obj)) {
       if (!haveComment) {
         haveComment = true;
@@ -298,14 +245,30 @@ emulation::EmulationData readRawlog(const std::string& path) {
       if (!m) throw Error(where(label, t) + ": expected a CObservationIMU, found " + o->GetRuntimeClass()->className);
       auto need = [&](mrpt::obs::TIMUDataIndex i, const char* name) {
         if (!m->has(i)) throw Error(where(label, t) + ": field " + name + " is not set");
-        return m->get(i);
+        const double v = m->get(i);
+        if (!std::isfinite(v)) throw Error(where(label, t) + ": field " + name + " is not finite");
+        return v;
+      };
+      auto rate = [&](mrpt::obs::TIMUDataIndex i, const char* name, double lim, const char* limText) {
+        const double v = need(i, name);
+        if (std::abs(v) > lim) {
+          char b[32];
+          std::snprintf(b, sizeof b, "%g", v);
+          throw Error(where(label, t) + ": " + name + " = " + b + " is beyond any IMU (|value| <= " + limText + ")");
+        }
+        return v;
       };
       if (label == "IMU") {
         emulation::ImuRecord r;
         r.t = t;
-        r.w_IB_B = {need(mrpt::obs::IMU_WX, "IMU_WX"), need(mrpt::obs::IMU_WY, "IMU_WY"), need(mrpt::obs::IMU_WZ, "IMU_WZ")};
-        r.f_B = {need(mrpt::obs::IMU_X_ACC, "IMU_X_ACC"), need(mrpt::obs::IMU_Y_ACC, "IMU_Y_ACC"),
-                 need(mrpt::obs::IMU_Z_ACC, "IMU_Z_ACC")};
+        const char* w = "1000 rad/s";
+        const char* f = "1e5 m/s^2";
+        r.w_IB_B = {rate(mrpt::obs::IMU_WX, "IMU_WX", kMaxAbsAngularRate, w),
+                    rate(mrpt::obs::IMU_WY, "IMU_WY", kMaxAbsAngularRate, w),
+                    rate(mrpt::obs::IMU_WZ, "IMU_WZ", kMaxAbsAngularRate, w)};
+        r.f_B = {rate(mrpt::obs::IMU_X_ACC, "IMU_X_ACC", kMaxAbsSpecificForce, f),
+                 rate(mrpt::obs::IMU_Y_ACC, "IMU_Y_ACC", kMaxAbsSpecificForce, f),
+                 rate(mrpt::obs::IMU_Z_ACC, "IMU_Z_ACC", kMaxAbsSpecificForce, f)};
         d.imu.push_back(r);
       } else if (label == "BARO") {
         d.baro.push_back({t, need(mrpt::obs::IMU_ALTITUDE, "IMU_ALTITUDE"), NAN});
@@ -349,6 +312,11 @@ emulation::EmulationData readRawlog(const std::string& path) {
       } else {
         throw Error(where(label, t) + ": GNSS entry has neither a TOPCON_PZS nor an NMEA GGA message");
       }
+      if (!std::isfinite(f.pos.lat) || !std::isfinite(f.pos.lon) || !std::isfinite(f.pos.h) ||
+          std::abs(f.pos.lat) > M_PI / 2 || std::abs(f.pos.lon) > 2 * M_PI || std::abs(f.pos.h) > 1e7)
+        throw Error(where(label, t) + ": GNSS position is not a place on Earth (latitude, longitude, height)");
+      if (!(f.v_N.array().isFinite().all() || f.v_N.array().isNaN().all()))
+        throw Error(where(label, t) + ": GNSS velocity is not finite");
       d.gnss.push_back(f);
     } else {
       ++skipped;

@@ -24,6 +24,16 @@ int channelIndex(const std::string& name);
 /// Quantity measured by a canonical channel ("gyro_*" rate, "acc_*" specific force).
 units::Quantity channelQuantity(const std::string& name);
 
+/// Largest |sample| a reader accepts, SI: beyond any IMU, so that garbage
+/// (1e300, a wrong unit by 10^6) is an error at the line or entry that holds
+/// it instead of an overflow later. Angular rate 1,000 rad/s (57,000 deg/s);
+/// specific force 1e5 m/s^2 (10,000 g).
+constexpr double kMaxAbsAngularRate = 1.0e3;
+constexpr double kMaxAbsSpecificForce = 1.0e5;
+inline double maxAbsSample(units::Quantity q) {
+  return q == units::Quantity::AngularRate ? kMaxAbsAngularRate : kMaxAbsSpecificForce;
+}
+
 /// One channel of samples, SI units (rad/s or m/s^2).
 struct ImuChannel {
   std::string name;          ///< canonical name, e.g. "gyro_z"

@@ -11,11 +11,13 @@
 namespace navimpact {
 
 /**
- * Read a whole file into memory; gzip-compressed files (any name) are
- * decompressed transparently.
- * @throws navimpact::Error naming the file if it cannot be opened or is corrupt.
+ * Read a whole (small) file into memory; gzip-compressed files (any name) are
+ * decompressed transparently and strictly (see GzInput). Large inputs are
+ * streamed instead (LineReader, GzInput).
+ * @throws navimpact::Error naming the file if it cannot be opened, is corrupt,
+ *         or holds more than @p max_bytes bytes.
  */
-std::string readFileMaybeGz(const std::string& path);
+std::string readFileMaybeGz(const std::string& path, std::size_t max_bytes = std::size_t(64) << 20);
 
 /// Split on a delimiter, no trimming; empty fields are kept.
 std::vector<std::string_view> splitView(std::string_view s, char delim);

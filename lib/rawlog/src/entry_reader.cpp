@@ -1,0 +1,82 @@
+#include "entry_reader.hpp"
+
+#include <mrpt/obs/registerAllClasses.h>
+
+#include <algorithm>
+#include <new>
+#include <stdexcept>
+
+#include "mrpt_errors.hpp"
+#include "navimpact/core/alloc_limit.hpp"
+
+namespace navimpact::rawlog::detail {
+
+size_t GzCStream::Read(void* out, size_t n) {
+  if (error) return 0;
+  try {
+    return in_.read(out, n);
+  } catch (const Error& e) {
+    error = e;
+    return 0;
+  }
+}
+
+size_t GzCStream::Write(const void*, size_t) { throw std::runtime_error("read-only stream"); }
+
+uint64_t GzCStream::Seek(int64_t, mrpt::io::CStream::TSeekOrigin) { throw std::runtime_error("not seekable"); }
+
+EntryReader::EntryReader(const std::string& path) : in_(path), stream_(in_), arch_(stream_) {
+  mrpt::obs::registerAllClasses_mrpt_obs();
+}
+
+std::size_t EntryReader::allocationCap() const {
+  constexpr std::uint64_t kFloor = std::uint64_t(64) << 20;
+  return static_cast<std::size_t>(std::max<std::uint64_t>(kFloor, in_.statedSize()));
+}
+
+void EntryReader::fail(const std::string& what) const {
+  throw Error(in_.path() + ": entry " + std::to_string(entry_) + ": " + what);
+}
+
+mrpt::serialization::CSerializable::Ptr EntryReader::next() {
+  try {
+    if (in_.atEnd()) return nullptr;  // clean end, between two entries
+  } catch (const Error& e) {
+    ++entry_;
+    throw;
+  }
+  ++entry_;
+  auto streamError = [this]() -> std::string {
+    std::string m = stream_.error->what();
+    const std::string pre = in_.path() + ": ";
+    return m.rfind(pre, 0) == 0 ? m.substr(pre.size()) : m;
+  };
+  auto refused = [this]() -> std::string {
+    const std::size_t n = AllocationLimit::takeRefused();
+    if (n == 0) return {};
+    return "a length field asks for " + std::to_string(n) + " bytes, more than the file can hold (" +
+           std::to_string(in_.statedSize()) + " bytes decompressed): malformed entry";
+  };
+  AllocationLimit::takeRefused();
+  try {
+    AllocationLimit limit(allocationCap());
+    auto obj = arch_.ReadObject();
+    if (!obj) fail("empty object (malformed entry)");
+    return obj;
+  } catch (const mrpt::serialization::CExceptionEOF&) {
+    if (stream_.error) fail(streamError());
+    if (const auto r = refused(); !r.empty()) fail(r);
+    fail("truncated or malformed entry (the file ends inside it)");
+  } catch (const std::bad_alloc&) {
+    if (const auto r = refused(); !r.empty()) fail(r);
+    fail("out of memory while decoding the entry");
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    if (stream_.error) fail(streamError());
+    if (const auto r = refused(); !r.empty()) fail(r);
+    fail("truncated or malformed entry (" + mrptCause(e) + ")");
+  }
+}
+
+}  // namespace navimpact::rawlog::detail

@@ -1,0 +1,70 @@
+// Bad rawlogs: each reader stops with one navimpact::Error naming the file and
+// the entry, in bounded memory and time. The files under tests/data/bad are
+// regressions (a real MRPT rawlog with one field corrupted).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/rawlog/imu_reader.hpp"
+#include "navimpact/rawlog/writer.hpp"
+#include "test_support.hpp"
+
+using namespace navimpact;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string message(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+std::string bad(const std::string& name) { return test::sourcePath("tests/data/bad/" + name); }
+
+void expectBoth(const std::string& path, const std::string& label, const std::vector<std::string>& parts) {
+  for (int reader = 0; reader < 2; ++reader) {
+    const std::string m = message([&] {
+      if (reader == 0) rawlog::readImuRawlog(path, label);
+      else rawlog::readRawlog(path);
+    });
+    for (const auto& p : parts) EXPECT_NE(m.find(p), std::string::npos) << "reader " << reader << ": '" << p << "' not in: " << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
+}  // namespace
+
+// A string length of 0xffffffff in a 1.8 KB file: refused before allocating
+// (it took 4.26 GB and 27 s before the cap).
+TEST(RawlogBadInput, LengthFieldLargerThanTheFileIsRefused) {
+  expectBoth(bad("huge_string_length.rawlog"), "XSENS",
+             {bad("huge_string_length.rawlog"), ": entry 0: a length field asks for 4294967296 bytes",
+              "more than the file can hold (1776 bytes decompressed)"});
+}
+
+TEST(RawlogBadInput, UnregisteredClassNamesTheCause) {
+  expectBoth(bad("unregistered_class.rawlog"), "XSENS",
+             {": entry 2: ", "stored object has class 'mrpt::poses\\xC7:CPose3D' which is not registered"});
+}
+
+TEST(RawlogBadInput, TrailingGarbageAfterTheGzipDataIsAnError) {
+  const auto src = test::sourcePath("tests/data/imu_label_xsens.rawlog");  // gzip
+  const auto p = (test::tempDir() / "tail.rawlog").string();
+  fs::copy_file(src, p);
+  std::ofstream(p, std::ios::app | std::ios::binary) << "trailing junk";
+  expectBoth(p, "XSENS", {p, "13 bytes of trailing garbage after the gzip data"});
+}
+
+TEST(RawlogBadInput, CsvWithByteOrderMarkIsNotSniffedAsRawlog) {
+  const auto p = (test::tempDir() / "bom.csv").string();
+  std::ofstream(p, std::ios::binary) << "\xEF\xBB\xBFgyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n1,2,3,4,5,6\n";
+  EXPECT_FALSE(rawlog::isRawlogFile(p));
+}
