@@ -121,7 +121,8 @@ INSTANTIATE_TEST_SUITE_P(AllCauses, HiddenCause,
                          [](const auto& info) { return std::string(na::causeName(info.param)); });
 
 TEST(Diagnose, TwoEffectsOnOneChannel) {
-  // A random pair of different causes on one channel, each at 5x its limit.
+  // A random pair of different causes on one channel, each at 5x its limit in
+  // the noise it sits in (the base model plus the other effect's random part).
   const int R = runs(24);
   std::mt19937_64 rng(rootSeed() + 77);
   const std::vector<na::Cause> all = {na::Cause::WhiteNoise, na::Cause::RandomWalk, na::Cause::GaussMarkov,
@@ -143,10 +144,11 @@ TEST(Diagnose, TwoEffectsOnOneChannel) {
     if (!ok) std::cout << "  [" << na::causeName(a) << "+" << na::causeName(b) << " seed " << s << "] " << out.why << "\n";
   }
   std::cout << "two effects on one channel: both right " << both << "/" << R << "\n";
-  // Known gap (README "Detection power"): with two effects on one channel the
-  // second is missed or misattributed in about 40 % of the draws (e.g. a
-  // random walk under a Gauss-Markov process, a level shift next to one).
-  EXPECT_GE(both, 0.5 * R);
+  // Known gap (README "Detection power"): below the 90 % (17/24 at
+  // the root seed): a random walk next to a Gauss-Markov process is taken
+  // for a drift or absorbed into a longer GM, white noise next to a GM for
+  // quantisation noise.
+  EXPECT_GE(both, 0.6 * R);
 }
 
 TEST(Diagnose, GainIsSignificantOnlyWhenTheHeldOutCriteriaImprove) {

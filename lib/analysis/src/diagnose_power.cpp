@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <ctime>
 #include <mutex>
 #include <random>
@@ -173,14 +174,34 @@ Case drawCase(const std::vector<Cause>& causes, const DrawRanges& rg, double snr
   }
   c.channel = channels == 1 ? 0 : static_cast<int>(rng.next() % 6);
   const int ci = channels == 1 ? first : c.channel;
-  const stochastic::Model& m = c.model.axis[ci];
-  auto& x = c.data.channels[c.channel].x;
+  const stochastic::Model& base = c.model.axis[ci];
+  auto& x_out = c.data.channels[c.channel].x;
+  // Each effect's size is a multiple of its limit in the noise it sits in:
+  // the base model plus the other effects' random (and drift) parts. Pass 1
+  // sizes every effect against the base model alone; pass 2 draws the same
+  // shapes (same random stream) and sizes each against the base plus the
+  // others' pass-1 processes, and writes the record. One effect: the base.
+  std::vector<std::optional<stochastic::Process>> noise_of(causes.size());
+  const Rng rng_start = rng;
+  std::vector<double> scratch(n, 0.0);
+  const int passes = causes.size() > 1 ? 2 : 1;
+  for (int pass = 0; pass < passes; ++pass) {
+  const bool last = pass == passes - 1;
+  rng = rng_start;
+  std::vector<std::optional<stochastic::Process>> noise_now(causes.size());
+  auto& x = last ? x_out : scratch;
   for (std::size_t e = 0; e < causes.size(); ++e) {
+    stochastic::Model m = base;
+    if (pass > 0)
+      for (std::size_t o = 0; o < causes.size(); ++o)
+        if (o != e && noise_of[o]) m.terms.push_back(*noise_of[o]);
     Hidden h;
     h.cause = causes[e];
     h.snr = snr_factor;
     const std::uint64_t ps = stochastic::deriveSeed(seed, 200 + e);
     auto addProc = [&](const stochastic::Process& p) {
+      noise_now[e] = p;
+      if (!last) return;
       stochastic::Model mm;
       mm.rate_hz = rate;
       mm.terms = {p};
@@ -212,7 +233,9 @@ Case drawCase(const std::vector<Cause>& causes, const DrawRanges& rg, double snr
       case Cause::Drift: {
         const double w = std::sqrt(wvScaleFor(stochastic::Process::dr(1.0), m, n, target));
         const double sign = rng.u() < 0.5 ? -1.0 : 1.0;
-        for (std::size_t k = 0; k < n; ++k) x[k] += sign * w * static_cast<double>(k);
+        noise_now[e] = stochastic::Process::dr(w);
+        if (last)
+          for (std::size_t k = 0; k < n; ++k) x[k] += sign * w * static_cast<double>(k);
         h.truth = {{"omega", w}};
         break;
       }
@@ -227,14 +250,16 @@ Case drawCase(const std::vector<Cause>& causes, const DrawRanges& rg, double snr
         const double f = rng.logU(5.0 / record, 0.45 * rate);
         const double a = snr_factor * lineLimit(m, f, n);
         const double ph = 2 * kPi * rng.u();
-        for (std::size_t k = 0; k < n; ++k) x[k] += a * std::sin(2 * kPi * f * static_cast<double>(k) / rate + ph);
+        if (last)
+          for (std::size_t k = 0; k < n; ++k) x[k] += a * std::sin(2 * kPi * f * static_cast<double>(k) / rate + ph);
         h.truth = {{"amplitude", a}, {"freq_hz", f}};
         break;
       }
       case Cause::LevelShift: {
         const std::size_t k0 = static_cast<std::size_t>((0.1 + 0.8 * rng.u()) * static_cast<double>(n));
         const double size = (rng.u() < 0.5 ? -1.0 : 1.0) * snr_factor * stepLimit(m, n, k0);
-        for (std::size_t k = k0; k < n; ++k) x[k] += size;
+        if (last)
+          for (std::size_t k = k0; k < n; ++k) x[k] += size;
         h.truth = {{"size", size}, {"t_s", static_cast<double>(k0) / rate}};
         break;
       }
@@ -253,16 +278,22 @@ Case drawCase(const std::vector<Cause>& causes, const DrawRanges& rg, double snr
           at.push_back(k);
           const int len = rng.u() < 0.5 ? 1 : 2 + static_cast<int>(rng.next() % 19);
           const double sign = rng.u() < 0.5 ? -1.0 : 1.0;
-          for (int j = 0; j < len; ++j) x[k + j] += (j % 2 ? -1.0 : 1.0) * sign * height;
+          if (last)
+            for (int j = 0; j < len; ++j) x[k + j] += (j % 2 ? -1.0 : 1.0) * sign * height;
         }
         h.events = count;
         h.truth = {{"count", static_cast<double>(count)}};
         break;
       }
     }
-    txt << " | hidden " << causeName(h.cause) << " at " << fmtNum(snr_factor, 3) << "x limit:";
+    if (!last) continue;
+    txt << " | hidden " << causeName(h.cause) << " at " << fmtNum(snr_factor, 3) << "x limit";
+    if (causes.size() > 1) txt << " (with the other effect as noise)";
+    txt << ":";
     for (const auto& kv : h.truth) txt << " " << kv.first << "=" << fmtNum(kv.second, 4);
     c.hidden.push_back(h);
+  }
+  noise_of = noise_now;
   }
   c.text = txt.str();
   return c;

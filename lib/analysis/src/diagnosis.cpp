@@ -20,6 +20,7 @@
 #include "navimpact/detect/lines.hpp"
 #include "navimpact/detect/null_model.hpp"
 #include "navimpact/detect/outliers.hpp"
+#include "navimpact/detect/step_test.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 #include "navimpact/stochastic/model_text.hpp"
@@ -847,12 +848,11 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   }
   sh.tick(cd.name + ": spectrum");
 
-  // 3. Level shifts, detected under the model and accepted only when "k
-  // shifts + the best stochastic extension of the model" explains the record
-  // better than "the best stochastic extension alone" (a random walk, a
-  // long Gauss-Markov or a drift also make large window contrasts): Gaussian
-  // multi-scale contrast log-likelihood with a BIC penalty of 0.5 log(number
-  // of contrasts) per parameter (2 per shift, 1-2 per process).
+  // 3. Level shifts, detected under the model and accepted only when each is
+  // significant against the best stochastic explanation of the record
+  // without shifts (a random walk, a long Gauss-Markov or a drift also make
+  // large window contrasts): exact likelihood-ratio test of block means,
+  // Bonferroni over the block boundaries (detect/step_test.hpp).
   const auto wv_pre = gmwm::waveletVariance(x.data(), n, rate);
   const std::vector<double> tau = toStd(wv_pre.tau);
   const std::size_t findings_pre = cd.findings.size();
@@ -864,7 +864,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     // runner-up of every shift and transient).
     int p_ext0 = 0;
     const Model ext0_model = [&]() {
-      if (cpr.transients.empty()) return m0n;  // only needed to judge transients
+      if (cpr.transients.empty() && cpr.changes.empty()) return m0n;  // only needed to judge those
       WvData d0{tau, toStd(wv_pre.wv), toStd(wv_pre.eta), static_cast<double>(n)};
       return greedyExtension(m0n, d0, opt.max_terms, &p_ext0);
     }();
@@ -926,81 +926,78 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
                         "each counts once however many samples it spans.";
     }
     if (!cpr.changes.empty()) {
-      double contrasts = 0;
-      for (std::size_t m = 16; 4 * m <= n; m *= 2) contrasts += static_cast<double>(n / m);
-      // BIC penalty 0.5 log(contrasts) per parameter, times 3: each sample
-      // enters two half-overlapping contrasts per scale and several scales,
-      // so the pseudo-likelihood counts its information several times over.
-      // (On simulated records the margin of shifts over a hidden random walk
-      // stayed below 15 and that of shifts at 5x their limit above 48, with
-      // 0.5 log(contrasts) = 4.2-4.8; the factor 3 separates them.)
-      const double pen = 3.0 * 0.5 * std::log(std::max(2.0, contrasts));
+      // Shift or wandering: exact likelihood ratio of each candidate shift
+      // (forward selection, each given those accepted before it) under the
+      // best stochastic explanation of the record without shifts, ext0; chi2_1
+      // at a fixed time, Bonferroni over the block boundaries a detector can
+      // pick (detect/step_test.hpp): the level holds whatever wanders.
+      std::vector<std::size_t> idx;
+      for (const auto& c : cpr.changes) idx.push_back(c.index);
       const int K = static_cast<int>(cpr.changes.size());
-      std::vector<int> ks = {0, 1, 2, K};
-      std::sort(ks.begin(), ks.end());
-      ks.erase(std::unique(ks.begin(), ks.end()), ks.end());
-      int best_k = 0;
-      double best_score = -std::numeric_limits<double>::infinity(), score0 = 0;
-      std::string ext0, ext_best;
-      std::vector<double> y_best;
-      for (int k : ks) {
-        if (k > K) continue;
-        std::vector<detect::ChangePoint> first(cpr.changes.begin(), cpr.changes.begin() + k);
-        std::vector<double> y = x;
-        for (const auto& c : first)
-          for (std::size_t q = c.index; q < n; ++q) y[q] -= c.size;
-        const auto wy = gmwm::waveletVariance(y.data(), n, rate);
-        WvData dy{toStd(wy.tau), toStd(wy.wv), toStd(wy.eta), static_cast<double>(n)};
-        int p = 0;
-        const Model ext = greedyExtension(m0n, dy, opt.max_terms, &p);
-        const double score = detect::contrastLogLikelihood(x, detect::haarWvOf(ext), first) -
-                             pen * (2.0 * k + p);
-        std::string txt = ext.terms.size() > m0n.terms.size() || p > 0 ? stochastic::formatTerms(ext.terms, 3) : "the model as given";
-        if (k == 0) {
-          score0 = score;
-          ext0 = txt;
-        }
-        if (score > best_score) {
-          best_score = score;
-          best_k = k;
-          ext_best = txt;
-          y_best = std::move(y);
-        }
+      const std::string ext0 =
+          p_ext0 > 0 ? stochastic::formatTerms(ext0_model.terms, 3) : std::string("the model as given");
+      detect::StepTestResult st;
+      std::string failed;
+      try {
+        st = detect::testLevelShifts(x, ext0_model, idx, B.steps);
+      } catch (const Error& e) {
+        failed = e.what();
       }
+      const int best_k = static_cast<int>(st.accepted());
+      const double boundaries = static_cast<double>(st.blocks > 1 ? st.blocks - 1 : 1);
+      const double lr_thr =
+          boost::math::quantile(boost::math::complement(boost::math::chi_squared(1.0), B.steps / boundaries));
+      const std::string how = "generalised likelihood ratio, every variance profiled and a random walk allowed; exact Gaussian likelihood of " +
+                              std::to_string(st.blocks) + " block means of " + std::to_string(st.block) +
+                              " sample(s); chi2_1 at a fixed time, Bonferroni over the " +
+                              fmtNum(boundaries, 6) + " block boundaries: threshold " + fmtNum(lr_thr, 4);
       if (best_k > 0) {
-        x = std::move(y_best);
         x_after_pre_changed = true;
-        for (int q = 0; q < best_k; ++q) {
+        double lr_rest = 0;  // strongest candidate left out
+        for (std::size_t q = 0; q < st.tests.size(); ++q) {
           const auto& c = cpr.changes[q];
+          const auto& t = st.tests[q];
+          if (!t.accepted) {
+            lr_rest = std::max(lr_rest, t.lr);
+            continue;
+          }
+          const double size = t.size, se = t.size_se;
+          for (std::size_t k = c.index; k < n; ++k) x[k] -= size;
           Finding f;
           f.channel = cd.name;
           f.cause = Cause::LevelShift;
-          const double t = t0 + static_cast<double>(c.index) / rate;
-          f.params = {{"size", c.size}, {"t_s", t}};
-          const double se = c.sd * 0.5;
-          f.intervals.push_back({"size", {c.size - 1.96 * se, c.size + 1.96 * se}});
+          const double tt = t0 + static_cast<double>(c.index) / rate;
+          f.params = {{"size", size}, {"t_s", tt}};
+          f.intervals.push_back({"size", {size - 1.96 * se, size + 1.96 * se}});
           f.range_key = "t_s";
-          f.range_lo = f.range_hi = t;
-          f.statistic = c.z;
-          f.threshold = c.threshold;
-          f.p_value = c.p_value;
-          f.explanation = "a level shift of " + fmtNum(c.size, 3) + " " + unit + " at t = " + fmtNum(t, 6) +
-                          " s (" + fmtNum(c.z, 3) + " sd of the model's " + fmtNum(c.half_width / rate, 3) +
-                          " s window contrast; threshold " + fmtNum(c.threshold, 3) + ").";
-          f.evidence = std::to_string(best_k) + " level shift(s) + " + ext_best + " score " + fmtNum(best_score, 7) +
-                       " against " + fmtNum(score0, 7) + " for the best stochastic explanation alone, " + ext0 +
-                       " (multi-scale contrast log-likelihood, penalised 1.5 log(contrasts) per parameter)";
-          f.action = "segment the record at t = " + fmtNum(t, 6) +
+          f.range_lo = f.range_hi = tt;
+          f.statistic = t.lr;
+          f.threshold = lr_thr;
+          f.p_value = t.p_value;
+          f.explanation = "a level shift of " + fmtNum(size, 3) + " " + unit + " at t = " + fmtNum(tt, 6) +
+                          " s (" + fmtNum(std::abs(size) / std::max(se, 1e-300), 3) + " standard errors; found by the model's " +
+                          fmtNum(c.half_width / rate, 3) + " s window contrast at " + fmtNum(c.z, 3) + " sd).";
+          f.evidence = "likelihood ratio " + fmtNum(t.lr, 4) + " for a shift here against the best stochastic explanation without shifts, " +
+                       ext0 + " (" + how + "; p = " + fmtNum(t.p_value, 3) + ")";
+          f.action = "segment the record at t = " + fmtNum(tt, 6) +
                      " s (estimate the model on each part) or remove the step; a stationary filter state cannot represent a one-off jump";
           cd.findings.push_back(f);
         }
         if (best_k < K)
-          cd.notes.push_back(std::to_string(K - best_k) + " weaker candidate level shift(s) did not improve the penalised likelihood: left to the wavelet-variance analysis");
+          cd.notes.push_back(std::to_string(K - best_k) + " weaker candidate level shift(s) are not significant given the " +
+                             std::to_string(best_k) + " found (likelihood ratio up to " + fmtNum(lr_rest, 4) +
+                             " below " + fmtNum(lr_thr, 4) + "): left to the wavelet-variance analysis");
+      } else if (!failed.empty()) {
+        cd.notes.push_back(std::to_string(K) + " candidate level shift(s) not tested (" + failed +
+                           "): left to the wavelet-variance analysis");
       } else {
-        cd.notes.push_back(std::to_string(K) + " candidate level shift(s) are explained better by " + ext0 +
-                           " (multi-scale contrast log-likelihood penalised 1.5 log(contrasts) per parameter: " + fmtNum(score0, 7) +
-                           " against at most " + fmtNum(best_k == 0 ? score0 : best_score, 7) +
-                           " with shifts): left to the wavelet-variance analysis");
+        cd.notes.push_back(std::to_string(K) + " candidate level shift(s) are explained as well by " + ext0 +
+                           " (likelihood ratio up to " + fmtNum([&] {
+                             double v = 0;
+                             for (const auto& t : st.tests) v = std::max(v, t.lr);
+                             return v;
+                           }(), 4) + ", " + how +
+                           "): left to the wavelet-variance analysis");
       }
     }
   }

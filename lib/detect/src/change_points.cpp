@@ -14,8 +14,6 @@ namespace navimpact::detect {
 
 namespace {
 
-constexpr double kLn2Pi = 1.8378770664093453;
-
 struct Scale {
   std::size_t m = 0, stride = 1, positions = 0;
   double sd = 0, threshold = 0;
@@ -33,13 +31,6 @@ std::vector<double> prefix(const std::vector<double>& x) {
   mean /= static_cast<double>(std::max<std::size_t>(1, x.size()));
   for (std::size_t k = 0; k < x.size(); ++k) S[k + 1] = S[k] + (x[k] - mean);
   return S;
-}
-
-/// Fraction of [a, b) at or after c.
-inline double fracAfter(std::size_t a, std::size_t b, std::size_t c) {
-  if (c <= a) return 1.0;
-  if (c >= b) return 0.0;
-  return static_cast<double>(b - c) / static_cast<double>(b - a);
 }
 
 }  // namespace
@@ -220,23 +211,6 @@ ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunctio
       if (k.index == c.index && k.half_width == c.half_width) ordered.push_back(k);
   res.changes = ordered;
   return res;
-}
-
-double contrastLogLikelihood(const std::vector<double>& x, const HaarWvFunction& wv,
-                             const std::vector<ChangePoint>& changes) {
-  const std::size_t n = x.size();
-  const auto S = prefix(x);
-  double ll = 0;
-  for (std::size_t m = 16; 4 * m <= n; m *= 2) {
-    const double sd = 2.0 * std::sqrt(std::max(1e-300, wv(2.0 * static_cast<double>(m))));
-    for (std::size_t k = m; k + m <= n; k += m) {
-      double d = meanOf(S, k, k + m) - meanOf(S, k - m, k);
-      for (const auto& c : changes)
-        d -= c.size * (fracAfter(k, k + m, c.index) - fracAfter(k - m, k, c.index));
-      ll += -0.5 * (kLn2Pi + 2.0 * std::log(sd) + d * d / (sd * sd));
-    }
-  }
-  return ll;
 }
 
 }  // namespace navimpact::detect

@@ -379,8 +379,8 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
        "level), Bonferroni over all bins from 4 cycles per record to Nyquist; harmonics and a wandering frequency "
        "are one finding. Subtracted.\n"
        "- **Level shifts:** window contrasts scaled by the model's Haar WV (valid under random walks and "
-       "Gauss-Markov noise); kept only when shifts plus the best stochastic extension explain the record better than "
-       "that extension alone (multi-scale contrast likelihood, penalty 1.5 log(contrasts) per parameter).\n"
+       "Gauss-Markov noise); each kept only when significant against the best stochastic explanation without shifts "
+       "(exact likelihood ratio of block means, chi2_1 at a fixed time, Bonferroni over the block boundaries).\n"
        "- **Wavelet variance:** measured Haar WV of the cleaned record against the model's, chi-square CI "
        "(dof lowered to what "
     << d.options.simulations << " simulations of the model show, seed " << d.options.seed

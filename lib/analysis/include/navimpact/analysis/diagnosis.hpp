@@ -13,9 +13,10 @@
  *     cycles per record to Nyquist; harmonics are one finding; subtracted;
  *  3. level shifts: equal-window contrasts scaled by the model's Haar WV
  *     (valid under random walks and Gauss-Markov noise), detect-and-remove;
- *     accepted only when they explain the record better than the best
- *     stochastic alternative (RW, DR or GM added to the model, fitted to the
- *     WV) by a multi-scale Gaussian pseudo-likelihood with an AIC penalty;
+ *     each accepted only when significant against the best stochastic
+ *     explanation without shifts (RW, DR or GM added to the model, fitted to
+ *     the WV): exact likelihood ratio of block means, chi2_1 at a fixed time,
+ *     Bonferroni over the block boundaries (detect/step_test.hpp);
  *  4. WV: measured Haar WV of the cleaned record against the model's WV with
  *     its chi-square CI (eta_j = max(M_j / 2^j, 1), Percival & Walden 2000
  *     §8.4; lowered to the dof seen in the model's own simulations where

@@ -74,14 +74,4 @@ struct ChangePointResult {
 ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunction& null_wv,
                                      double alpha, const ChangePointOptions& opt = {});
 
-/**
- * Gaussian multi-scale pseudo-log-likelihood of @p x's contrasts D(k, m)
- * (dyadic m from 16 to N/4, windows of stride m) under a null with Haar WV
- * @p wv, after removing the contrasts that the level shifts @p changes
- * produce (pass none for a purely stochastic explanation). Used to compare a
- * level-shift explanation with a random walk / Gauss-Markov / drift one.
- */
-double contrastLogLikelihood(const std::vector<double>& x, const HaarWvFunction& wv,
-                             const std::vector<ChangePoint>& changes);
-
 }  // namespace navimpact::detect
