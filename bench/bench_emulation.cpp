@@ -39,7 +39,7 @@ bool haveData(benchmark::State& state) {
 
 /// Emulated 600 s data (and its rawlog in the temp folder), made once.
 struct Fixture {
-  emu::EmulationData data;
+  navimpact::Recording data;
   std::string rawlog;
   static const Fixture& get() {
     static std::unique_ptr<Fixture> f;
@@ -124,17 +124,9 @@ static void replayFilter(benchmark::State& state, int every) {
   }
   // truth at 10 Hz from the GT records
   navimpact::analysis::TruthSeries truth;
-  for (const auto& g : d.truth) {
-    navimpact::ins::NavState x;
-    x.t = g.t;
-    const auto p = navimpact::earth::nedToGeodetic(d.origin, g.p_L);
-    x.lat = p.lat;
-    x.lon = p.lon;
-    x.h = p.h;
-    x.v_N = g.v_N;
-    x.q_BtoN = g.q_BtoN;
+  for (const auto& g : d.reference) {
     truth.t.push_back(g.t);
-    truth.x.push_back(x);
+    truth.x.push_back(navimpact::ins::navStateOf(g, d.origin));
   }
   navimpact::analysis::NavRunInput in;
   in.x0 = truth.x.front();

@@ -27,7 +27,7 @@ std::string benchRawlog() {
 /// Inputs of runNav as the replay builds them (GT at every epoch as truth).
 struct Prepared {
   std::vector<ins::ImuSample> imu;
-  emulation::EmulationData d;
+  Recording d;
   an::TruthSeries truth;
   ins::NavState x0;
 };
@@ -41,18 +41,10 @@ Prepared prepare(const std::string& path) {
     p.imu.push_back(ins::ImuSample::fromRates(r.t, r.t - prev, r.w_IB_B, r.f_B));
     prev = r.t;
   }
-  for (auto& b : p.d.baro) b.sigma = 0.5;
-  for (const auto& g : p.d.truth) {
-    ins::NavState x;
-    x.t = g.t;
-    const earth::Geodetic q = earth::nedToGeodetic(p.d.origin, g.p_L);
-    x.lat = q.lat;
-    x.lon = q.lon;
-    x.h = q.h;
-    x.v_N = g.v_N;
-    x.q_BtoN = g.q_BtoN.normalized();
+  for (auto& b : p.d.baro) b.sigma_m = 0.5;
+  for (const auto& g : p.d.reference) {
     p.truth.t.push_back(g.t);
-    p.truth.x.push_back(x);
+    p.truth.x.push_back(ins::navStateOf(g, p.d.origin));
   }
   p.x0 = p.truth.x.front();
   p.x0.t = p.d.imu.front().t - dt;
@@ -70,7 +62,7 @@ static void BM_ReplayRead(benchmark::State& st) {
   }
   std::size_t n = 0;
   for (auto _ : st) {
-    const emulation::EmulationData d = rawlog::readRawlog(path);
+    const Recording d = rawlog::readRawlog(path);
     n = d.imu.size();
     benchmark::DoNotOptimize(d.imu.data());
   }

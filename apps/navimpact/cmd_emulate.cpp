@@ -41,7 +41,7 @@ navimpact::cli::Registrar reg({
         const auto cfg = navimpact::emulation::loadEmulationConfig(o->config);
         auto data = navimpact::emulation::runEmulation(cfg, NAVIMPACT_VERSION);
         if (o->no_gt) {
-          data.truth.clear();
+          data.reference.clear();
           data.notices.push_back("--no-gt: ground-truth records (label GT) left out of the rawlog");
         }
         const auto staged = outs.stagedFile();
@@ -54,7 +54,7 @@ navimpact::cli::Registrar reg({
         for (const auto& n : data.notices) std::printf("notice: %s\n", n.c_str());
         std::printf("emulated %.2f s: IMU %zu samples at %g Hz, GNSS %zu fixes, BARO %zu, GT %zu\n",
                     data.imu.empty() ? 0.0 : data.imu.back().t - data.t_start_s, data.imu.size(),
-                    data.imu_rate_hz, data.gnss.size(), data.baro.size(), data.truth.size());
+                    data.imu_rate_hz, data.gnss.size(), data.baro.size(), data.reference.size());
         std::printf("wrote %s (%.2f MB%s)\n", o->out.c_str(), bytes / 1e6, wo.gzip ? ", gzip" : "");
         return 0;
       };

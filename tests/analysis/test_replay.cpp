@@ -13,7 +13,7 @@ namespace an = navimpact::analysis;
 
 namespace {
 
-emu::EmulationData emulate60(const std::string& errors) {
+navimpact::Recording emulate60(const std::string& errors) {
   emu::EmulationConfig c;
   c.trajectory.file = navimpact::test::sourcePath("datasets/uav_flight_260s.csv.gz");
   c.trajectory.end_s = 60.0;

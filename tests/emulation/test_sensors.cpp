@@ -136,14 +136,15 @@ TEST(Gnss, NoiseMatchesSigmasAndLeverArmIsRotated) {
     const auto dp = navimpact::earth::geodeticToNed(tr.origin(), f.pos);
     n.push_back(dp[0]);
     d.push_back(dp[2]);
-    ve.push_back(f.v_N[1]);
-    vd.push_back(f.v_N[2]);
+    ASSERT_TRUE(f.v_N && f.cov_pos_N && f.cov_vel_N);
+    ve.push_back((*f.v_N)[1]);
+    vd.push_back((*f.v_N)[2]);
   }
   EXPECT_NEAR(stdev(n), 2.0, 2.0 * 0.05);
   EXPECT_NEAR(stdev(d), 4.0, 4.0 * 0.05);
   EXPECT_NEAR(stdev(ve), 0.05, 0.05 * 0.05);
   EXPECT_NEAR(stdev(vd), 0.10, 0.10 * 0.05);
-  EXPECT_DOUBLE_EQ(fixes[5].cov_pos_N(2, 2), 16.0);
+  EXPECT_DOUBLE_EQ((*fixes[5].cov_pos_N)(2, 2), 16.0);
   // Heading east: an antenna 1 m forward is 1 m east of the IMU.
   emu::GnssOptions l;
   l.sigma_pos_h_m = l.sigma_pos_v_m = l.sigma_vel_h_mps = l.sigma_vel_v_mps = 1e-12;

@@ -207,22 +207,11 @@ struct DynRun {
 // The committed UAV excerpt (first 150 s) through the emulation with the
 // Table 1 Ref errors on all six axes, filtered with the Ref model: GNSS
 // position + velocity at 1 Hz except in the outage (90, 150] s, baro at 10 Hz.
-DynRun dynamicRun(const emulation::EmulationData& d, const stochastic::ImuModel& m, int every) {
+DynRun dynamicRun(const Recording& d, const stochastic::ImuModel& m, int every) {
   filter::EkfConfig cfg;
   cfg.propagate_every = every;
   const double dt = 1.0 / d.imu_rate_hz;
-  auto truthAt = [&](std::size_t i) {
-    const emulation::TruthRecord& g = d.truth[i];
-    ins::NavState x;
-    x.t = g.t;
-    const earth::Geodetic p = earth::nedToGeodetic(d.origin, g.p_L);
-    x.lat = p.lat;
-    x.lon = p.lon;
-    x.h = p.h;
-    x.v_N = g.v_N;
-    x.q_BtoN = g.q_BtoN.normalized();
-    return x;
-  };
+  auto truthAt = [&](std::size_t i) { return ins::navStateOf(d.reference[i], d.origin); };
   ins::NavState x0 = truthAt(0);
   x0.t = d.imu.front().t - dt;
   filter::Vector9d p0;
@@ -232,21 +221,21 @@ DynRun dynamicRun(const emulation::EmulationData& d, const stochastic::ImuModel&
   std::size_t ig = 0, ib = 0, it = 0;
   double prev = x0.t;
   const double outage0 = 90.0, outage1 = 150.0;
-  for (const emulation::ImuRecord& rec : d.imu) {
+  for (const ImuRecord& rec : d.imu) {
     ekf.predict(ins::ImuSample::fromRates(rec.t, rec.t - prev, rec.w_IB_B, rec.f_B));
     prev = rec.t;
     while (ig < d.gnss.size() && d.gnss[ig].t <= rec.t + 0.5 * dt) {
-      const emulation::GnssFix& f = d.gnss[ig++];
+      const GnssFix& f = d.gnss[ig++];
       if (f.t - d.t_start_s > outage0 && f.t - d.t_start_s <= outage1) continue;
-      ekf.updateGnssPosition(f.pos, f.cov_pos_N.diagonal().cwiseSqrt());
-      ekf.updateGnssVelocity(f.v_N, f.cov_vel_N.diagonal().cwiseSqrt());
+      ekf.updateGnssPosition(f.pos, f.cov_pos_N->diagonal().cwiseSqrt());
+      ekf.updateGnssVelocity(*f.v_N, f.cov_vel_N->diagonal().cwiseSqrt());
     }
     while (ib < d.baro.size() && d.baro[ib].t <= rec.t + 0.5 * dt) {
-      ekf.updateBaro(d.baro[ib].h, d.baro[ib].sigma);
+      ekf.updateBaro(d.baro[ib].h, *d.baro[ib].sigma_m);
       ++ib;
     }
-    while (it < d.truth.size() && d.truth[it].t <= rec.t + 0.5 * dt) {
-      const double tr = d.truth[it].t - d.t_start_s;
+    while (it < d.reference.size() && d.reference[it].t <= rec.t + 0.5 * dt) {
+      const double tr = d.reference[it].t - d.t_start_s;
       if (std::abs(tr - std::round(tr)) < 1e-6) {  // 1 Hz
         ekf.flushPropagation();
         r.t.push_back(tr);
@@ -277,7 +266,7 @@ TEST(LowerRate, PropagationEveryTenSamplesOnTurningFlightWithOutage) {
   emulation::EmulationConfig ec =
       emulation::loadEmulationConfig(test::sourcePath("config/emulation/uav_flight_260s_ref.yaml"));
   ec.trajectory.end_s = 150.0;
-  const emulation::EmulationData d = emulation::runEmulation(ec, "test");
+  const Recording d = emulation::runEmulation(ec, "test");
   const stochastic::ImuModel m =
       stochastic::loadImuModel(test::sourcePath("config/models/navchip_table1.yaml") + ":ref");
   const DynRun a = dynamicRun(d, m, 1);

@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "navimpact/ins/mechanization.hpp"
+#include "navimpact/core/error.hpp"
 
 using namespace navimpact;
 using Eigen::Vector3d;
@@ -96,4 +97,28 @@ TEST(Mechanization, ForwardAccelerationMovesNorth) {
   const Vector3d dp = earth::curvilinearDiffNed(x.geodetic(), x0.geodetic());
   EXPECT_NEAR(dp.x(), 50.0, 0.05);
   EXPECT_NEAR(dp.y(), 0.0, 0.01);
+}
+
+// A reference record becomes the navigation state it describes: the NED
+// offset from the origin goes to geodetic and back to the same offset, and a
+// reference without velocity or attitude is refused (never a zero state).
+TEST(NavState, OfAReferenceRecord) {
+  const earth::Geodetic o{46.57 * kDeg, 7.65 * kDeg, 550.0};
+  ReferenceRecord r;
+  r.t = 12.5;
+  r.p_L = Vector3d(1234.5, -678.25, -31.0);
+  r.v_N = Vector3d(20.0, -3.0, 0.5);
+  r.q_BtoN = Eigen::Quaterniond(2.0, 0.2, -0.1, 0.4);  // not normalised on purpose
+  const ins::NavState x = ins::navStateOf(r, o);
+  EXPECT_EQ(x.t, 12.5);
+  EXPECT_LT((earth::geodeticToNed(o, x.geodetic()) - r.p_L).norm(), 1e-6);
+  EXPECT_EQ(x.v_N, *r.v_N);
+  EXPECT_NEAR(x.q_BtoN.norm(), 1.0, 1e-15);
+  EXPECT_LT(x.q_BtoN.angularDistance(*r.q_BtoN), 1e-12);
+  ReferenceRecord noAtt = r;
+  noAtt.q_BtoN.reset();
+  EXPECT_THROW(ins::navStateOf(noAtt, o), Error);
+  ReferenceRecord noVel = r;
+  noVel.v_N.reset();
+  EXPECT_THROW(ins::navStateOf(noVel, o), Error);
 }

@@ -1,5 +1,6 @@
-// Rawlog writer + event reader: every field of every label round-trips, and
-// malformed files are reported with the offending entry.
+// Rawlog writer + reader of navimpact::Recording: every field of every label
+// round-trips (optional fields as present or absent), and malformed files are
+// reported with the offending entry.
 #include <filesystem>
 #include <fstream>
 
@@ -7,18 +8,19 @@
 #include "navimpact/rawlog/writer.hpp"
 #include "test_support.hpp"
 
-namespace emu = navimpact::emulation;
 namespace fs = std::filesystem;
+using navimpact::GnssFix;
+using navimpact::Recording;
 
 namespace {
 
-emu::EmulationData sample() {
-  emu::EmulationData d;
+Recording sample() {
+  Recording d;
   d.origin = {46.57 * M_PI / 180, 6.54 * M_PI / 180, 517.891};
   d.imu_rate_hz = 200;
   d.start_unix_s = 1767225600;
   d.t_start_s = 10.0;  // trajectory time of the start timestamp
-  d.scenario_yaml =
+  d.metadata =
       "navimpact_scenario:\n  origin: {lat_deg: 46.57, lon_deg: 6.54, height_m: 517.891}\n"
       "  time: {start_unix_s: 1767225600}\n  imu: {rate_hz: 200}\n";
   for (int k = 1; k <= 400; ++k) {
@@ -28,26 +30,26 @@ emu::EmulationData sample() {
   }
   for (int k = 0; k <= 20; ++k) d.baro.push_back({10.0 + 0.1 * k, 520.0 + 0.123 * k, 0.5});
   for (int k = 0; k <= 2; ++k) {
-    emu::GnssFix f;
+    GnssFix f;
     f.t = 10.0 + k;
     f.pos = {d.origin.lat + 1e-6 * k, d.origin.lon - 2e-6 * k, 530.25 + k};
     f.v_N = Eigen::Vector3d(12.5, -3.25, 0.75 * k);
     Eigen::Matrix3d A;
     A << 4, 0.5, -0.2, 0.5, 4, 0.1, -0.2, 0.1, 16;
     f.cov_pos_N = A;
-    f.cov_vel_N = A * 1e-3;
+    f.cov_vel_N = Eigen::Matrix3d(A * 1e-3);
     d.gnss.push_back(f);
   }
   for (int k = 0; k <= 20; ++k) {
     Eigen::Quaterniond q(Eigen::AngleAxisd(0.1 * k, Eigen::Vector3d(1, 2, 3).normalized()));
-    d.truth.push_back({10.0 + 0.1 * k, Eigen::Vector3d(1.5 * k, -2.25 * k, -0.5 * k),
-                       Eigen::Vector3d(15, -22.5, -5 + k), q});
+    d.reference.push_back({10.0 + 0.1 * k, Eigen::Vector3d(1.5 * k, -2.25 * k, -0.5 * k),
+                           Eigen::Vector3d(15, -22.5, -5 + k), q, {}, {}, {}});
   }
   return d;
 }
 
-void expectRoundTrip(const emu::EmulationData& a, const emu::EmulationData& b) {
-  EXPECT_EQ(b.scenario_yaml, a.scenario_yaml);
+void expectRoundTrip(const Recording& a, const Recording& b) {
+  EXPECT_EQ(b.metadata, a.metadata);
   EXPECT_EQ(b.start_unix_s, a.start_unix_s);
   EXPECT_NEAR(b.origin.lat, a.origin.lat, 1e-15);
   EXPECT_NEAR(b.origin.h, a.origin.h, 1e-12);
@@ -63,13 +65,21 @@ void expectRoundTrip(const emu::EmulationData& a, const emu::EmulationData& b) {
   for (std::size_t i = 0; i < a.baro.size(); ++i) {
     EXPECT_NEAR(b.baro[i].t, a.baro[i].t - t0, 1e-9);
     EXPECT_EQ(b.baro[i].h, a.baro[i].h);
+    EXPECT_FALSE(b.baro[i].sigma_m.has_value());  // the sigma belongs to the scenario
   }
-  ASSERT_EQ(b.truth.size(), a.truth.size());
-  for (std::size_t i = 0; i < a.truth.size(); ++i) {
-    EXPECT_NEAR(b.truth[i].t, a.truth[i].t - t0, 1e-9);
-    EXPECT_EQ(b.truth[i].p_L, a.truth[i].p_L);
-    EXPECT_EQ(b.truth[i].v_N, a.truth[i].v_N);
-    EXPECT_EQ(b.truth[i].q_BtoN.coeffs(), a.truth[i].q_BtoN.coeffs());
+  ASSERT_EQ(b.reference.size(), a.reference.size());
+  for (std::size_t i = 0; i < a.reference.size(); ++i) {
+    const auto &x = a.reference[i], &y = b.reference[i];
+    EXPECT_NEAR(y.t, x.t - t0, 1e-9);
+    EXPECT_EQ(y.p_L, x.p_L);
+    ASSERT_EQ(y.v_N.has_value(), x.v_N.has_value());
+    if (x.v_N) {
+      EXPECT_EQ(*y.v_N, *x.v_N);
+    }
+    ASSERT_EQ(y.q_BtoN.has_value(), x.q_BtoN.has_value());
+    if (x.q_BtoN) {
+      EXPECT_EQ(y.q_BtoN->coeffs(), x.q_BtoN->coeffs());
+    }
   }
   ASSERT_EQ(b.gnss.size(), a.gnss.size());
   for (std::size_t i = 0; i < a.gnss.size(); ++i) {
@@ -78,10 +88,19 @@ void expectRoundTrip(const emu::EmulationData& a, const emu::EmulationData& b) {
     EXPECT_NEAR(y.pos.lat, x.pos.lat, 1e-14);  // via ECEF (double)
     EXPECT_NEAR(y.pos.lon, x.pos.lon, 1e-14);
     EXPECT_NEAR(y.pos.h, x.pos.h, 1e-7);
-    EXPECT_LT((y.v_N - x.v_N).norm(), 1e-12);
+    ASSERT_EQ(y.v_N.has_value(), x.v_N.has_value());
+    if (x.v_N) {
+      EXPECT_LT((*y.v_N - *x.v_N).norm(), 1e-12);
+    }
     // covariances are stored as float in TOPCON_PZS
-    EXPECT_LT((y.cov_pos_N - x.cov_pos_N).norm(), 1e-6 * x.cov_pos_N.norm());
-    EXPECT_LT((y.cov_vel_N - x.cov_vel_N).norm(), 1e-6 * x.cov_vel_N.norm());
+    ASSERT_EQ(y.cov_pos_N.has_value(), x.cov_pos_N.has_value());
+    if (x.cov_pos_N) {
+      EXPECT_LT((*y.cov_pos_N - *x.cov_pos_N).norm(), 1e-6 * x.cov_pos_N->norm());
+    }
+    ASSERT_EQ(y.cov_vel_N.has_value(), x.cov_vel_N.has_value());
+    if (x.cov_vel_N) {
+      EXPECT_LT((*y.cov_vel_N - *x.cov_vel_N).norm(), 1e-6 * x.cov_vel_N->norm());
+    }
   }
 }
 
@@ -103,6 +122,43 @@ TEST(RawlogWriter, EveryFieldRoundTripsGzipAndPlain) {
     navimpact::rawlog::writeRawlog(p, d, {gz, 6});
     expectRoundTrip(d, navimpact::rawlog::readRawlog(p));
   }
+}
+
+// Measured data carry less: position-only fixes, fixes without a covariance,
+// a reference with position only or without attitude. What is absent stays
+// absent after the round trip (never a zero or an invented value).
+TEST(RawlogWriter, AbsentOptionalFieldsStayAbsent) {
+  Recording d = sample();
+  d.gnss[0].v_N.reset();
+  d.gnss[0].cov_vel_N.reset();
+  d.gnss[1].cov_pos_N.reset();
+  d.gnss[2].cov_vel_N.reset();
+  for (std::size_t i = 0; i < d.reference.size(); ++i) {
+    if (i % 2 == 0) d.reference[i].q_BtoN.reset();
+    if (i % 3 == 0) d.reference[i].v_N.reset();
+  }
+  const auto p = (navimpact::test::tempDir() / "partial.rawlog").string();
+  navimpact::rawlog::writeRawlog(p, d);
+  const Recording b = navimpact::rawlog::readRawlog(p);
+  expectRoundTrip(d, b);
+  EXPECT_EQ(b.source, p);
+}
+
+// Without a time base in the comment, time zero is the first entry and its
+// absolute time is kept: start_unix_s + (0 - t_start_s) is that UTC instant.
+TEST(RawlogWriter, AbsoluteTimeIsKeptWithoutAScenarioTimeBase) {
+  Recording d = sample();
+  d.metadata = "navimpact_scenario:\n  origin: {lat_deg: 46.57, lon_deg: 6.54, height_m: 517.891}\n";
+  d.start_unix_s = 1767225600;
+  d.t_start_s = 9.25;  // first entry (GT at 10 s) is at 1767225600.75 UTC
+  const auto p = (navimpact::test::tempDir() / "nobase.rawlog").string();
+  navimpact::rawlog::writeRawlog(p, d);
+  const Recording b = navimpact::rawlog::readRawlog(p);
+  ASSERT_FALSE(b.reference.empty());
+  EXPECT_NEAR(b.reference.front().t, 0.0, 1e-9);
+  EXPECT_EQ(b.start_unix_s, 1767225600);
+  EXPECT_NEAR(double(b.start_unix_s) - b.t_start_s, 1767225600.75, 1e-6);
+  EXPECT_NEAR(b.imu.front().t, d.imu.front().t - 10.0, 1e-6);
 }
 
 TEST(RawlogWriter, TruncatedFileNamesTheEntry) {

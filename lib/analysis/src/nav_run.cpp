@@ -78,22 +78,25 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
 
   auto applyAiding = [&](double t_now, double half_dt) {
     while (ig < ng && (*in.gnss)[ig].t <= t_now + half_dt) {
-      const emulation::GnssFix& f = (*in.gnss)[ig++];
+      const GnssFix& f = (*in.gnss)[ig++];
       if (f.t < in.x0.t - half_dt) continue;  // before the run
       if (inOutage(f.t, opt.outages)) continue;
-      const Eigen::Vector3d sp = f.cov_pos_N.diagonal().cwiseSqrt();
+      if (!f.cov_pos_N) throw Error("navigation run: GNSS fix at " + num(f.t) + " s has no position covariance");
+      const Eigen::Vector3d sp = f.cov_pos_N->diagonal().cwiseSqrt();
       ekf.updateGnssPosition(f.pos, sp, opt.lever_arm_B);
-      if (opt.use_gnss_velocity) {
-        const Eigen::Vector3d sv = f.cov_vel_N.diagonal().cwiseSqrt();
-        ekf.updateGnssVelocity(f.v_N, sv, opt.lever_arm_B);
+      if (opt.use_gnss_velocity && f.v_N) {
+        if (!f.cov_vel_N) throw Error("navigation run: GNSS fix at " + num(f.t) + " s has no velocity covariance");
+        const Eigen::Vector3d sv = f.cov_vel_N->diagonal().cwiseSqrt();
+        ekf.updateGnssVelocity(*f.v_N, sv, opt.lever_arm_B);
       }
       ++res.gnss_updates;
     }
     while (ib < nb && (*in.baro)[ib].t <= t_now + half_dt) {
-      const emulation::BaroSample& b = (*in.baro)[ib++];
+      const BaroSample& b = (*in.baro)[ib++];
       if (b.t < in.x0.t - half_dt) continue;
       if (!opt.baro_in_outage && inOutage(b.t, opt.outages)) continue;
-      ekf.updateBaro(b.h, b.sigma);
+      if (!b.sigma_m) throw Error("navigation run: baro sample at " + num(b.t) + " s has no sigma");
+      ekf.updateBaro(b.h, *b.sigma_m);
       ++res.baro_updates;
     }
   };

@@ -152,10 +152,10 @@ ReplayConfig loadReplayConfig(const std::string& path) {
 
 namespace {
 /// Initial state without GT: GNSS fix at time zero, levelling, GNSS course (see replay.hpp).
-ins::NavState initialWithoutTruth(const emulation::EmulationData& d, const ReplayConfig& cfg, double t_zero,
+ins::NavState initialWithoutTruth(const Recording& d, const ReplayConfig& cfg, double t_zero,
                                   double dt, const Eigen::Vector3d& lever_B, filter::Matrix9d& P0,
                                   std::vector<std::string>& notices) {
-  const emulation::GnssFix* fix = nullptr;
+  const GnssFix* fix = nullptr;
   for (const auto& f : d.gnss)
     if (std::abs(f.t - t_zero) <= 0.5 * dt) {
       fix = &f;
@@ -164,7 +164,7 @@ ins::NavState initialWithoutTruth(const emulation::EmulationData& d, const Repla
   if (!fix)
     throw Error(cfg.rawlog + ": no ground truth (label GT) and no GNSS fix at the start of the IMU data (t = " +
                 num(t_zero) + " s) to initialise the filter from");
-  if (!fix->v_N.allFinite())
+  if (!fix->v_N)
     throw Error(cfg.rawlog + ": no ground truth and the first GNSS fix has no velocity (GGA only)");
   Eigen::Vector3d rpy;
   std::string how;
@@ -178,14 +178,15 @@ ins::NavState initialWithoutTruth(const emulation::EmulationData& d, const Repla
     // (u = sum dC_k f_B,k dt), onto the measured velocity change minus gravity
     // (v = v1 - v0 - g_N T; Coriolis and transport rate neglected) - levelling
     // (Groves 2013 eq. 5.101) corrected for the vehicle's own acceleration.
-    const double vh = fix->v_N.head<2>().norm();
+    const Eigen::Vector3d& v0 = *fix->v_N;
+    const double vh = v0.head<2>().norm();
     if (vh < 1.0)
       throw Error(cfg.rawlog + ": no ground truth and a horizontal GNSS speed of " + num(vh) +
                   " m/s at the start, too slow for a course: give initial_attitude_deg: [roll, pitch, yaw]");
-    rpy[2] = std::atan2(fix->v_N.y(), fix->v_N.x());
-    const emulation::GnssFix* fix1 = nullptr;
+    rpy[2] = std::atan2(v0.y(), v0.x());
+    const GnssFix* fix1 = nullptr;
     for (const auto& f : d.gnss)
-      if (f.t > fix->t + 0.5 * dt && f.v_N.allFinite()) {
+      if (f.t > fix->t + 0.5 * dt && f.v_N) {
         fix1 = &f;
         break;
       }
@@ -203,7 +204,7 @@ ins::NavState initialWithoutTruth(const emulation::EmulationData& d, const Repla
       prev = s.t;
     }
     const double T = fix1->t - fix->t;
-    const Eigen::Vector3d v = fix1->v_N - fix->v_N - earth::gravity_N(fix->pos.lat, fix->pos.h) * T;
+    const Eigen::Vector3d v = *fix1->v_N - v0 - earth::gravity_N(fix->pos.lat, fix->pos.h) * T;
     const Eigen::Vector3d uh = u.normalized(), vhat = v.normalized();
     auto resid = [&](double r, double p) {
       ins::NavState a;
@@ -234,11 +235,11 @@ ins::NavState initialWithoutTruth(const emulation::EmulationData& d, const Repla
   x.lat = p.lat;
   x.lon = p.lon;
   x.h = p.h;
-  x.v_N = fix->v_N;
+  x.v_N = *fix->v_N;
   const double rp = std::max(cfg.p0_roll_pitch_deg, 2.0) * kDeg, yw = std::max(cfg.p0_yaw_deg, 5.0) * kDeg;
   P0.setZero();
-  P0.topLeftCorner<3, 3>() = fix->cov_pos_N.diagonal().asDiagonal();
-  P0.block<3, 3>(3, 3) = fix->cov_vel_N.diagonal().asDiagonal();
+  P0.topLeftCorner<3, 3>() = fix->cov_pos_N->diagonal().asDiagonal();
+  P0.block<3, 3>(3, 3) = fix->cov_vel_N->diagonal().asDiagonal();
   P0.diagonal().tail<3>() << rp * rp, rp * rp, yw * yw;
   notices.push_back("no ground truth in the rawlog: filter initialised from the GNSS fix at time zero, " + how +
                     " (initial sigmas " + num(rp / kDeg) + " deg roll/pitch, " + num(yw / kDeg) +
@@ -250,17 +251,17 @@ ins::NavState initialWithoutTruth(const emulation::EmulationData& d, const Repla
 ReplayResult runReplay(const ReplayConfig& cfg) {
   if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
   const std::clock_t c0 = std::clock();
-  emulation::EmulationData d = rawlog::readRawlog(cfg.rawlog);
+  Recording d = rawlog::readRawlog(cfg.rawlog);
   ReplayResult r;
   r.read_s = double(std::clock() - c0) / CLOCKS_PER_SEC;
   r.cfg = cfg;
-  r.scenario_yaml = d.scenario_yaml;
+  r.scenario_yaml = d.metadata;
   r.notices = d.notices;
   if (d.imu.size() < 2) throw Error(cfg.rawlog + ": no IMU data (label IMU) to replay");
 
   YAML::Node scen;
   try {
-    if (!d.scenario_yaml.empty()) scen = YAML::Load(d.scenario_yaml)["navimpact_scenario"];
+    if (!d.metadata.empty()) scen = YAML::Load(d.metadata)["navimpact_scenario"];
   } catch (const YAML::Exception&) {
   }
   // IMU model of the filter.
@@ -307,23 +308,28 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
     opt.outages.push_back({a, b});
   }
 
-  // Measurement noise: recorded, or overridden.
+  // Measurement noise: overridden by the configuration, else recorded with the
+  // sample, else (baro) the scenario's.
   double sBaro = NAN;
   if (scen && scen["baro"] && scen["baro"]["sigma_m"]) sBaro = scen["baro"]["sigma_m"].as<double>();
-  if (cfg.sigma_baro_m) sBaro = *cfg.sigma_baro_m;
-  if (!d.baro.empty() && !std::isfinite(sBaro))
-    throw Error(cfg.rawlog + ": barometer sigma not recorded in the scenario: set noise.sigma_baro_m");
-  for (auto& b : d.baro) b.sigma = sBaro;
+  for (auto& b : d.baro) {
+    if (cfg.sigma_baro_m) b.sigma_m = *cfg.sigma_baro_m;
+    else if (!b.sigma_m) b.sigma_m = sBaro;
+    if (!std::isfinite(*b.sigma_m))
+      throw Error(cfg.rawlog + ": barometer sigma not recorded in the scenario: set noise.sigma_baro_m");
+  }
+  const Eigen::Vector3d kNaN3 = Eigen::Vector3d::Constant(NAN);
   for (auto& f : d.gnss) {
-    Eigen::Vector3d sp = f.cov_pos_N.diagonal().cwiseSqrt(), sv = f.cov_vel_N.diagonal().cwiseSqrt();
+    Eigen::Vector3d sp = f.cov_pos_N ? Eigen::Vector3d(f.cov_pos_N->diagonal().cwiseSqrt()) : kNaN3;
+    Eigen::Vector3d sv = f.cov_vel_N ? Eigen::Vector3d(f.cov_vel_N->diagonal().cwiseSqrt()) : kNaN3;
     if (cfg.sigma_pos_h_m) sp.head<2>().setConstant(*cfg.sigma_pos_h_m);
     if (cfg.sigma_pos_v_m) sp[2] = *cfg.sigma_pos_v_m;
     if (cfg.sigma_vel_h_mps) sv.head<2>().setConstant(*cfg.sigma_vel_h_mps);
     if (cfg.sigma_vel_v_mps) sv[2] = *cfg.sigma_vel_v_mps;
-    if (!sp.allFinite() || !sv.allFinite())
+    if (!sp.allFinite() || (f.v_N && !sv.allFinite()))
       throw Error(cfg.rawlog + ": GNSS fix at t = " + num(f.t) + " s has no covariance: set the noise.* sigmas");
-    f.cov_pos_N = sp.cwiseAbs2().asDiagonal();
-    f.cov_vel_N = sv.cwiseAbs2().asDiagonal();
+    f.cov_pos_N = Eigen::Matrix3d(sp.cwiseAbs2().asDiagonal());
+    if (sv.allFinite()) f.cov_vel_N = Eigen::Matrix3d(sv.cwiseAbs2().asDiagonal());
   }
   Eigen::Vector3d lever = Eigen::Vector3d::Zero();
   if (scen && scen["gnss"] && scen["gnss"]["lever_arm_B_m"]) {
@@ -334,20 +340,15 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   opt.lever_arm_B = lever;
 
   // Truth series from GT (tangent-plane NED at the origin -> geodetic).
-  const bool hasTruth = !d.truth.empty();
+  const bool hasTruth = !d.reference.empty();
   TruthSeries truth;
-  for (const auto& g : d.truth) {
+  for (const auto& g : d.reference) {
     if (g.t < r.t_zero - 0.5 * dt || g.t > t_last + 0.5 * dt) continue;
-    ins::NavState x;
-    x.t = g.t;
-    const earth::Geodetic p = earth::nedToGeodetic(d.origin, g.p_L);
-    x.lat = p.lat;
-    x.lon = p.lon;
-    x.h = p.h;
-    x.v_N = g.v_N;
-    x.q_BtoN = g.q_BtoN.normalized();
+    if (!g.v_N || !g.q_BtoN)
+      throw Error(cfg.rawlog + ": the reference (GT) at t = " + num(g.t) +
+                  " s has no velocity or attitude; a replay scores against a full reference");
     truth.t.push_back(g.t);
-    truth.x.push_back(x);
+    truth.x.push_back(ins::navStateOf(g, d.origin));
   }
   if (hasTruth && (truth.t.empty() || std::abs(truth.t.front() - r.t_zero) > 0.5 * dt))
     throw Error(cfg.rawlog + ": no GT entry at the start of the IMU data (t = " + num(r.t_zero) +

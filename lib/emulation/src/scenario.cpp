@@ -211,10 +211,11 @@ EmulationConfig loadEmulationConfig(const std::string& path) {
   return cfg;
 }
 
-EmulationData runEmulation(const EmulationConfig& cfg, const std::string& version) {
+Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
   Ctx c{cfg.config_file, {}};
   const long long startUnix = parseUtc(cfg.start_utc, c);
-  EmulationData d;
+  Recording d;
+  d.source = cfg.config_file.empty() ? "emulation" : cfg.config_file;
   const SmoothTrajectory tr(readTrajectoryCsv(cfg.trajectory), cfg.smoothing);
   d.origin = tr.origin();
   d.imu_rate_hz = cfg.imu_rate_hz;
@@ -247,11 +248,11 @@ EmulationData runEmulation(const EmulationConfig& cfg, const std::string& versio
   d.gnss = simulateGnss(tr, cfg.gnss, t0, t1);
   d.baro = simulateBaro(tr, cfg.baro, t0, t1);
   const auto nt = static_cast<std::size_t>(std::floor((t1 - t0) * cfg.truth_rate_hz + 1e-9)) + 1;
-  d.truth.resize(nt);
+  d.reference.resize(nt);
   for (std::size_t k = 0; k < nt; ++k) {
     const double t = t0 + double(k) / cfg.truth_rate_hz;
     const TruthState s = tr.at(t);
-    d.truth[k] = {t, s.p_L, s.v_N, Eigen::Quaterniond(s.C_BtoN).normalized()};
+    d.reference[k] = {t, s.p_L, s.v_N, Eigen::Quaterniond(s.C_BtoN).normalized(), {}, {}, {}};
   }
 
   // Scenario text (YAML), stored as the rawlog's first entry.
@@ -293,7 +294,7 @@ EmulationData runEmulation(const EmulationConfig& cfg, const std::string& versio
     std::string line;
     while (std::getline(in, line)) y << "    " << line << "\n";
   }
-  d.scenario_yaml = y.str();
+  d.metadata = y.str();
   return d;
 }
 

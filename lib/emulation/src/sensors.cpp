@@ -116,10 +116,10 @@ std::vector<GnssFix> simulateGnss(const SmoothTrajectory& tr, const GnssOptions&
     const Eigen::Vector3d lever_N = s.C_BtoN * opt.lever_arm_B;
     const Eigen::Vector3d dpos_N = lever_N + sp.cwiseProduct(Eigen::Vector3d(z[6 * k], z[6 * k + 1], z[6 * k + 2]));
     f.pos = earth::nedToGeodetic(s.pos, dpos_N);
-    f.v_N = s.v_N + s.C_BtoN * s.w_NB_B.cross(opt.lever_arm_B) +
-            sv.cwiseProduct(Eigen::Vector3d(z[6 * k + 3], z[6 * k + 4], z[6 * k + 5]));
-    f.cov_pos_N = sp.cwiseAbs2().asDiagonal();
-    f.cov_vel_N = sv.cwiseAbs2().asDiagonal();
+    f.v_N = Eigen::Vector3d(s.v_N + s.C_BtoN * s.w_NB_B.cross(opt.lever_arm_B) +
+                            sv.cwiseProduct(Eigen::Vector3d(z[6 * k + 3], z[6 * k + 4], z[6 * k + 5])));
+    f.cov_pos_N = Eigen::Matrix3d(sp.cwiseAbs2().asDiagonal());
+    f.cov_vel_N = Eigen::Matrix3d(sv.cwiseAbs2().asDiagonal());
   }
   return out;
 }

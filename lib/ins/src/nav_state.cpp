@@ -1,6 +1,9 @@
 #include "navimpact/ins/nav_state.hpp"
 
 #include <cmath>
+#include <sstream>
+
+#include "navimpact/core/error.hpp"
 
 namespace navimpact::ins {
 
@@ -18,6 +21,24 @@ Eigen::Vector3d rollPitchYaw(const Eigen::Matrix3d& C) {
   const double pitch = -std::asin(std::max(-1.0, std::min(1.0, C(2, 0))));
   const double yaw = std::atan2(C(1, 0), C(0, 0));
   return Eigen::Vector3d(roll, pitch, yaw);
+}
+
+NavState navStateOf(const ReferenceRecord& r, const earth::Geodetic& origin) {
+  if (!r.v_N || !r.q_BtoN) {
+    std::ostringstream m;
+    m.precision(10);
+    m << "reference at t = " << r.t << " s has no " << (r.v_N ? "attitude" : "velocity");
+    throw Error(m.str());
+  }
+  NavState x;
+  x.t = r.t;
+  const earth::Geodetic p = earth::nedToGeodetic(origin, r.p_L);
+  x.lat = p.lat;
+  x.lon = p.lon;
+  x.h = p.h;
+  x.v_N = *r.v_N;
+  x.q_BtoN = r.q_BtoN->normalized();
+  return x;
 }
 
 Eigen::Vector3d NavState::rollPitchYaw() const { return ins::rollPitchYaw(C_BtoN()); }

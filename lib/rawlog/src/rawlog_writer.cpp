@@ -1,4 +1,4 @@
-// Rawlog writer and event reader for emulations (see writer.hpp).
+// Rawlog writer and reader of navimpact::Recording (see writer.hpp).
 #include "navimpact/rawlog/writer.hpp"
 
 #include <mrpt/io/CFileGZInputStream.h>
@@ -54,7 +54,7 @@ Eigen::Matrix4f cov4(const Eigen::Matrix3d& c) {
 
 }  // namespace
 
-void writeRawlog(const std::string& path, const emulation::EmulationData& d, const RawlogWriteOptions& opt) {
+void writeRawlog(const std::string& path, const Recording& d, const RawlogWriteOptions& opt) {
   mrpt::io::CFileGZOutputStream out;
   if (!out.open(path, opt.gzip ? std::clamp(opt.gzip_level, 1, 9) : 0))
     throw Error(path + ": cannot open the rawlog for writing");
@@ -66,12 +66,12 @@ void writeRawlog(const std::string& path, const emulation::EmulationData& d, con
     mrpt::obs::CObservationComment c;
     c.sensorLabel = "SCENARIO";
     c.timestamp = stamp(su, 0.0);
-    c.text = d.scenario_yaml;
+    c.text = d.metadata;
     arch << c;
   }
   std::vector<Entry> order;
-  order.reserve(d.imu.size() + d.gnss.size() + d.baro.size() + d.truth.size());
-  for (std::size_t i = 0; i < d.truth.size(); ++i) order.push_back({d.truth[i].t, 0, i});
+  order.reserve(d.imu.size() + d.gnss.size() + d.baro.size() + d.reference.size());
+  for (std::size_t i = 0; i < d.reference.size(); ++i) order.push_back({d.reference[i].t, 0, i});
   for (std::size_t i = 0; i < d.imu.size(); ++i) order.push_back({d.imu[i].t, 1, i});
   for (std::size_t i = 0; i < d.baro.size(); ++i) order.push_back({d.baro[i].t, 2, i});
   for (std::size_t i = 0; i < d.gnss.size(); ++i) order.push_back({d.gnss[i].t, 3, i});
@@ -87,8 +87,6 @@ void writeRawlog(const std::string& path, const emulation::EmulationData& d, con
   mrpt::obs::CObservationGPS gps;
   gps.sensorLabel = "GNSS";
   gps.has_satellite_timestamp = false;
-  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
-  (void)zero;
   for (const Entry& e : order) {
     const auto ts = stamp(su, rel(e.t));
     if (e.order == 1) {
@@ -106,18 +104,23 @@ void writeRawlog(const std::string& path, const emulation::EmulationData& d, con
       baro.set(mrpt::obs::IMU_ALTITUDE, d.baro[e.index].h);
       arch << baro;
     } else if (e.order == 0) {
-      const auto& r = d.truth[e.index];
+      const auto& r = d.reference[e.index];
       gt.timestamp = ts;
+      gt.dataIsPresent.fill(false);
       gt.set(mrpt::obs::IMU_X, r.p_L[0]);
       gt.set(mrpt::obs::IMU_Y, r.p_L[1]);
       gt.set(mrpt::obs::IMU_Z, r.p_L[2]);
-      gt.set(mrpt::obs::IMU_X_VEL, r.v_N[0]);
-      gt.set(mrpt::obs::IMU_Y_VEL, r.v_N[1]);
-      gt.set(mrpt::obs::IMU_Z_VEL, r.v_N[2]);
-      gt.set(mrpt::obs::IMU_ORI_QUAT_X, r.q_BtoN.x());
-      gt.set(mrpt::obs::IMU_ORI_QUAT_Y, r.q_BtoN.y());
-      gt.set(mrpt::obs::IMU_ORI_QUAT_Z, r.q_BtoN.z());
-      gt.set(mrpt::obs::IMU_ORI_QUAT_W, r.q_BtoN.w());
+      if (r.v_N) {
+        gt.set(mrpt::obs::IMU_X_VEL, (*r.v_N)[0]);
+        gt.set(mrpt::obs::IMU_Y_VEL, (*r.v_N)[1]);
+        gt.set(mrpt::obs::IMU_Z_VEL, (*r.v_N)[2]);
+      }
+      if (r.q_BtoN) {
+        gt.set(mrpt::obs::IMU_ORI_QUAT_X, r.q_BtoN->x());
+        gt.set(mrpt::obs::IMU_ORI_QUAT_Y, r.q_BtoN->y());
+        gt.set(mrpt::obs::IMU_ORI_QUAT_Z, r.q_BtoN->z());
+        gt.set(mrpt::obs::IMU_ORI_QUAT_W, r.q_BtoN->w());
+      }
       arch << gt;
     } else {
       const auto& f = d.gnss[e.index];
@@ -146,11 +149,11 @@ void writeRawlog(const std::string& path, const emulation::EmulationData& d, con
       pzs.longitude_degrees = gga.fields.longitude_degrees;
       pzs.height_meters = f.pos.h;
       pzs.RTK_height_meters = f.pos.h;
-      pzs.PSigma = static_cast<float>(std::sqrt(f.cov_pos_N.trace()));
+      if (f.cov_pos_N) pzs.PSigma = static_cast<float>(std::sqrt(f.cov_pos_N->trace()));
       pzs.Fix = 1;
       const Eigen::Matrix3d C_NtoE = earth::C_EtoN(f.pos.lat, f.pos.lon).transpose();
       const Eigen::Vector3d r_E = earth::geodeticToEcef(f.pos);
-      const Eigen::Vector3d v_E = C_NtoE * f.v_N;
+      const Eigen::Vector3d v_E = f.v_N ? Eigen::Vector3d(C_NtoE * *f.v_N) : Eigen::Vector3d::Constant(NAN);
       pzs.hasCartesianPosVel = true;
       pzs.cartesian_x = r_E[0];
       pzs.cartesian_y = r_E[1];
@@ -158,10 +161,10 @@ void writeRawlog(const std::string& path, const emulation::EmulationData& d, con
       pzs.cartesian_vx = v_E[0];
       pzs.cartesian_vy = v_E[1];
       pzs.cartesian_vz = v_E[2];
-      pzs.hasPosCov = true;
-      pzs.pos_covariance = mrpt::math::CMatrixFloat44(cov4(C_NtoE * f.cov_pos_N * C_NtoE.transpose()));
-      pzs.hasVelCov = true;
-      pzs.vel_covariance = mrpt::math::CMatrixFloat44(cov4(C_NtoE * f.cov_vel_N * C_NtoE.transpose()));
+      pzs.hasPosCov = f.cov_pos_N.has_value();
+      if (f.cov_pos_N) pzs.pos_covariance = mrpt::math::CMatrixFloat44(cov4(C_NtoE * *f.cov_pos_N * C_NtoE.transpose()));
+      pzs.hasVelCov = f.cov_vel_N.has_value();
+      if (f.cov_vel_N) pzs.vel_covariance = mrpt::math::CMatrixFloat44(cov4(C_NtoE * *f.cov_vel_N * C_NtoE.transpose()));
       gps.setMsg(pzs);
       arch << gps;
     }
@@ -170,22 +173,20 @@ void writeRawlog(const std::string& path, const emulation::EmulationData& d, con
   if (!std::filesystem::exists(path)) throw Error(path + ": rawlog was not written");
 }
 
-emulation::EmulationData readRawlog(const std::string& path) {
+Recording readRawlog(const std::string& path) {
   InputScope scope(path);
   if (!std::filesystem::exists(path)) throw Error(path + ": rawlog not found");
   // Entries through one 1 MiB buffer (MRPT's archive reads every field with its
   // own small Read() call), with the length caps and gzip checks of EntryReader.
   detail::EntryReader reader(path);
-  emulation::EmulationData d;
+  Recording d;
+  d.source = path;
   bool haveComment = false, haveOrigin = false, haveBase = false;
   mrpt::Clock::time_point base{};
   std::size_t entry = 0, skipped = 0;
   double lastT = -1e300;
   std::string lastLabel;
-  std::vector<mrpt::Clock::time_point> pendingGt;  // unused: GT requires the comment first
   earth::Geodetic origin;
-  Eigen::Vector3d r0_E = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d C_LtoE = Eigen::Matrix3d::Identity();
   auto where = [&](const std::string& label, double t) {
     std::string s = path + ": entry " + std::to_string(entry);
     if (!label.empty()) s += " (label " + printable(label, 40) + (std::isfinite(t) ? ", t = " + std::to_string(t) + " s" : "") + ")";
@@ -198,15 +199,13 @@ emulation::EmulationData readRawlog(const std::string& path) {
     if (auto c = std::dynamic_pointer_cast<mrpt::obs::CObservationComment>(obj)) {
       if (!haveComment) {
         haveComment = true;
-        d.scenario_yaml = c->text;
+        d.metadata = c->text;
         try {
           const YAML::Node y = YAML::Load(c->text)["navimpact_scenario"];
           if (y && y["origin"]) {
             origin = {y["origin"]["lat_deg"].as<double>() * M_PI / 180, y["origin"]["lon_deg"].as<double>() * M_PI / 180,
                       y["origin"]["height_m"].as<double>()};
             haveOrigin = true;
-            r0_E = earth::geodeticToEcef(origin);
-            C_LtoE = earth::C_EtoN(origin.lat, origin.lon).transpose();
           }
           if (y && y["time"] && y["time"]["start_unix_s"]) {
             d.start_unix_s = y["time"]["start_unix_s"].as<long long>();
@@ -223,16 +222,14 @@ emulation::EmulationData readRawlog(const std::string& path) {
     auto o = std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj);
     if (!o) { ++skipped; continue; }
     const std::string& label = o->sensorLabel;
-    if (!haveBase) {
-      if (label != "IMU") {  // no time base yet: the first IMU sample defines it
-        if (label == "GT" || label == "GNSS" || label == "BARO") {
-          base = o->timestamp;
-          haveBase = true;
-        }
-      } else {
-        base = o->timestamp;
-        haveBase = true;
-      }
+    if (!haveBase && (label == "IMU" || label == "GT" || label == "GNSS" || label == "BARO")) {
+      // no time base in the comment: the first entry of a known label defines
+      // time zero; its absolute time is kept as start_unix_s + (0 - t_start_s)
+      base = o->timestamp;
+      haveBase = true;
+      const double u = mrpt::Clock::toDouble(base);
+      d.start_unix_s = static_cast<long long>(std::floor(u));
+      d.t_start_s = static_cast<double>(d.start_unix_s) - u;
     }
     const double t = haveBase ? static_cast<double>((o->timestamp - base).count()) * kTick : 0.0;
     if (t < lastT)
@@ -259,7 +256,7 @@ emulation::EmulationData readRawlog(const std::string& path) {
         return v;
       };
       if (label == "IMU") {
-        emulation::ImuRecord r;
+        ImuRecord r;
         r.t = t;
         const char* w = "1000 rad/s";
         const char* f = "1e5 m/s^2";
@@ -271,44 +268,48 @@ emulation::EmulationData readRawlog(const std::string& path) {
                  rate(mrpt::obs::IMU_Z_ACC, "IMU_Z_ACC", kMaxAbsSpecificForce, f)};
         d.imu.push_back(r);
       } else if (label == "BARO") {
-        d.baro.push_back({t, need(mrpt::obs::IMU_ALTITUDE, "IMU_ALTITUDE"), NAN});
+        d.baro.push_back({t, need(mrpt::obs::IMU_ALTITUDE, "IMU_ALTITUDE"), std::nullopt});
       } else {
         if (!haveOrigin) throw Error(where(label, t) + ": ground truth needs the scenario comment's origin, none found before it");
-        emulation::TruthRecord r;
+        ReferenceRecord r;
         r.t = t;
         r.p_L = {need(mrpt::obs::IMU_X, "IMU_X"), need(mrpt::obs::IMU_Y, "IMU_Y"), need(mrpt::obs::IMU_Z, "IMU_Z")};
-        r.v_N = {need(mrpt::obs::IMU_X_VEL, "IMU_X_VEL"), need(mrpt::obs::IMU_Y_VEL, "IMU_Y_VEL"),
-                 need(mrpt::obs::IMU_Z_VEL, "IMU_Z_VEL")};
-        r.q_BtoN = Eigen::Quaterniond(need(mrpt::obs::IMU_ORI_QUAT_W, "IMU_ORI_QUAT_W"),
-                                      need(mrpt::obs::IMU_ORI_QUAT_X, "IMU_ORI_QUAT_X"),
-                                      need(mrpt::obs::IMU_ORI_QUAT_Y, "IMU_ORI_QUAT_Y"),
-                                      need(mrpt::obs::IMU_ORI_QUAT_Z, "IMU_ORI_QUAT_Z"));
-        d.truth.push_back(r);
+        // velocity and attitude: all of their fields or none
+        if (m->has(mrpt::obs::IMU_X_VEL) || m->has(mrpt::obs::IMU_Y_VEL) || m->has(mrpt::obs::IMU_Z_VEL))
+          r.v_N = Eigen::Vector3d(need(mrpt::obs::IMU_X_VEL, "IMU_X_VEL"), need(mrpt::obs::IMU_Y_VEL, "IMU_Y_VEL"),
+                                  need(mrpt::obs::IMU_Z_VEL, "IMU_Z_VEL"));
+        if (m->has(mrpt::obs::IMU_ORI_QUAT_W) || m->has(mrpt::obs::IMU_ORI_QUAT_X) ||
+            m->has(mrpt::obs::IMU_ORI_QUAT_Y) || m->has(mrpt::obs::IMU_ORI_QUAT_Z))
+          r.q_BtoN = Eigen::Quaterniond(need(mrpt::obs::IMU_ORI_QUAT_W, "IMU_ORI_QUAT_W"),
+                                        need(mrpt::obs::IMU_ORI_QUAT_X, "IMU_ORI_QUAT_X"),
+                                        need(mrpt::obs::IMU_ORI_QUAT_Y, "IMU_ORI_QUAT_Y"),
+                                        need(mrpt::obs::IMU_ORI_QUAT_Z, "IMU_ORI_QUAT_Z"));
+        d.reference.push_back(r);
       }
     } else if (label == "GNSS") {
       auto g = std::dynamic_pointer_cast<mrpt::obs::CObservationGPS>(o);
       if (!g) throw Error(where(label, t) + ": expected a CObservationGPS, found " + o->GetRuntimeClass()->className);
-      emulation::GnssFix f;
+      GnssFix f;
       f.t = t;
       if (const auto* p = g->getMsgByClassPtr<gnss::Message_TOPCON_PZS>(); p && p->hasCartesianPosVel) {
         const Eigen::Vector3d r_E(p->cartesian_x, p->cartesian_y, p->cartesian_z);
         f.pos = earth::ecefToGeodetic(r_E);
         const Eigen::Matrix3d C_EtoN = earth::C_EtoN(f.pos.lat, f.pos.lon);
-        f.v_N = C_EtoN * Eigen::Vector3d(p->cartesian_vx, p->cartesian_vy, p->cartesian_vz);
-        f.cov_pos_N = f.cov_vel_N = Eigen::Matrix3d::Constant(NAN);
+        const Eigen::Vector3d v_E(p->cartesian_vx, p->cartesian_vy, p->cartesian_vz);
+        // products assigned into the emplaced values (as into a plain Matrix3d: Eigen evaluates an
+        // assignment and a construction from a product differently in the last bit)
+        if (v_E.allFinite()) f.v_N.emplace() = C_EtoN * v_E;
         if (p->hasPosCov) {
           const Eigen::Matrix3d c = p->pos_covariance.asEigen().topLeftCorner<3, 3>().cast<double>();
-          f.cov_pos_N = C_EtoN * c * C_EtoN.transpose();
+          f.cov_pos_N.emplace() = C_EtoN * c * C_EtoN.transpose();
         }
         if (p->hasVelCov) {
           const Eigen::Matrix3d c = p->vel_covariance.asEigen().topLeftCorner<3, 3>().cast<double>();
-          f.cov_vel_N = C_EtoN * c * C_EtoN.transpose();
+          f.cov_vel_N.emplace() = C_EtoN * c * C_EtoN.transpose();
         }
       } else if (const auto* gga = g->getMsgByClassPtr<gnss::Message_NMEA_GGA>()) {
         f.pos = {gga->fields.latitude_degrees * M_PI / 180, gga->fields.longitude_degrees * M_PI / 180,
                  gga->fields.altitude_meters + gga->fields.geoidal_distance * 0.0};
-        f.v_N = Eigen::Vector3d::Constant(NAN);
-        f.cov_pos_N = f.cov_vel_N = Eigen::Matrix3d::Constant(NAN);
       } else {
         throw Error(where(label, t) + ": GNSS entry has neither a TOPCON_PZS nor an NMEA GGA message");
       }
@@ -324,10 +325,7 @@ emulation::EmulationData readRawlog(const std::string& path) {
   }
   if (skipped) d.notices.push_back(std::to_string(skipped) + " entries with other labels or types skipped");
   d.origin = origin;
-  d.t_start_s = 0.0;
   if (!haveOrigin && !d.gnss.empty()) d.origin = d.gnss.front().pos;
-  (void)r0_E;
-  (void)C_LtoE;
   return d;
 }
 

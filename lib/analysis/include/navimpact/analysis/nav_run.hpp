@@ -8,9 +8,9 @@
  * This is THE navigation loop of navimpact. Both the Monte Carlo emulation
  * study (analysis/study.hpp, `navimpact study`) and the rawlog replay
  * (`navimpact replay`) must run their filters through runNav(): the replay
- * converts its rawlog records to the inputs below (emulation::ImuRecord ->
- * ins::ImuSample::fromRates, GNSS/BARO records as they are, GT records to a
- * TruthSeries) and calls runNav() once. Without ground truth (a real
+ * converts its recording (navimpact::Recording) to the inputs below
+ * (ImuRecord -> ins::ImuSample::fromRates, GNSS fixes and baro samples as
+ * they are, the reference to a TruthSeries) and calls runNav() once. Without ground truth (a real
  * flight's rawlog) the truth pointer is null and only the estimate and the
  * predicted sigmas are recorded.
  *
@@ -42,6 +42,7 @@
 
 #include <Eigen/Core>
 
+#include "navimpact/core/recording.hpp"
 #include "navimpact/emulation/sensors.hpp"
 #include "navimpact/filter/ekf.hpp"
 #include "navimpact/ins/nav_state.hpp"
@@ -65,8 +66,10 @@ struct TruthSeries {
 struct NavRunInput {
   ins::NavState x0;                                        ///< initial estimate at x0.t
   const std::vector<ins::ImuSample>* imu = nullptr;        ///< raw samples (with errors), first covers (x0.t, x0.t + dt]
-  const std::vector<emulation::GnssFix>* gnss = nullptr;   ///< may be null (no GNSS)
-  const std::vector<emulation::BaroSample>* baro = nullptr;///< may be null (no baro)
+  /// May be null (no GNSS). Every fix used needs cov_pos_N; its velocity is
+  /// applied (with use_gnss_velocity) when the fix has one, and then needs cov_vel_N.
+  const std::vector<GnssFix>* gnss = nullptr;
+  const std::vector<BaroSample>* baro = nullptr;  ///< may be null (no baro); every sample used needs sigma_m
   /// Record epochs and truth. May be null (data without ground truth): the
   /// run then records the estimate and sigmas every NavRunOptions::record_interval_s,
   /// with errors and NEES NaN.
@@ -122,7 +125,8 @@ struct NavRunResult {
  * @param[in] model  the IMU error model the FILTER uses (need not be the truth's).
  * @param[in] opt    options.
  * @throws navimpact::Error when inputs are missing, times are not increasing,
- *         or a truth epoch does not fall on an IMU sample (to half an interval).
+ *         a truth epoch does not fall on an IMU sample (to half an interval),
+ *         or a GNSS fix or baro sample used lacks its covariance / sigma.
  */
 NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
                     const NavRunOptions& opt);
@@ -130,8 +134,8 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
 /// The data of one emulated run, owned; input() points a NavRunInput at them.
 struct EmulatedRun {
   std::vector<ins::ImuSample> imu;           ///< perfect increments + IMU errors
-  std::vector<emulation::GnssFix> gnss;      ///< seeded GNSS fixes
-  std::vector<emulation::BaroSample> baro;   ///< seeded barometer samples
+  std::vector<GnssFix> gnss;                 ///< seeded GNSS fixes
+  std::vector<BaroSample> baro;              ///< seeded barometer samples
   ins::NavState x0;                          ///< truth at t0 with the seeded initial error
   /// Inputs for runNav over this run against @p truth (which must outlive the call).
   NavRunInput input(const TruthSeries& truth) const;

@@ -42,7 +42,7 @@
 #include <vector>
 
 #include "navimpact/analysis/nav_run.hpp"
-#include "navimpact/emulation/records.hpp"
+#include "navimpact/core/recording.hpp"
 
 namespace navimpact::analysis {
 

@@ -2,7 +2,7 @@
  * @file scenario.hpp
  * @brief An emulation scenario from a YAML configuration, and its run:
  *        trajectory -> smooth truth -> perfect IMU -> IMU errors -> GNSS,
- *        barometer and ground truth records.
+ *        barometer and ground truth records (a navimpact::Recording).
  *
  * Configuration keys (units in the names or stated; relative paths are
  * resolved against the configuration file's folder):
@@ -39,7 +39,7 @@
 
 #include <string>
 
-#include "navimpact/emulation/records.hpp"
+#include "navimpact/core/recording.hpp"
 #include "navimpact/emulation/sensors.hpp"
 #include "navimpact/emulation/trajectory.hpp"
 
@@ -72,8 +72,13 @@ EmulationConfig loadEmulationConfig(const std::string& path);
  * Run a scenario.
  * @param[in] cfg      configuration.
  * @param[in] version  navimpact version string, recorded in the scenario text.
+ * @return the recording: IMU at imu_rate_hz, GNSS fixes with velocity and
+ *         covariances, baro with sigma, the truth as its reference (position,
+ *         velocity, attitude) at ground_truth.rate_hz, times on the
+ *         trajectory's axis (t_start_s = first trajectory time), the scenario
+ *         YAML as its metadata.
  * @throws navimpact::Error for any bad input (trajectory, model, recording).
  */
-EmulationData runEmulation(const EmulationConfig& cfg, const std::string& version);
+Recording runEmulation(const EmulationConfig& cfg, const std::string& version);
 
 }  // namespace navimpact::emulation

@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 
 #include "navimpact/core/csv_reader.hpp"
+#include "navimpact/core/recording.hpp"
 #include "navimpact/emulation/trajectory.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 
@@ -89,31 +90,16 @@ struct BaroOptions {
   std::uint64_t seed = 3;  ///< noise seed
 };
 
-/// One GNSS fix: antenna position and velocity with white noise, and its covariance.
-struct GnssFix {
-  double t = 0.0;                 ///< [s]
-  earth::Geodetic pos;            ///< antenna position (noisy)
-  Eigen::Vector3d v_N;            ///< antenna velocity w.r.t. Earth in N (noisy) [m/s]
-  Eigen::Matrix3d cov_pos_N;      ///< position covariance in N [m^2]
-  Eigen::Matrix3d cov_vel_N;      ///< velocity covariance in N [m^2/s^2]
-};
-
-/// One barometer sample: ellipsoidal height with white noise.
-struct BaroSample {
-  double t = 0.0;      ///< [s]
-  double h = 0.0;      ///< height above the ellipsoid [m]
-  double sigma = 0.0;  ///< its standard deviation [m]
-};
-
 /**
- * GNSS fixes at t_start + k / rate_hz (k = 0, 1, ...) up to t_end. The antenna
+ * GNSS fixes at t_start + k / rate_hz (k = 0, 1, ...) up to t_end, each with
+ * its velocity and diagonal covariances (white noise of GnssOptions). The antenna
  * is at r_IMU + C_BtoN l_B, moving at v_N + C_BtoN (w_NB_B x l_B) (Groves 2013
  * eq. 14.121 without the small Earth-rate term of the lever arm).
  */
 std::vector<GnssFix> simulateGnss(const SmoothTrajectory& tr, const GnssOptions& opt, double t_start,
                                   double t_end);
 
-/// Barometer samples at t_start + k / rate_hz up to t_end.
+/// Barometer samples at t_start + k / rate_hz up to t_end, with their sigma.
 std::vector<BaroSample> simulateBaro(const SmoothTrajectory& tr, const BaroOptions& opt, double t_start,
                                      double t_end);
 

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "navimpact/core/earth.hpp"
+#include "navimpact/core/recording.hpp"
 
 namespace navimpact::ins {
 
@@ -32,6 +33,14 @@ struct NavState {
   /// Set the attitude from roll, pitch, yaw [rad] (ZYX, Groves 2.22).
   void setRollPitchYaw(double roll, double pitch, double yaw);
 };
+
+/**
+ * Navigation state of a reference record (the truth of an emulation):
+ * position from its tangent-plane NED offset at @p origin
+ * (earth::nedToGeodetic), velocity, attitude normalised, t = r.t.
+ * @throws navimpact::Error "reference at t = T s has no velocity|attitude".
+ */
+NavState navStateOf(const ReferenceRecord& r, const earth::Geodetic& origin);
 
 /// Quaternion of the ZYX Euler angles roll, pitch, yaw [rad].
 Eigen::Quaterniond quatFromRollPitchYaw(double roll, double pitch, double yaw);

@@ -1,29 +1,34 @@
 /**
  * @file writer.hpp
- * @brief Write an emulation as an MRPT rawlog (observation-only format: a
- *        sequence of serialized CObservation objects, gzip by default), and
- *        read any such rawlog back as time-ordered records for a replay.
+ * @brief Write a navimpact::Recording as an MRPT rawlog (observation-only
+ *        format: a sequence of serialized CObservation objects, gzip by
+ *        default), and read any such rawlog back as a Recording.
  *
  * Entries, in time order (equal times: GT, IMU, BARO, GNSS):
- *  - first a CObservationComment (label "SCENARIO"): the scenario as YAML text
- *    (frames, units, origin, time base, seeds, models, source files, version);
+ *  - first a CObservationComment (label "SCENARIO"): the recording's metadata
+ *    (an emulation's scenario as YAML: frames, units, origin, time base,
+ *    seeds, models, source files, version);
  *  - label "IMU": CObservationIMU, IMU_WX/WY/WZ [rad/s] and IMU_X_ACC/Y_ACC/Z_ACC
  *    [m/s^2], body FRD, means over the interval ending at the timestamp;
- *  - label "BARO": CObservationIMU with only IMU_ALTITUDE [m above the ellipsoid];
+ *  - label "BARO": CObservationIMU with only IMU_ALTITUDE [m above the ellipsoid]
+ *    (the sample's sigma is not stored: it belongs to the scenario);
  *  - label "GNSS": CObservationGPS with an NMEA GGA (lat/lon [deg], ellipsoidal
  *    height in altitude_meters, geoidal separation 0) and a TOPCON_PZS carrying
  *    ECEF position [m] and velocity [m/s] and their covariances (ECEF, upper-left
- *    3x3 of the 4x4 matrices; float precision);
+ *    3x3 of the 4x4 matrices; float precision). A fix without velocity has NaN
+ *    in the PZS velocity fields; a fix without a covariance leaves hasPosCov /
+ *    hasVelCov false;
  *  - label "GT": CObservationIMU with IMU_X/Y/Z [m] in the tangent-plane NED
- *    frame at the comment's origin, IMU_X_VEL/Y_VEL/Z_VEL [m/s] local NED, and
- *    IMU_ORI_QUAT_X/Y/Z/W of C_BtoN.
+ *    frame at the comment's origin, and when the reference has them,
+ *    IMU_X_VEL/Y_VEL/Z_VEL [m/s] local NED and IMU_ORI_QUAT_X/Y/Z/W of C_BtoN
+ *    (reference sigmas are not stored).
  * Timestamps: start_unix_s + (t - t_start_s), in MRPT's 100 ns ticks, exact.
  */
 #pragma once
 
 #include <string>
 
-#include "navimpact/emulation/records.hpp"
+#include "navimpact/core/recording.hpp"
 
 namespace navimpact::rawlog {
 
@@ -37,19 +42,23 @@ struct RawlogWriteOptions {
  * Write @p data to @p path (overwritten).
  * @throws navimpact::Error naming the file when it cannot be written.
  */
-void writeRawlog(const std::string& path, const emulation::EmulationData& data,
-                 const RawlogWriteOptions& opt = {});
+void writeRawlog(const std::string& path, const Recording& data, const RawlogWriteOptions& opt = {});
 
 /**
  * Read a rawlog with the labels above (any other entry is skipped, counted in
  * the notices). Times are seconds since the scenario's start (start_unix_s
- * from the comment), or since the first IMU sample when there is no
- * scenario comment. GNSS fixes come from the PZS message when present (ECEF
- * position, velocity, covariances), else from GGA with the velocity left NaN.
+ * from the comment, t_start_s = 0), or since the first IMU/GNSS/BARO/GT entry
+ * when the comment has no time base (then start_unix_s and t_start_s keep
+ * that entry's absolute time). GNSS fixes come from the PZS message when
+ * present (ECEF position, velocity, covariances; each only when present),
+ * else from GGA (position only). The reference (GT) has its velocity and
+ * attitude when all their fields are set. source = @p path, metadata = the
+ * first comment, origin from the comment (else the first GNSS fix).
  * @throws navimpact::Error "FILE: entry N (label L, t = ...): ..." for a
  *         malformed or truncated entry, timestamps going backwards, a GT entry
- *         without a scenario origin.
+ *         without a scenario origin or with only some of its velocity or
+ *         attitude fields.
  */
-emulation::EmulationData readRawlog(const std::string& path);
+Recording readRawlog(const std::string& path);
 
 }  // namespace navimpact::rawlog
