@@ -4,7 +4,9 @@
 # paper's static covariance study, replay the bundled emulated UAV rawlog with
 # a 60 s GNSS outage after 200 s of GNSS, and run the paper's Monte Carlo
 # model comparison with a modest run count; then diagnose what a white-noise
-# simulation of the excerpt gets wrong, and what fixing it gains in navigation.
+# simulation of the excerpt gets wrong, and what fixing it gains in navigation;
+# finally import a real rover run (ESA Katwijk: IMU + RTK GNSS CSV) through its
+# manifest into an MRPT rawlog.
 # Re-running replaces the earlier outputs (--overwrite).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,27 +18,31 @@ NI=build/bin/navimpact
 mkdir -p "$OUT"
 
 echo
-echo "== 1/5 GMWM model of the bundled ADIS16405 static excerpt (navimpact fit) =="
+echo "== 1/6 GMWM model of the bundled ADIS16405 static excerpt (navimpact fit) =="
 "$NI" fit --input datasets/adis16405_static_excerpt.csv.gz --rate 100 \
   --gyro-unit deg/s --acc-unit g --structure auto --out "$OUT/fit" --overwrite
 
 echo
-echo "== 2/5 static covariance analysis, paper Figs. 5-6 (navimpact covariance) =="
+echo "== 2/6 static covariance analysis, paper Figs. 5-6 (navimpact covariance) =="
 "$NI" covariance --config config/paper/covariance_static.yaml --out "$OUT/covariance" --overwrite
 
 echo
-echo "== 3/5 replay of the emulated UAV rawlog with a 60 s GNSS outage (navimpact replay) =="
+echo "== 3/6 replay of the emulated UAV rawlog with a 60 s GNSS outage (navimpact replay) =="
 "$NI" replay --config config/replay/default.yaml --out "$OUT/replay" --overwrite
 
 echo
-echo "== 4/5 Monte Carlo model comparison, paper Figs. 8-9 (navimpact study, $RUNS runs) =="
+echo "== 4/6 Monte Carlo model comparison, paper Figs. 8-9 (navimpact study, $RUNS runs) =="
 "$NI" study --config config/paper/study_navchip_uav.yaml --runs "$RUNS" --out "$OUT/study" --overwrite
 
 echo
-echo "== 5/5 what a white-noise simulation of the excerpt gets wrong, and the navigation gain (navimpact diagnose) =="
+echo "== 5/6 what a white-noise simulation of the excerpt gets wrong, and the navigation gain (navimpact diagnose) =="
 "$NI" diagnose --input datasets/adis16405_static_excerpt.csv.gz --rate 100 \
   --gyro-unit deg/s --acc-unit g --model fit:WN \
   --trajectory datasets/uav_flight_260s.csv.gz --outage 200:60 --out "$OUT/diagnose" --overwrite
+
+echo
+echo "== 6/6 import of a real rover run, ESA Katwijk IMU + RTK GNSS (navimpact import) =="
+"$NI" import --manifest datasets/katwijk_rover/manifest.yaml --out "$OUT/katwijk_rover.rawlog" --overwrite
 
 echo
 echo "demo outputs in $OUT/:"
@@ -45,3 +51,4 @@ echo "  $OUT/covariance/summary.json, covariance_*.png"
 echo "  $OUT/replay/summary.json, *.png"
 echo "  $OUT/study/report.md   <- read this first"
 echo "  $OUT/diagnose/report.md, diagnosis.json, model_extended.yaml, *.png"
+echo "  $OUT/katwijk_rover.rawlog   (rawlog-edit --info -i ...; RawLogViewer)"

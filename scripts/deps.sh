@@ -9,6 +9,7 @@ PKGS=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev zlib1g-dev
   libmrpt-obs-dev libmrpt-io-dev libmrpt-poses-dev libmrpt-random-dev
   libmrpt-system-dev libmrpt-config-dev
+  mrpt-apps
   libopencv-dev libopencv-contrib-dev fonts-dejavu-core
   libgtest-dev libbenchmark-dev
   slurm-wlm munge

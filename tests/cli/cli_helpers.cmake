@@ -244,17 +244,76 @@ function(check_rawlog_edit_info)
   if(NOT rc EQUAL 0)
     fail("rawlog-edit --info failed (${rc}): ${out}${err}")
   endif()
-  foreach(re "All sensor labels *: *, BARO, GNSS, GT, IMU"
+  foreach(re "All sensor labels *: *, BARO, GNSS, GT, GT_VEL, IMU"
              "IMU / +6000 /200\\.000"
              "GNSS / +31 /1\\.000"
              "BARO / +301 /10\\.000"
              "GT / +301 /10\\.000"
+             "GT_VEL / +301 /10\\.000"
              "Observations format *: Yes")
     if(NOT "${out}" MATCHES "${re}")
       fail("rawlog-edit --info output does not match '${re}':\n${out}")
     endif()
   endforeach()
   message("rawlog-edit --info: labels and rates as expected")
+endfunction()
+
+# rawlog-edit --export-txt of an imported rawlog: the reference (label GT) is a
+# pose observation whose rows give a travelled distance. The horizontal L1 path
+# length (sum of |dE| + |dN|, in 1e-5 m from the 5-decimal text) must lie
+# between MIN_M and MAX_M metres, and there must be ROWS rows.
+function(check_rawlog_edit_gt_distance)
+  find_program(RAWLOG_EDIT rawlog-edit)
+  if(NOT RAWLOG_EDIT)
+    message("rawlog-edit not installed (apt-get install mrpt-apps): check skipped")
+    return()
+  endif()
+  get_filename_component(dir ${RAWLOG} DIRECTORY)
+  get_filename_component(stem ${RAWLOG} NAME_WE)
+  get_filename_component(name ${RAWLOG} NAME)
+  file(REMOVE ${dir}/${stem}_GT.txt)
+  # a relative -i: rawlog-edit prefixes the output names with the input's folder without a separator
+  execute_process(COMMAND ${RAWLOG_EDIT} --export-txt -i ${name} WORKING_DIRECTORY ${dir}
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT EXISTS ${dir}/${stem}_GT.txt)
+    fail("rawlog-edit --export-txt failed (${rc}) or wrote no ${stem}_GT.txt: ${out}${err}")
+  endif()
+  file(STRINGS ${dir}/${stem}_GT.txt lines REGEX "^[0-9]")
+  list(LENGTH lines n)
+  if(NOT n EQUAL ${ROWS})
+    fail("${stem}_GT.txt: ${n} pose rows, expected ${ROWS}")
+  endif()
+  set(total 0)
+  set(first TRUE)
+  foreach(l ${lines})
+    string(REGEX MATCHALL "[-0-9.]+" f "${l}")
+    list(GET f 1 x)
+    list(GET f 2 y)
+    foreach(v x y)   # metres with 5 decimals -> integer 1e-5 m
+      string(REPLACE "." "" ${v} "${${v}}")
+      math(EXPR ${v} "${${v}} + 0")
+    endforeach()
+    if(NOT first)
+      math(EXPR dx "${x} - ${px}")
+      math(EXPR dy "${y} - ${py}")
+      if(dx LESS 0)
+        math(EXPR dx "-${dx}")
+      endif()
+      if(dy LESS 0)
+        math(EXPR dy "-${dy}")
+      endif()
+      math(EXPR total "${total} + ${dx} + ${dy}")
+    endif()
+    set(first FALSE)
+    set(px ${x})
+    set(py ${y})
+  endforeach()
+  math(EXPR lo "${MIN_M} * 100000")
+  math(EXPR hi "${MAX_M} * 100000")
+  if(total LESS lo OR total GREATER hi)
+    fail("rawlog-edit: reference path length (L1) ${total} x 1e-5 m outside [${MIN_M}, ${MAX_M}] m")
+  endif()
+  message("rawlog-edit --export-txt: ${n} reference poses, L1 path length ${total} x 1e-5 m")
 endfunction()
 
 # replay of the committed rawlog into DIR: outputs, one outage with a

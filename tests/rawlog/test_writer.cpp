@@ -4,6 +4,11 @@
 #include <filesystem>
 #include <fstream>
 
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/obs/CObservationGPS.h>
+#include <mrpt/obs/CObservationRobotPose.h>
+#include <mrpt/serialization/CArchive.h>
+
 #include "navimpact/core/error.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "test_support.hpp"
@@ -77,8 +82,16 @@ void expectRoundTrip(const Recording& a, const Recording& b) {
       EXPECT_EQ(*y.v_N, *x.v_N);
     }
     ASSERT_EQ(y.q_BtoN.has_value(), x.q_BtoN.has_value());
-    if (x.q_BtoN) {
-      EXPECT_EQ(y.q_BtoN->coeffs(), x.q_BtoN->coeffs());
+    if (x.q_BtoN) {  // through MRPT's pose rotation matrix: to rounding
+      EXPECT_LT(y.q_BtoN->angularDistance(*x.q_BtoN), 1e-14);
+    }
+    ASSERT_EQ(y.sigma_p_L.has_value(), x.sigma_p_L.has_value());
+    if (x.sigma_p_L) {
+      EXPECT_LT((*y.sigma_p_L - *x.sigma_p_L).norm(), 1e-15 * x.sigma_p_L->norm());
+    }
+    ASSERT_EQ(y.sigma_att.has_value(), x.sigma_att.has_value() && x.q_BtoN.has_value());
+    if (y.sigma_att) {
+      EXPECT_LT((*y.sigma_att - *x.sigma_att).norm(), 1e-15 * x.sigma_att->norm());
     }
   }
   ASSERT_EQ(b.gnss.size(), a.gnss.size());
@@ -191,4 +204,82 @@ TEST(RawlogWriter, BackwardsTimestampsAreRejected) {
 
 TEST(RawlogWriter, MissingFileIsAClearError) {
   EXPECT_NE(errorOf("/nonexistent/x.rawlog").find("not found"), std::string::npos);
+}
+
+// The reference is an MRPT pose observation as MRPT's tools read it: ENU map
+// frame, vehicle x forward / y left / z up, sigmas in its covariance; the GNSS
+// lever arm is the GNSS sensorPose; sigmas and a reference without attitude
+// come back as they went in.
+TEST(RawlogWriter, ReferenceIsAnMrptPoseAndLeverArmTheGnssSensorPose) {
+  Recording d = sample();
+  d.lever_arm_B = Eigen::Vector3d(0.25, -0.5, -1.5);
+  for (std::size_t i = 0; i < d.reference.size(); ++i) {
+    if (i % 2) d.reference[i].sigma_p_L = Eigen::Vector3d(0.01 * (i + 1), 0.02, 0.05);
+    if (i % 3 == 1) d.reference[i].sigma_att = Eigen::Vector3d(1e-3, 2e-3, 5e-3);
+    if (i % 4 == 3) d.reference[i].q_BtoN.reset();
+  }
+  const auto p = (navimpact::test::tempDir() / "pose.rawlog").string();
+  navimpact::rawlog::writeRawlog(p, d);
+  const Recording b = navimpact::rawlog::readRawlog(p);
+  expectRoundTrip(d, b);
+  ASSERT_TRUE(b.lever_arm_B);
+  EXPECT_EQ(*b.lever_arm_B, *d.lever_arm_B);
+
+  // read with MRPT alone: the pose of reference k is (E, N, U) and a level body
+  // yawed by psi (clockwise from north) has MRPT yaw pi/2 - psi (anticlockwise from east)
+  mrpt::io::CFileGZInputStream in(p);
+  auto arch = mrpt::serialization::archiveFrom(in);
+  std::size_t k = 0, gps = 0;
+  for (;;) {
+    mrpt::serialization::CSerializable::Ptr o;
+    try {
+      o = arch.ReadObject();
+    } catch (const std::exception&) {
+      break;
+    }
+    if (!o) break;
+    if (auto g = std::dynamic_pointer_cast<mrpt::obs::CObservationGPS>(o)) {
+      EXPECT_DOUBLE_EQ(g->sensorPose.x(), 0.25);
+      EXPECT_DOUBLE_EQ(g->sensorPose.y(), 0.5);   // right -> left
+      EXPECT_DOUBLE_EQ(g->sensorPose.z(), 1.5);   // down -> up
+      ++gps;
+    }
+    auto r = std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(o);
+    if (!r) continue;
+    const auto& x = d.reference[k];
+    EXPECT_EQ(r->sensorLabel, "GT");
+    EXPECT_DOUBLE_EQ(r->pose.mean.x(), x.p_L[1]);
+    EXPECT_DOUBLE_EQ(r->pose.mean.y(), x.p_L[0]);
+    EXPECT_DOUBLE_EQ(r->pose.mean.z(), -x.p_L[2]);
+    ++k;
+  }
+  EXPECT_EQ(k, d.reference.size());
+  EXPECT_EQ(gps, d.gnss.size());
+
+  // a level body: MRPT yaw = pi/2 - psi
+  Recording lv = sample();
+  lv.reference.resize(1);
+  const double psi = 0.7;
+  lv.reference[0].q_BtoN = Eigen::Quaterniond(Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()));
+  const auto q = (navimpact::test::tempDir() / "level.rawlog").string();
+  navimpact::rawlog::writeRawlog(q, lv);
+  mrpt::io::CFileGZInputStream in2(q);
+  auto arch2 = mrpt::serialization::archiveFrom(in2);
+  for (;;) {
+    auto o = arch2.ReadObject();
+    if (auto r = std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(o)) {
+      EXPECT_NEAR(r->pose.mean.yaw(), M_PI / 2 - psi, 1e-14);
+      EXPECT_NEAR(r->pose.mean.pitch(), 0.0, 1e-14);
+      EXPECT_NEAR(r->pose.mean.roll(), 0.0, 1e-14);
+      break;
+    }
+  }
+}
+
+// Rawlogs written before the pose observation (GT as CObservationIMU) still read.
+TEST(RawlogWriter, LegacyGroundTruthAsImuObservationReads) {
+  const Recording b = navimpact::rawlog::readRawlog(navimpact::test::sourcePath("datasets/uav_flight_260s_ref.rawlog"));
+  ASSERT_EQ(b.reference.size(), 2601u);
+  EXPECT_TRUE(b.reference.front().v_N && b.reference.front().q_BtoN);
+  EXPECT_EQ(b.imu.size(), 52000u);
 }

@@ -295,6 +295,7 @@ Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
     while (std::getline(in, line)) y << "    " << line << "\n";
   }
   d.metadata = y.str();
+  d.lever_arm_B = g.lever_arm_B;
   return d;
 }
 

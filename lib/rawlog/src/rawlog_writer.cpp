@@ -6,6 +6,8 @@
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationGPS.h>
 #include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/obs/CObservationRobotPose.h>
+#include <mrpt/poses/CPose3D.h>
 #include <mrpt/serialization/CArchive.h>
 #include <yaml-cpp/yaml.h>
 
@@ -46,6 +48,20 @@ struct Entry {
   std::size_t index;
 };
 
+// The reference as a pose observation in MRPT's conventions: map frame ENU at
+// the origin (x east, y north, z up), vehicle frame x forward, y left, z up.
+// T_NtoENU maps NED to ENU; T_FLUtoFRD maps FLU to FRD (both are their own inverse).
+const Eigen::Matrix3d& T_NtoENU() {
+  static const Eigen::Matrix3d T = (Eigen::Matrix3d() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished();
+  return T;
+}
+const Eigen::Matrix3d& T_FLUtoFRD() {
+  static const Eigen::Matrix3d T = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  return T;
+}
+// Attitude variance that stands for "no attitude known" (sigma 1e6 rad).
+constexpr double kUnknownAttitudeVar = 1e12;
+
 Eigen::Matrix4f cov4(const Eigen::Matrix3d& c) {
   Eigen::Matrix4f m = Eigen::Matrix4f::Zero();
   m.topLeftCorner<3, 3>() = c.cast<float>();
@@ -80,13 +96,19 @@ void writeRawlog(const std::string& path, const Recording& d, const RawlogWriteO
     return ta != tb ? ta < tb : a.order < b.order;
   });
 
-  CObservationIMU imu, baro, gt;
+  CObservationIMU imu, baro, gtVel;
   imu.sensorLabel = "IMU";
   baro.sensorLabel = "BARO";
+  gtVel.sensorLabel = "GT_VEL";
+  mrpt::obs::CObservationRobotPose gt;
   gt.sensorLabel = "GT";
   mrpt::obs::CObservationGPS gps;
   gps.sensorLabel = "GNSS";
   gps.has_satellite_timestamp = false;
+  if (d.lever_arm_B) {  // antenna on the vehicle, MRPT vehicle frame FLU
+    const Eigen::Vector3d l = T_FLUtoFRD() * *d.lever_arm_B;
+    gps.sensorPose = mrpt::poses::CPose3D(l[0], l[1], l[2], 0, 0, 0);
+  }
   for (const Entry& e : order) {
     const auto ts = stamp(su, rel(e.t));
     if (e.order == 1) {
@@ -106,22 +128,35 @@ void writeRawlog(const std::string& path, const Recording& d, const RawlogWriteO
     } else if (e.order == 0) {
       const auto& r = d.reference[e.index];
       gt.timestamp = ts;
-      gt.dataIsPresent.fill(false);
-      gt.set(mrpt::obs::IMU_X, r.p_L[0]);
-      gt.set(mrpt::obs::IMU_Y, r.p_L[1]);
-      gt.set(mrpt::obs::IMU_Z, r.p_L[2]);
-      if (r.v_N) {
-        gt.set(mrpt::obs::IMU_X_VEL, (*r.v_N)[0]);
-        gt.set(mrpt::obs::IMU_Y_VEL, (*r.v_N)[1]);
-        gt.set(mrpt::obs::IMU_Z_VEL, (*r.v_N)[2]);
+      const Eigen::Vector3d p = T_NtoENU() * r.p_L;
+      Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+      if (r.q_BtoN) R = T_NtoENU() * r.q_BtoN->normalized().toRotationMatrix() * T_FLUtoFRD();
+      mrpt::math::CMatrixDouble33 rot;
+      mrpt::math::CVectorFixedDouble<3> xyz;
+      for (int a = 0; a < 3; ++a) {
+        xyz[a] = p[a];
+        for (int b = 0; b < 3; ++b) rot(a, b) = R(a, b);
       }
-      if (r.q_BtoN) {
-        gt.set(mrpt::obs::IMU_ORI_QUAT_X, r.q_BtoN->x());
-        gt.set(mrpt::obs::IMU_ORI_QUAT_Y, r.q_BtoN->y());
-        gt.set(mrpt::obs::IMU_ORI_QUAT_Z, r.q_BtoN->z());
-        gt.set(mrpt::obs::IMU_ORI_QUAT_W, r.q_BtoN->w());
+      gt.pose.mean = mrpt::poses::CPose3D(rot, xyz);
+      gt.pose.cov.setZero();  // zero: no sigma given
+      if (r.sigma_p_L) {
+        const Eigen::Vector3d s = T_NtoENU() * *r.sigma_p_L;
+        for (int a = 0; a < 3; ++a) gt.pose.cov(a, a) = std::abs(s[a]) * std::abs(s[a]);
       }
+      // angles in MRPT's order yaw, pitch, roll (about D, E, N for a level vehicle)
+      for (int a = 0; a < 3; ++a)
+        gt.pose.cov(3 + a, 3 + a) = !r.q_BtoN ? kUnknownAttitudeVar
+                                    : r.sigma_att ? (*r.sigma_att)[2 - a] * (*r.sigma_att)[2 - a]
+                                                  : 0.0;
       arch << gt;
+      if (r.v_N) {  // MRPT's pose observation has no velocity: a companion entry, same time
+        gtVel.timestamp = ts;
+        gtVel.dataIsPresent.fill(false);
+        gtVel.set(mrpt::obs::IMU_X_VEL, (*r.v_N)[0]);
+        gtVel.set(mrpt::obs::IMU_Y_VEL, (*r.v_N)[1]);
+        gtVel.set(mrpt::obs::IMU_Z_VEL, (*r.v_N)[2]);
+        arch << gtVel;
+      }
     } else {
       const auto& f = d.gnss[e.index];
       gps.timestamp = ts;
@@ -213,6 +248,10 @@ Recording readRawlog(const std::string& path) {
             haveBase = true;
           }
           if (y && y["imu"] && y["imu"]["rate_hz"]) d.imu_rate_hz = y["imu"]["rate_hz"].as<double>();
+          if (y && y["gnss"] && y["gnss"]["lever_arm_B_m"]) {
+            const YAML::Node l = y["gnss"]["lever_arm_B_m"];
+            d.lever_arm_B = Eigen::Vector3d(l[0].as<double>(), l[1].as<double>(), l[2].as<double>());
+          }
         } catch (const YAML::Exception& e) {
           throw Error(where("SCENARIO", NAN) + ": scenario comment is not valid YAML (" + e.msg + ")");
         }
@@ -222,7 +261,7 @@ Recording readRawlog(const std::string& path) {
     auto o = std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj);
     if (!o) { ++skipped; continue; }
     const std::string& label = o->sensorLabel;
-    if (!haveBase && (label == "IMU" || label == "GT" || label == "GNSS" || label == "BARO")) {
+    if (!haveBase && (label == "IMU" || label == "GT" || label == "GT_VEL" || label == "GNSS" || label == "BARO")) {
       // no time base in the comment: the first entry of a known label defines
       // time zero; its absolute time is kept as start_unix_s + (0 - t_start_s)
       base = o->timestamp;
@@ -237,6 +276,38 @@ Recording readRawlog(const std::string& path) {
                   std::to_string(lastT) + " s)");
     lastT = t;
     lastLabel = label;
+    if (label == "GT" && std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(o)) {
+      const auto& rp = *std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(o);
+      if (!haveOrigin) throw Error(where(label, t) + ": the reference needs the scenario comment's origin, none found before it");
+      ReferenceRecord r;
+      r.t = t;
+      const auto& m = rp.pose.mean;
+      r.p_L = T_NtoENU() * Eigen::Vector3d(m.x(), m.y(), m.z());
+      const auto& c = rp.pose.cov;
+      if (!(c(3, 3) >= kUnknownAttitudeVar / 2)) {
+        Eigen::Matrix3d R;
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) R(a, b) = m.getRotationMatrix()(a, b);
+        r.q_BtoN.emplace(Eigen::Quaterniond(T_NtoENU() * R * T_FLUtoFRD()).normalized());
+        if (c(3, 3) > 0 && c(4, 4) > 0 && c(5, 5) > 0)
+          r.sigma_att = Eigen::Vector3d(std::sqrt(c(5, 5)), std::sqrt(c(4, 4)), std::sqrt(c(3, 3)));
+      }
+      if (c(0, 0) > 0 && c(1, 1) > 0 && c(2, 2) > 0)
+        r.sigma_p_L = Eigen::Vector3d(std::sqrt(c(1, 1)), std::sqrt(c(0, 0)), std::sqrt(c(2, 2)));
+      d.reference.push_back(r);
+      continue;
+    }
+    if (label == "GT_VEL") {
+      auto m = std::dynamic_pointer_cast<CObservationIMU>(o);
+      if (!m) throw Error(where(label, t) + ": expected a CObservationIMU, found " + o->GetRuntimeClass()->className);
+      if (d.reference.empty() || d.reference.back().t != t || d.reference.back().v_N)
+        throw Error(where(label, t) + ": reference velocity without a reference pose (label GT) at the same time before it");
+      for (auto i : {mrpt::obs::IMU_X_VEL, mrpt::obs::IMU_Y_VEL, mrpt::obs::IMU_Z_VEL})
+        if (!m->has(i)) throw Error(where(label, t) + ": a velocity field (IMU_X_VEL, IMU_Y_VEL, IMU_Z_VEL) is not set");
+      d.reference.back().v_N = Eigen::Vector3d(m->get(mrpt::obs::IMU_X_VEL), m->get(mrpt::obs::IMU_Y_VEL),
+                                               m->get(mrpt::obs::IMU_Z_VEL));
+      continue;
+    }
     if (label == "IMU" || label == "BARO" || label == "GT") {
       auto m = std::dynamic_pointer_cast<CObservationIMU>(o);
       if (!m) throw Error(where(label, t) + ": expected a CObservationIMU, found " + o->GetRuntimeClass()->className);
@@ -291,6 +362,8 @@ Recording readRawlog(const std::string& path) {
       if (!g) throw Error(where(label, t) + ": expected a CObservationGPS, found " + o->GetRuntimeClass()->className);
       GnssFix f;
       f.t = t;
+      if (!d.lever_arm_B && (g->sensorPose.x() != 0 || g->sensorPose.y() != 0 || g->sensorPose.z() != 0))
+        d.lever_arm_B = T_FLUtoFRD() * Eigen::Vector3d(g->sensorPose.x(), g->sensorPose.y(), g->sensorPose.z());
       if (const auto* p = g->getMsgByClassPtr<gnss::Message_TOPCON_PZS>(); p && p->hasCartesianPosVel) {
         const Eigen::Vector3d r_E(p->cartesian_x, p->cartesian_y, p->cartesian_z);
         f.pos = earth::ecefToGeodetic(r_E);

@@ -76,6 +76,10 @@ struct Recording {
   double imu_rate_hz = 0.0;           ///< nominal IMU rate [Hz] from the metadata; 0: unknown (use the time stamps)
   long long start_unix_s = 0;         ///< UTC (Unix seconds) of time t_start_s; 0 with t_start_s = 0: unknown
   double t_start_s = 0.0;             ///< time on the recording's axis [s] that start_unix_s stands for
+  /// GNSS antenna position relative to the IMU, body FRD [m], when the data
+  /// state it (an import manifest's gnss.lever_arm_m, a rawlog's GNSS
+  /// sensorPose); absent: unknown (the replay takes its configuration's).
+  std::optional<Eigen::Vector3d> lever_arm_B;
   std::vector<ImuRecord> imu;
   std::vector<GnssFix> gnss;
   std::vector<BaroSample> baro;

@@ -18,10 +18,19 @@
  *    3x3 of the 4x4 matrices; float precision). A fix without velocity has NaN
  *    in the PZS velocity fields; a fix without a covariance leaves hasPosCov /
  *    hasVelCov false;
- *  - label "GT": CObservationIMU with IMU_X/Y/Z [m] in the tangent-plane NED
- *    frame at the comment's origin, and when the reference has them,
- *    IMU_X_VEL/Y_VEL/Z_VEL [m/s] local NED and IMU_ORI_QUAT_X/Y/Z/W of C_BtoN
- *    (reference sigmas are not stored).
+ *  - label "GT": CObservationRobotPose, the reference in MRPT's conventions:
+ *    pose.mean x/y/z = east/north/up [m] in the tangent plane at the comment's
+ *    origin, its rotation the vehicle frame (x forward, y left, z up) in that
+ *    ENU frame (= C_BtoN with the axes renamed); pose.cov diagonal: position
+ *    variances (E, N, U) when the reference has sigmas, else 0; attitude
+ *    variances (yaw, pitch, roll), 0 without sigmas, 1e12 rad^2 when the
+ *    reference has no attitude (the pose's rotation is then the identity);
+ *  - label "GT_VEL" (right after its GT entry, same time, when the reference has
+ *    a velocity): CObservationIMU with IMU_X_VEL/Y_VEL/Z_VEL [m/s] local NED.
+ *  - the GNSS entries carry the antenna lever arm (Recording::lever_arm_B) as
+ *    their sensorPose (MRPT vehicle frame x forward, y left, z up).
+ * Rawlogs written before stored GT as a CObservationIMU (IMU_X/Y/Z NED [m],
+ * IMU_X_VEL.., IMU_ORI_QUAT_X..W of C_BtoN); readRawlog reads both.
  * Timestamps: start_unix_s + (t - t_start_s), in MRPT's 100 ns ticks, exact.
  */
 #pragma once

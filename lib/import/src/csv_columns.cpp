@@ -1,0 +1,137 @@
+#include "navimpact/import/csv_columns.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string_view>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/text_io.hpp"
+
+namespace navimpact::import {
+
+namespace {
+
+std::string_view cleanName(std::string_view n) {
+  n = trim(n);
+  if (n.size() >= 2 && n.front() == '"' && n.back() == '"') n = trim(n.substr(1, n.size() - 2));
+  return n;
+}
+
+}  // namespace
+
+ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest>& req, char delimiter) {
+  InputScope scope(path);
+  const std::string text = readFileMaybeGz(path);
+  const char* p = text.data();
+  const char* end = text.data() + text.size();
+  std::size_t lineNo = 0;
+  auto nextLine = [&](std::string_view& line) {
+    if (p >= end) return false;
+    const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
+    if (!eol) eol = end;
+    line = std::string_view(p, static_cast<std::size_t>(eol - p));
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    p = eol + 1;
+    ++lineNo;
+    return true;
+  };
+
+  // --- header ---------------------------------------------------------------
+  std::string_view header;
+  bool found = false;
+  while (nextLine(header)) {
+    if (lineNo == 1 && header.size() >= 3 && header.substr(0, 3) == "\xEF\xBB\xBF") header.remove_prefix(3);  // BOM
+    const auto t = trim(header);
+    if (t.empty() || t.front() == '#') continue;
+    found = true;
+    break;
+  }
+  if (!found) throw fileError(path, 0, "file is empty (expected a header line naming the columns)");
+  const std::size_t headerLine = lineNo;
+  const auto names = splitView(header, delimiter);
+  const std::size_t ncol = names.size();
+  std::vector<int> slot(ncol, -1);
+  for (std::size_t r = 0; r < req.size(); ++r) {
+    int at = -1;
+    for (int pass = 0; pass < 2 && at < 0; ++pass)
+      for (std::size_t c = 0; c < ncol; ++c) {
+        std::string_view n = cleanName(names[c]);
+        if (pass == 1) {
+          const auto lb = n.find('[');
+          if (lb == std::string_view::npos) continue;
+          n = trim(n.substr(0, lb));
+        }
+        if (n == req[r].name) {
+          if (at >= 0)
+            throw fileError(path, headerLine, "column '" + printable(req[r].name) + "' (key " + req[r].key +
+                                                  ") appears more than once in the header");
+          at = static_cast<int>(c);
+        }
+      }
+    if (at < 0)
+      throw fileError(path, headerLine, "no column '" + printable(req[r].name) + "' (key " + req[r].key +
+                                            ") in the header '" + printable(trim(header), 100) + "'");
+    if (slot[at] >= 0 && req[slot[at]].name != req[r].name) continue;
+    slot[at] = static_cast<int>(r);
+  }
+  // several requests may name one column: map each request to its column
+  std::vector<std::size_t> colOf(req.size());
+  for (std::size_t r = 0; r < req.size(); ++r)
+    for (std::size_t c = 0; c < ncol; ++c)
+      if (slot[c] >= 0 && req[slot[c]].name == req[r].name) colOf[r] = c;
+
+  // --- rows -----------------------------------------------------------------
+  ColumnTable t;
+  std::vector<std::vector<double>> byCol(ncol);
+  const std::size_t approx = static_cast<std::size_t>(std::count(p, end, '\n')) + 1;
+  for (std::size_t c = 0; c < ncol; ++c)
+    if (slot[c] >= 0) byCol[c].reserve(approx);
+  t.line.reserve(approx);
+  std::string_view line;
+  while (nextLine(line)) {
+    if (trim(line).empty()) continue;
+    std::size_t c = 0, start = 0;
+    for (;; ++c) {
+      std::size_t cut = line.find(delimiter, start);
+      const bool last = cut == std::string_view::npos;
+      if (last) cut = line.size();
+      if (c >= ncol)
+        throw fileError(path, lineNo, "more fields than the " + std::to_string(ncol) + " header columns");
+      if (slot[c] >= 0) {
+        const ColumnRequest& rq = req[slot[c]];
+        const std::string_view field = line.substr(start, cut - start);
+        double v;
+        if (!parseDouble(field, v)) {
+          if (rq.allow_empty && trim(field).empty()) {
+            v = NAN;
+          } else {
+            throw fileError(path, lineNo, "column '" + printable(rq.name) + "' (key " + rq.key + "): '" +
+                                              printable(field) + "' is not a number");
+          }
+        } else if (!std::isfinite(v)) {
+          throw fileError(path, lineNo, "column '" + printable(rq.name) + "' (key " + rq.key + "): value is " +
+                                            printable(trim(field)) + " (finite numbers only)");
+        }
+        byCol[c].push_back(v);
+      }
+      if (last) break;
+      start = cut + 1;
+    }
+    if (c + 1 != ncol)
+      throw fileError(path, lineNo, "missing fields: " + std::to_string(c + 1) + " of the " + std::to_string(ncol) +
+                                        " header columns");
+    t.line.push_back(static_cast<std::uint32_t>(lineNo));
+  }
+  if (t.line.empty()) throw fileError(path, headerLine, "no data rows after the header");
+  t.columns.resize(req.size());
+  for (std::size_t r = 0; r < req.size(); ++r) {
+    std::size_t first = r;
+    for (std::size_t q = 0; q < r; ++q)
+      if (colOf[q] == colOf[r]) { first = q; break; }
+    t.columns[r] = first < r ? t.columns[first] : std::move(byCol[colOf[r]]);
+  }
+  return t;
+}
+
+}  // namespace navimpact::import

@@ -1,0 +1,626 @@
+// Import of a measured run from a YAML manifest (see manifest.hpp and README, "Import").
+#include "navimpact/import/manifest.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/text_io.hpp"
+#include "navimpact/core/units.hpp"
+#include "navimpact/import/csv_columns.hpp"
+
+namespace navimpact::import {
+
+namespace {
+
+namespace fs = std::filesystem;
+using units::kDeg;
+
+// ---------------------------------------------------------------------------
+// Manifest keys: the one place that reads YAML nodes (types, units, ranges,
+// unknown and duplicate keys), every error naming the manifest and the key.
+// ---------------------------------------------------------------------------
+
+struct Keys {
+  std::string file;
+  fs::path dir;
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+  Error err(const std::string& key, const std::string& what) const { return keyError(file, key, what); }
+
+  /// @p n must be a map whose keys are in @p allowed, each once, with every key of @p required.
+  void map(const YAML::Node& n, const std::string& path, std::initializer_list<const char*> allowed,
+           std::initializer_list<const char*> required = {}) const {
+    std::string list;
+    for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+    if (!n || !n.IsMap()) throw err(path.empty() ? "(top level)" : path, "expected a map with keys " + list);
+    std::set<std::string> seen;
+    for (const auto& kv : n) {
+      const std::string k = kv.first.IsScalar() ? kv.first.Scalar() : std::string("(not a name)");
+      if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }) == allowed.end())
+        throw err(join(path, k), "unknown key (expected one of: " + list + ")");
+      if (!seen.insert(k).second) throw err(join(path, k), "appears twice");
+    }
+    for (const char* r : required)
+      if (!n[r]) throw err(join(path, r), "missing (required)");
+  }
+  double number(const YAML::Node& n, const std::string& key) const {
+    double v;
+    if (!n.IsScalar() || !parseDouble(n.Scalar(), v) || !std::isfinite(v))
+      throw err(key, "expected a finite number, found '" + printable(n.IsScalar() ? n.Scalar() : "(not a scalar)") + "'");
+    return v;
+  }
+  double number(const YAML::Node& n, const std::string& key, double lo, double hi, const char* unit) const {
+    const double v = number(n, key);
+    if (v < lo || v > hi)
+      throw err(key, printable(n.Scalar()) + " is out of range [" + formatRange(lo) + ", " + formatRange(hi) + "] " + unit);
+    return v;
+  }
+  double positive(const YAML::Node& n, const std::string& key, double hi, const char* unit) const {
+    const double v = number(n, key);
+    if (!(v > 0.0) || v > hi)
+      throw err(key, printable(n.Scalar()) + " must be > 0 and at most " + formatRange(hi) + " " + unit);
+    return v;
+  }
+  std::string text(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar() || n.Scalar().empty()) throw err(key, "expected a non-empty text");
+    return n.Scalar();
+  }
+  std::vector<std::string> texts(const YAML::Node& n, const std::string& key, std::size_t lo, std::size_t hi) const {
+    if (!n.IsSequence() || n.size() < lo || n.size() > hi)
+      throw err(key, lo == hi ? "expected a list of " + std::to_string(lo) + " names"
+                              : "expected a list of " + std::to_string(lo) + " to " + std::to_string(hi) + " names");
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < n.size(); ++i) out.push_back(text(n[i], key + "[" + std::to_string(i) + "]"));
+    return out;
+  }
+  /// A unit from a list; returns its index.
+  std::size_t oneOf(const YAML::Node& n, const std::string& key, const std::vector<std::string>& names) const {
+    const std::string s = n.IsScalar() ? n.Scalar() : std::string("(not a name)");
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (s == names[i]) return i;
+    std::string list;
+    for (const auto& a : names) list += (list.empty() ? "" : ", ") + a;
+    throw err(key, "'" + printable(s) + "' is not accepted (expected one of: " + list + ")");
+  }
+  std::string resolve(const std::string& p) const {
+    if (p.empty() || fs::path(p).is_absolute() || dir.empty()) return p;
+    return (dir / p).lexically_normal().string();
+  }
+  static std::string formatRange(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  }
+};
+
+// ---------------------------------------------------------------------------
+// Streams
+// ---------------------------------------------------------------------------
+
+/// A stream's file, delimiter, time and gap rule.
+struct StreamSpec {
+  std::string name;   // imu, gnss, baro, reference
+  std::string file;
+  char delimiter = ',';
+  bool time_column = false;
+  std::string column;
+  double time_factor = 1.0;  // column unit -> s
+  double rate_hz = 0.0;
+  double start_s = 0.0;
+  double offset_s = 0.0;
+  double max_gap_s = 0.0;    // 0: no limit
+};
+
+StreamSpec streamSpec(const Keys& k, const YAML::Node& n, const std::string& name) {
+  StreamSpec s;
+  s.name = name;
+  s.file = k.resolve(k.text(n["file"], name + ".file"));
+  if (n["delimiter"]) {
+    const std::size_t i = k.oneOf(n["delimiter"], name + ".delimiter", {",", ";", "tab"});
+    s.delimiter = i == 0 ? ',' : i == 1 ? ';' : '\t';
+  }
+  const std::string tk = name + ".time";
+  const YAML::Node t = n["time"];
+  if (t && t.IsMap() && t["rate_hz"]) {
+    if (name != "imu") throw k.err(tk + ".rate_hz", "only the IMU stream may be given by a rate (others need a time column)");
+    k.map(t, tk, {"rate_hz", "start_s"}, {"rate_hz"});
+    s.rate_hz = k.positive(t["rate_hz"], tk + ".rate_hz", 1e5, "Hz");
+    if (t["start_s"]) s.start_s = k.number(t["start_s"], tk + ".start_s");
+  } else {
+    k.map(t, tk, {"column", "unit"}, {"column", "unit"});
+    s.time_column = true;
+    s.column = k.text(t["column"], tk + ".column");
+    static const double f[] = {1.0, 1e-3, 1e-6, 1e-9};
+    s.time_factor = f[k.oneOf(t["unit"], tk + ".unit", {"s", "ms", "us", "ns"})];
+  }
+  if (n["max_gap_s"]) s.max_gap_s = k.positive(n["max_gap_s"], name + ".max_gap_s", 1e9, "s");
+  return s;
+}
+
+/// Times of a stream (file time * unit + offset), checked increasing and within the gap rule.
+std::vector<double> streamTimes(const StreamSpec& s, const ColumnTable& tab, std::size_t timeCol) {
+  const std::size_t n = tab.rows();
+  std::vector<double> t(n);
+  if (s.time_column) {
+    const auto& c = tab.columns[timeCol];
+    for (std::size_t i = 0; i < n; ++i) t[i] = c[i] * s.time_factor + s.offset_s;
+    const std::string key = s.name + ".time.column";
+    for (std::size_t i = 1; i < n; ++i) {
+      const double dt = t[i] - t[i - 1];
+      if (dt <= 0.0)
+        throw fileError(s.file, tab.line[i], "column '" + printable(s.column) + "' (key " + key + "): time " +
+                                                 (dt == 0.0 ? "repeats" : "goes backwards") + " (" +
+                                                 Keys::formatRange(c[i]) + " after " + Keys::formatRange(c[i - 1]) +
+                                                 " on line " + std::to_string(tab.line[i - 1]) + ")");
+      if (s.max_gap_s > 0.0 && dt > s.max_gap_s)
+        throw fileError(s.file, tab.line[i], "column '" + printable(s.column) + "' (key " + key + "): gap of " +
+                                                 Keys::formatRange(dt) + " s after line " +
+                                                 std::to_string(tab.line[i - 1]) + " exceeds " + s.name +
+                                                 ".max_gap_s = " + Keys::formatRange(s.max_gap_s) + " s");
+    }
+  } else {
+    for (std::size_t i = 0; i < n; ++i) t[i] = s.start_s + static_cast<double>(i) / s.rate_hz + s.offset_s;
+  }
+  return t;
+}
+
+/// Column indices of a request list being built.
+struct Requests {
+  std::vector<ColumnRequest> req;
+  std::size_t add(const std::string& name, const std::string& key, bool allowEmpty = false) {
+    req.push_back({name, key, allowEmpty});
+    return req.size() - 1;
+  }
+};
+
+std::size_t addTime(Requests& r, const StreamSpec& s) {
+  return s.time_column ? r.add(s.column, s.name + ".time.column") : std::size_t(-1);
+}
+
+/// Axes: body FRD axis i = sign_i * file axis src_i (a proper signed permutation), or a rotation matrix.
+Eigen::Matrix3d axesMatrix(const Keys& k, const YAML::Node& n, const std::string& key) {
+  const char* accepted = " (expected the body forward, right, down axes written in the file's axes as a proper signed "
+                         "permutation such as [-y, x, z], or a 3x3 rotation matrix [[..], [..], [..]] from file to body axes)";
+  if (!n.IsSequence() || n.size() != 3) throw k.err(key, std::string("expected a list of three axes") + accepted);
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  if (n[0].IsSequence()) {
+    for (int i = 0; i < 3; ++i) {
+      if (!n[i].IsSequence() || n[i].size() != 3) throw k.err(key, std::string("a rotation matrix needs 3 rows of 3 numbers") + accepted);
+      for (int j = 0; j < 3; ++j) C(i, j) = k.number(n[i][j], key + "[" + std::to_string(i) + "][" + std::to_string(j) + "]");
+    }
+    if ((C * C.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || C.determinant() < 0.0)
+      throw k.err(key, "is not a rotation matrix (orthonormal to 1e-6 with determinant +1)");
+    return C;
+  }
+  bool used[3] = {false, false, false};
+  for (int i = 0; i < 3; ++i) {
+    const std::string s = n[i].IsScalar() ? n[i].Scalar() : std::string("(not an axis)");
+    std::string_view p = trim(s);
+    double sign = 1.0;
+    if (!p.empty() && (p.front() == '-' || p.front() == '+')) {
+      sign = p.front() == '-' ? -1.0 : 1.0;
+      p.remove_prefix(1);
+    }
+    if (p.size() != 1 || p[0] < 'x' || p[0] > 'z')
+      throw k.err(key + "[" + std::to_string(i) + "]", "'" + printable(s) + "' is not an axis" + accepted);
+    const int a = p[0] - 'x';
+    if (used[a]) throw k.err(key, "axis '" + std::string(p) + "' is used twice" + accepted);
+    used[a] = true;
+    C(i, a) = sign;
+  }
+  if (C.determinant() < 0.0)
+    throw k.err(key, "is a mirror (determinant -1): the body axes would be left-handed" + std::string(accepted));
+  return C;
+}
+
+/// height_datum: "ellipsoid" or {geoid_undulation_m: N}; returns N [m] (added to the heights).
+double heightDatum(const Keys& k, const YAML::Node& n, const std::string& key) {
+  if (n.IsScalar()) {
+    k.oneOf(n, key, {"ellipsoid"});
+    return 0.0;
+  }
+  k.map(n, key, {"geoid_undulation_m"}, {"geoid_undulation_m"});
+  return k.number(n["geoid_undulation_m"], key + ".geoid_undulation_m", -120.0, 120.0, "m");
+}
+
+/// position: {lat, lon, height, angle_unit}
+struct PositionSpec {
+  std::size_t lat, lon, h;
+  double angle = kDeg;
+};
+
+PositionSpec positionSpec(const Keys& k, const YAML::Node& n, const std::string& key, Requests& r) {
+  k.map(n, key, {"lat", "lon", "height", "angle_unit", "height_unit"}, {"lat", "lon", "height", "angle_unit"});
+  PositionSpec p;
+  p.lat = r.add(k.text(n["lat"], key + ".lat"), key + ".lat");
+  p.lon = r.add(k.text(n["lon"], key + ".lon"), key + ".lon");
+  p.h = r.add(k.text(n["height"], key + ".height"), key + ".height");
+  p.angle = k.oneOf(n["angle_unit"], key + ".angle_unit", {"deg", "rad"}) == 0 ? kDeg : 1.0;
+  if (n["height_unit"]) k.oneOf(n["height_unit"], key + ".height_unit", {"m"});
+  return p;
+}
+
+earth::Geodetic positionAt(const StreamSpec& s, const ColumnTable& tab, const PositionSpec& p, double undulation,
+                           const std::string& key, std::size_t i) {
+  const double lat = tab.columns[p.lat][i] * p.angle, lon = tab.columns[p.lon][i] * p.angle;
+  const double h = tab.columns[p.h][i] + undulation;
+  if (std::abs(lat) > 90.0 * kDeg)
+    throw fileError(s.file, tab.line[i], "column key " + key + ".lat: latitude " + Keys::formatRange(tab.columns[p.lat][i]) +
+                                             " is outside [-90, 90] deg (is angle_unit right?)");
+  if (lon < -180.0 * kDeg || lon > 360.0 * kDeg)
+    throw fileError(s.file, tab.line[i], "column key " + key + ".lon: longitude " + Keys::formatRange(tab.columns[p.lon][i]) +
+                                             " is outside [-180, 360] deg (is angle_unit right?)");
+  if (h < -12000.0 || h > 1e6)
+    throw fileError(s.file, tab.line[i], "column key " + key + ".height: height " + Keys::formatRange(h) +
+                                             " m is outside [-12000, 1e6] m");
+  return {lat, lon > 180.0 * kDeg ? lon - 360.0 * kDeg : lon, h};
+}
+
+/// sigma: {horizontal_m, vertical_m} constant, or {columns: [n, e, vertical] | [horizontal, vertical], unit: m}.
+struct SigmaSpec {
+  bool present = false;
+  bool per_row = false;
+  double h = 0.0, v = 0.0;
+  std::vector<std::size_t> cols;
+};
+
+SigmaSpec sigmaSpec(const Keys& k, const YAML::Node& n, const std::string& key, Requests& r, const char* unitName,
+                    const char* hKey, const char* vKey) {
+  SigmaSpec s;
+  if (!n) return s;
+  s.present = true;
+  if (n.IsMap() && n["columns"]) {
+    k.map(n, key, {"columns", "unit"}, {"columns", "unit"});
+    k.oneOf(n["unit"], key + ".unit", {unitName});
+    const auto names = k.texts(n["columns"], key + ".columns", 2, 3);
+    for (std::size_t i = 0; i < names.size(); ++i) s.cols.push_back(r.add(names[i], key + ".columns[" + std::to_string(i) + "]"));
+    s.per_row = true;
+    return s;
+  }
+  k.map(n, key, {hKey, vKey, "columns"}, {hKey, vKey});
+  s.h = k.positive(n[hKey], key + "." + hKey, 1e6, unitName);
+  s.v = k.positive(n[vKey], key + "." + vKey, 1e6, unitName);
+  return s;
+}
+
+/// Per-axis (N, E, D) sigma of row i.
+Eigen::Vector3d sigmaAt(const StreamSpec& st, const ColumnTable& tab, const SigmaSpec& s, const std::string& key, std::size_t i) {
+  if (!s.per_row) return {s.h, s.h, s.v};
+  Eigen::Vector3d out;
+  for (std::size_t c = 0; c < s.cols.size(); ++c) {
+    const double v = tab.columns[s.cols[c]][i];
+    if (!(v > 0.0))
+      throw fileError(st.file, tab.line[i], "column key " + key + ".columns[" + std::to_string(c) + "]: sigma " +
+                                                Keys::formatRange(v) + " must be > 0");
+  }
+  if (s.cols.size() == 3) return {tab.columns[s.cols[0]][i], tab.columns[s.cols[1]][i], tab.columns[s.cols[2]][i]};
+  return {tab.columns[s.cols[0]][i], tab.columns[s.cols[0]][i], tab.columns[s.cols[1]][i]};
+}
+
+/// velocity: {columns: [3], frame: NED|ENU, unit: m/s|km/h, sigma: ...}
+struct VelocitySpec {
+  bool present = false;
+  std::size_t c[3];
+  bool enu = false;
+  double factor = 1.0;
+  SigmaSpec sigma;
+};
+
+VelocitySpec velocitySpec(const Keys& k, const YAML::Node& n, const std::string& key, Requests& r) {
+  VelocitySpec v;
+  if (!n) return v;
+  v.present = true;
+  k.map(n, key, {"columns", "frame", "unit", "sigma"}, {"columns", "frame", "unit"});
+  const auto names = k.texts(n["columns"], key + ".columns", 3, 3);
+  for (int i = 0; i < 3; ++i) v.c[i] = r.add(names[i], key + ".columns[" + std::to_string(i) + "]", true);
+  v.enu = k.oneOf(n["frame"], key + ".frame", {"NED", "ENU"}) == 1;
+  v.factor = k.oneOf(n["unit"], key + ".unit", {"m/s", "km/h"}) == 0 ? 1.0 : 1.0 / 3.6;
+  v.sigma = sigmaSpec(k, n["sigma"], key + ".sigma", r, "m/s", "horizontal_m_s", "vertical_m_s");
+  return v;
+}
+
+/// Velocity of row i in NED [m/s]; absent when all three fields are empty.
+std::optional<Eigen::Vector3d> velocityAt(const StreamSpec& s, const ColumnTable& tab, const VelocitySpec& v,
+                                          const std::string& key, std::size_t i) {
+  if (!v.present) return std::nullopt;
+  const double a = tab.columns[v.c[0]][i], b = tab.columns[v.c[1]][i], c = tab.columns[v.c[2]][i];
+  const int empty = std::isnan(a) + std::isnan(b) + std::isnan(c);
+  if (empty == 3) return std::nullopt;
+  if (empty != 0)
+    throw fileError(s.file, tab.line[i], "key " + key + ".columns: some velocity fields are empty (give all three or none)");
+  if (v.enu) return Eigen::Vector3d(b * v.factor, a * v.factor, -c * v.factor);
+  return Eigen::Vector3d(a * v.factor, b * v.factor, c * v.factor);
+}
+
+/// C_BtoN from ZYX roll, pitch, yaw (yaw clockwise from true north; README conventions).
+Eigen::Quaterniond quatRpy(double roll, double pitch, double yaw) {
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .normalized();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+std::string fmt17(double x) {
+  std::ostringstream o;
+  o.precision(17);
+  o << x;
+  return o.str();
+}
+
+}  // namespace
+
+Recording importManifest(const std::string& manifestPath, ImportReport* report) {
+  InputScope scope(manifestPath);
+  std::string manifestText;
+  {
+    std::ifstream in(manifestPath, std::ios::binary);
+    if (!in) throw Error(manifestPath + ": cannot open the manifest");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    manifestText = ss.str();
+  }
+  if (manifestText.size() > (1u << 20)) throw Error(manifestPath + ": manifest larger than 1 MiB");
+  YAML::Node root;
+  try {
+    root = YAML::Load(manifestText);
+  } catch (const YAML::Exception& e) {
+    throw Error(manifestPath + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                ": YAML syntax: " + e.msg);
+  }
+  const Keys k{manifestPath, fs::path(manifestPath).parent_path()};
+  k.map(root, "", {"imu", "gnss", "baro", "reference", "time_offset_s", "time_zero_unix_s"}, {"imu"});
+
+  double offset[4] = {0, 0, 0, 0};  // imu, gnss, baro, reference
+  if (root["time_offset_s"]) {
+    const YAML::Node o = root["time_offset_s"];
+    k.map(o, "time_offset_s", {"imu", "gnss", "baro", "reference"});
+    const char* names[] = {"imu", "gnss", "baro", "reference"};
+    for (int i = 0; i < 4; ++i)
+      if (o[names[i]]) offset[i] = k.number(o[names[i]], std::string("time_offset_s.") + names[i], -1e6, 1e6, "s");
+  }
+  std::optional<double> zeroUnix;
+  if (root["time_zero_unix_s"]) zeroUnix = k.number(root["time_zero_unix_s"], "time_zero_unix_s", 0.0, 1e10, "s");
+
+  Recording d;
+  d.source = manifestPath;
+  ImportReport rep;
+
+  // --- IMU ------------------------------------------------------------------
+  {
+    const YAML::Node n = root["imu"];
+    k.map(n, "imu", {"file", "delimiter", "time", "gyro", "acc", "axes", "max_gap_s"}, {"file", "time", "gyro", "acc", "axes"});
+    StreamSpec s = streamSpec(k, n, "imu");
+    s.offset_s = offset[0];
+    Requests r;
+    const std::size_t tc = addTime(r, s);
+    std::size_t sc[2][3];
+    double factor[2];
+    bool increments[2];
+    const char* sensor[2] = {"gyro", "acc"};
+    for (int q = 0; q < 2; ++q) {
+      const std::string key = std::string("imu.") + sensor[q];
+      const YAML::Node g = n[sensor[q]];
+      k.map(g, key, {"columns", "unit", "increments"}, {"columns"});
+      const auto names = k.texts(g["columns"], key + ".columns", 3, 3);
+      for (int i = 0; i < 3; ++i) sc[q][i] = r.add(names[i], key + ".columns[" + std::to_string(i) + "]");
+      if (!!g["unit"] == !!g["increments"])
+        throw k.err(key, q == 0 ? "give exactly one of unit (rad/s, deg/s, deg/h, mrad/s) or increments (rad, deg, mrad)"
+                                : "give exactly one of unit (m/s2, g, mg, ug) or increments (m/s)");
+      increments[q] = !!g["increments"];
+      if (!increments[q]) {
+        const auto quantity = q == 0 ? units::Quantity::AngularRate : units::Quantity::SpecificForce;
+        const std::string u = k.text(g["unit"], key + ".unit");
+        try {
+          factor[q] = units::toSiFactor(quantity, u);
+        } catch (const Error& e) {
+          throw k.err(key + ".unit", e.what());
+        }
+      } else if (q == 0) {
+        static const double f[] = {1.0, kDeg, 1e-3};
+        factor[q] = f[k.oneOf(g["increments"], key + ".increments", {"rad", "deg", "mrad"})];
+      } else {
+        factor[q] = 1.0;
+        k.oneOf(g["increments"], key + ".increments", {"m/s"});
+      }
+    }
+    const Eigen::Matrix3d C_FtoB = axesMatrix(k, n["axes"], "imu.axes");
+    const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
+    if (tab.rows() < 2) throw fileError(s.file, tab.line[0], "the IMU stream needs at least 2 samples");
+    // the nominal step: the rate, or the median time step (the default gap limit is 1.5 of it)
+    std::vector<double> t;
+    if (s.time_column) {
+      std::vector<double> raw(tab.rows());
+      for (std::size_t i = 0; i < raw.size(); ++i) raw[i] = tab.columns[tc][i] * s.time_factor;
+      std::vector<double> steps(raw.size() - 1);
+      for (std::size_t i = 1; i < raw.size(); ++i) steps[i - 1] = raw[i] - raw[i - 1];
+      const double med = median(steps);
+      if (!(med > 0.0))
+        throw fileError(s.file, tab.line[0], "column '" + printable(s.column) + "' (key imu.time.column): the median time step is not > 0");
+      if (s.max_gap_s == 0.0) s.max_gap_s = 1.5 * med;
+      d.imu_rate_hz = 1.0 / med;
+    } else {
+      d.imu_rate_hz = s.rate_hz;
+    }
+    t = streamTimes(s, tab, tc);
+    const double dtNominal = 1.0 / d.imu_rate_hz;
+    d.imu.resize(tab.rows());
+    double maxGap = 0.0;
+    for (std::size_t i = 0; i < tab.rows(); ++i) {
+      const double dt = i == 0 ? dtNominal : t[i] - t[i - 1];
+      if (i > 0) maxGap = std::max(maxGap, dt);
+      Eigen::Vector3d v[2];
+      for (int q = 0; q < 2; ++q) {
+        const Eigen::Vector3d file(tab.columns[sc[q][0]][i], tab.columns[sc[q][1]][i], tab.columns[sc[q][2]][i]);
+        v[q] = C_FtoB * file * (increments[q] ? factor[q] / dt : factor[q]);
+      }
+      d.imu[i] = {t[i], v[0], v[1]};
+    }
+    rep.imu_file = s.file;
+    rep.imu_rate_hz = d.imu_rate_hz;
+    rep.imu_max_gap_s = maxGap;
+  }
+
+  // --- GNSS -----------------------------------------------------------------
+  std::optional<double> gnssUndulation;
+  if (const YAML::Node n = root["gnss"]) {
+    k.map(n, "gnss", {"file", "delimiter", "time", "position", "height_datum", "velocity", "sigma", "lever_arm_m", "max_gap_s"},
+          {"file", "time", "position", "height_datum"});
+    StreamSpec s = streamSpec(k, n, "gnss");
+    s.offset_s = offset[1];
+    Requests r;
+    const std::size_t tc = addTime(r, s);
+    const PositionSpec ps = positionSpec(k, n["position"], "gnss.position", r);
+    gnssUndulation = heightDatum(k, n["height_datum"], "gnss.height_datum");
+    const VelocitySpec vs = velocitySpec(k, n["velocity"], "gnss.velocity", r);
+    const SigmaSpec ss = sigmaSpec(k, n["sigma"], "gnss.sigma", r, "m", "horizontal_m", "vertical_m");
+    if (n["lever_arm_m"]) {
+      const YAML::Node l = n["lever_arm_m"];
+      if (!l.IsSequence() || l.size() != 3) throw k.err("gnss.lever_arm_m", "expected [forward, right, down] in metres (body FRD, from the IMU to the antenna)");
+      Eigen::Vector3d la;
+      for (int i = 0; i < 3; ++i) la[i] = k.number(l[i], "gnss.lever_arm_m[" + std::to_string(i) + "]", -100.0, 100.0, "m");
+      d.lever_arm_B = la;
+    }
+    const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
+    const std::vector<double> t = streamTimes(s, tab, tc);
+    d.gnss.resize(tab.rows());
+    for (std::size_t i = 0; i < tab.rows(); ++i) {
+      GnssFix& f = d.gnss[i];
+      f.t = t[i];
+      f.pos = positionAt(s, tab, ps, *gnssUndulation, "gnss.position", i);
+      f.v_N = velocityAt(s, tab, vs, "gnss.velocity", i);
+      if (ss.present) f.cov_pos_N = sigmaAt(s, tab, ss, "gnss.sigma", i).cwiseAbs2().asDiagonal();
+      if (f.v_N && vs.sigma.present) f.cov_vel_N = sigmaAt(s, tab, vs.sigma, "gnss.velocity.sigma", i).cwiseAbs2().asDiagonal();
+    }
+    rep.gnss_file = s.file;
+  }
+
+  // --- barometer ------------------------------------------------------------
+  if (const YAML::Node n = root["baro"]) {
+    k.map(n, "baro", {"file", "delimiter", "time", "height", "height_datum", "sigma_m", "max_gap_s"}, {"file", "time", "height"});
+    StreamSpec s = streamSpec(k, n, "baro");
+    s.offset_s = offset[2];
+    Requests r;
+    const std::size_t tc = addTime(r, s);
+    k.map(n["height"], "baro.height", {"column", "unit"}, {"column"});
+    if (n["height"]["unit"]) k.oneOf(n["height"]["unit"], "baro.height.unit", {"m"});
+    const std::size_t hc = r.add(k.text(n["height"]["column"], "baro.height.column"), "baro.height.column");
+    double und;
+    if (n["height_datum"]) und = heightDatum(k, n["height_datum"], "baro.height_datum");
+    else if (gnssUndulation) und = *gnssUndulation;
+    else throw k.err("baro.height_datum", "missing (required without a gnss stream, whose datum it otherwise takes)");
+    std::optional<double> sigma;
+    if (n["sigma_m"]) sigma = k.positive(n["sigma_m"], "baro.sigma_m", 1e4, "m");
+    const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
+    const std::vector<double> t = streamTimes(s, tab, tc);
+    d.baro.resize(tab.rows());
+    for (std::size_t i = 0; i < tab.rows(); ++i) d.baro[i] = {t[i], tab.columns[hc][i] + und, sigma};
+    rep.baro_file = s.file;
+  }
+
+  // --- reference ------------------------------------------------------------
+  if (const YAML::Node n = root["reference"]) {
+    k.map(n, "reference", {"file", "delimiter", "time", "position", "height_datum", "attitude", "velocity", "sigma", "max_gap_s"},
+          {"file", "time", "position"});
+    StreamSpec s = streamSpec(k, n, "reference");
+    s.offset_s = offset[3];
+    Requests r;
+    const std::size_t tc = addTime(r, s);
+    const PositionSpec ps = positionSpec(k, n["position"], "reference.position", r);
+    double und;
+    if (n["height_datum"]) und = heightDatum(k, n["height_datum"], "reference.height_datum");
+    else if (gnssUndulation) und = *gnssUndulation;
+    else throw k.err("reference.height_datum", "missing (required without a gnss stream, whose datum it otherwise takes)");
+    bool att = false;
+    std::size_t ac[3] = {0, 0, 0};
+    double aunit = kDeg;
+    if (const YAML::Node a = n["attitude"]) {
+      k.map(a, "reference.attitude", {"roll", "pitch", "yaw", "unit"}, {"roll", "pitch", "yaw", "unit"});
+      const char* names[] = {"roll", "pitch", "yaw"};
+      for (int i = 0; i < 3; ++i)
+        ac[i] = r.add(k.text(a[names[i]], std::string("reference.attitude.") + names[i]), std::string("reference.attitude.") + names[i]);
+      aunit = k.oneOf(a["unit"], "reference.attitude.unit", {"deg", "rad"}) == 0 ? kDeg : 1.0;
+      att = true;
+    }
+    const VelocitySpec vs = velocitySpec(k, n["velocity"], "reference.velocity", r);
+    const SigmaSpec ss = sigmaSpec(k, n["sigma"], "reference.sigma", r, "m", "horizontal_m", "vertical_m");
+    const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
+    const std::vector<double> t = streamTimes(s, tab, tc);
+    std::vector<earth::Geodetic> pos(tab.rows());
+    for (std::size_t i = 0; i < tab.rows(); ++i) pos[i] = positionAt(s, tab, ps, und, "reference.position", i);
+    d.origin = pos.front();
+    d.reference.resize(tab.rows());
+    for (std::size_t i = 0; i < tab.rows(); ++i) {
+      ReferenceRecord& e = d.reference[i];
+      e.t = t[i];
+      e.p_L = earth::geodeticToNed(d.origin, pos[i]);
+      e.v_N = velocityAt(s, tab, vs, "reference.velocity", i);
+      if (att) e.q_BtoN = quatRpy(tab.columns[ac[0]][i] * aunit, tab.columns[ac[1]][i] * aunit, tab.columns[ac[2]][i] * aunit);
+      if (ss.present) e.sigma_p_L = sigmaAt(s, tab, ss, "reference.sigma", i);
+      if (e.v_N && vs.sigma.present) e.sigma_v_N = sigmaAt(s, tab, vs.sigma, "reference.velocity.sigma", i);
+    }
+    rep.reference_file = s.file;
+  } else if (!d.gnss.empty()) {
+    d.origin = d.gnss.front().pos;
+  }
+
+  // --- time base --------------------------------------------------------------
+  if (zeroUnix) {
+    double earliest = d.imu.front().t;
+    if (!d.gnss.empty()) earliest = std::min(earliest, d.gnss.front().t);
+    if (!d.baro.empty()) earliest = std::min(earliest, d.baro.front().t);
+    if (!d.reference.empty()) earliest = std::min(earliest, d.reference.front().t);
+    d.start_unix_s = static_cast<long long>(std::floor(*zeroUnix + earliest));
+    const double shift = *zeroUnix - static_cast<double>(d.start_unix_s);
+    for (auto& x : d.imu) x.t += shift;
+    for (auto& x : d.gnss) x.t += shift;
+    for (auto& x : d.baro) x.t += shift;
+    for (auto& x : d.reference) x.t += shift;
+  }
+  d.t_start_s = 0.0;
+
+  // --- metadata -------------------------------------------------------------
+  {
+    YAML::Emitter y;
+    y << YAML::BeginMap << YAML::Key << "navimpact_scenario" << YAML::Value << YAML::BeginMap;
+    y << YAML::Key << "source" << YAML::Value << "import";
+    y << YAML::Key << "frames" << YAML::Value
+      << "body FRD, navigation NED, reference position tangent-plane NED at origin, attitude C_BtoN";
+    y << YAML::Key << "origin" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "lat_deg" << YAML::Value
+      << fmt17(d.origin.lat / kDeg) << YAML::Key << "lon_deg" << YAML::Value << fmt17(d.origin.lon / kDeg) << YAML::Key
+      << "height_m" << YAML::Value << fmt17(d.origin.h) << YAML::EndMap;
+    y << YAML::Key << "time" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "start_unix_s" << YAML::Value
+      << d.start_unix_s << YAML::Key << "time_base_known" << YAML::Value << zeroUnix.has_value() << YAML::EndMap;
+    y << YAML::Key << "imu" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value
+      << fmt17(d.imu_rate_hz) << YAML::EndMap;
+    if (d.lever_arm_B) {
+      y << YAML::Key << "gnss" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "lever_arm_B_m" << YAML::Value
+        << YAML::Flow << YAML::BeginSeq << fmt17((*d.lever_arm_B)[0]) << fmt17((*d.lever_arm_B)[1])
+        << fmt17((*d.lever_arm_B)[2]) << YAML::EndSeq << YAML::EndMap;
+    }
+    y << YAML::EndMap;
+    y << YAML::Key << "navimpact_import" << YAML::Value << YAML::BeginMap;
+    y << YAML::Key << "manifest_file" << YAML::Value << manifestPath;
+    y << YAML::Key << "manifest" << YAML::Value << YAML::Literal << manifestText;
+    y << YAML::EndMap << YAML::EndMap;
+    d.metadata = y.c_str();
+  }
+  if (report) *report = rep;
+  return d;
+}
+
+}  // namespace navimpact::import

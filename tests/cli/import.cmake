@@ -1,0 +1,63 @@
+# navimpact import: the committed Katwijk rover run (manifest in datasets/), the
+# reference as a pose observation that rawlog-edit reads with its travelled
+# distance, and bad manifests / streams (one line naming file, line and key;
+# nothing written).
+set(_idir ${CMAKE_CURRENT_BINARY_DIR}/import_cli)
+file(MAKE_DIRECTORY ${_idir})
+set(_kat ${CMAKE_SOURCE_DIR}/datasets/katwijk_rover)
+
+add_test(NAME cli_import_katwijk
+  COMMAND ${NI} import --manifest ${_kat}/manifest.yaml --out ${_idir}/katwijk.rawlog --overwrite)
+set_tests_properties(cli_import_katwijk PROPERTIES FIXTURES_SETUP import_katwijk
+  PASS_REGULAR_EXPRESSION "IMU 37501 samples, 300.000 s at 125 Hz.*GNSS 101 fixes \\(position only, with sigma\\).*reference 101 samples \\(position only\\).*after Unix 1448546402")
+
+# rawlog-edit (mrpt-apps): the reference poses give the rover's path (48.6 m in README.json)
+navimpact_cli_check(cli_import_rawlog_edit_distance CHECK rawlog_edit_gt_distance
+  DEFINES RAWLOG=${_idir}/katwijk.rawlog ROWS=101 MIN_M=45 MAX_M=70)
+set_tests_properties(cli_import_rawlog_edit_distance PROPERTIES FIXTURES_REQUIRED import_katwijk)
+
+# navimpact's own readers take the imported rawlog (IMU at its real rate)
+add_test(NAME cli_import_wv_reads_it
+  COMMAND ${NI} wv --input ${_idir}/katwijk.rawlog --label IMU --out ${_idir}/wv --overwrite)
+set_tests_properties(cli_import_wv_reads_it PROPERTIES FIXTURES_REQUIRED import_katwijk
+  PASS_REGULAR_EXPRESSION "125")
+
+# Bad input: a copy of the manifest with one defect at a time.
+file(READ ${_kat}/manifest.yaml _m)
+string(REPLACE "file: imu.csv.gz" "file: ${_kat}/imu.csv.gz" _m "${_m}")
+string(REPLACE "file: gnss.csv" "file: ${_kat}/gnss.csv" _m "${_m}")
+string(REPLACE "file: reference.csv" "file: ${_kat}/reference.csv" _m "${_m}")
+string(REPLACE "unit: rad/s" "unit: rpm" _bad_unit "${_m}")
+file(WRITE ${_idir}/bad_unit.yaml "${_bad_unit}")
+navimpact_cli_fail(cli_import_bad_unit
+  ARGS import --manifest ${_idir}/bad_unit.yaml --out ${_idir}/bad.rawlog
+  REGEX "bad_unit.yaml: key 'imu.gyro.unit'.*rpm" NOOUT ${_idir}/bad.rawlog)
+string(REPLACE "max_gap_s: 3.5" "max_gapp_s: 3.5" _bad_key "${_m}")
+file(WRITE ${_idir}/bad_key.yaml "${_bad_key}")
+navimpact_cli_fail(cli_import_unknown_key
+  ARGS import --manifest ${_idir}/bad_key.yaml --out ${_idir}/bad.rawlog
+  REGEX "bad_key.yaml: key 'gnss.max_gapp_s': unknown key" NOOUT ${_idir}/bad.rawlog)
+string(REPLACE "axes: [-x, y, -z]" "axes: [-x, y, z]" _bad_axes "${_m}")
+file(WRITE ${_idir}/bad_axes.yaml "${_bad_axes}")
+navimpact_cli_fail(cli_import_mirror_axes
+  ARGS import --manifest ${_idir}/bad_axes.yaml --out ${_idir}/bad.rawlog
+  REGEX "key 'imu.axes': is a mirror" NOOUT ${_idir}/bad.rawlog)
+# a stream with a NaN and a repeated time (the GNSS file copied with defects)
+file(READ ${_kat}/gnss.csv _g)
+string(REPLACE "0.700,3.000,1448546405.617,52.2141820426667" "0.700,3.000,1448546405.617,nan" _g_nan "${_g}")
+file(WRITE ${_idir}/gnss_nan.csv "${_g_nan}")
+string(REPLACE "${_kat}/gnss.csv" "${_idir}/gnss_nan.csv" _m_nan "${_m}")
+file(WRITE ${_idir}/nan.yaml "${_m_nan}")
+navimpact_cli_fail(cli_import_nan
+  ARGS import --manifest ${_idir}/nan.yaml --out ${_idir}/bad.rawlog
+  REGEX "gnss_nan.csv:3: column 'lat_deg' \\(key gnss.position.lat\\): value is nan" NOOUT ${_idir}/bad.rawlog)
+string(REPLACE "0.700,3.000" "-2.300,3.000" _g_rep "${_g}")
+file(WRITE ${_idir}/gnss_rep.csv "${_g_rep}")
+string(REPLACE "${_kat}/gnss.csv" "${_idir}/gnss_rep.csv" _m_rep "${_m}")
+file(WRITE ${_idir}/rep.yaml "${_m_rep}")
+navimpact_cli_fail(cli_import_repeated_time
+  ARGS import --manifest ${_idir}/rep.yaml --out ${_idir}/bad.rawlog
+  REGEX "gnss_rep.csv:3: column 't_s' \\(key gnss.time.column\\): time repeats" NOOUT ${_idir}/bad.rawlog)
+navimpact_cli_fail(cli_import_missing_manifest
+  ARGS import --manifest ${_idir}/none.yaml --out ${_idir}/bad.rawlog
+  REGEX "none.yaml: cannot open the manifest" NOOUT ${_idir}/bad.rawlog)
