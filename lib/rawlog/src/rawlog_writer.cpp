@@ -371,6 +371,8 @@ Recording readRawlog(const std::string& path) {
         const Eigen::Vector3d v_E(p->cartesian_vx, p->cartesian_vy, p->cartesian_vz);
         // products assigned into the emplaced values (as into a plain Matrix3d: Eigen evaluates an
         // assignment and a construction from a product differently in the last bit)
+        if (!(v_E.allFinite() || v_E.array().isNaN().all()))
+          throw Error(where(label, t) + ": GNSS velocity is not finite");
         if (v_E.allFinite()) f.v_N.emplace() = C_EtoN * v_E;
         if (p->hasPosCov) {
           const Eigen::Matrix3d c = p->pos_covariance.asEigen().topLeftCorner<3, 3>().cast<double>();
@@ -389,8 +391,6 @@ Recording readRawlog(const std::string& path) {
       if (!std::isfinite(f.pos.lat) || !std::isfinite(f.pos.lon) || !std::isfinite(f.pos.h) ||
           std::abs(f.pos.lat) > M_PI / 2 || std::abs(f.pos.lon) > 2 * M_PI || std::abs(f.pos.h) > 1e7)
         throw Error(where(label, t) + ": GNSS position is not a place on Earth (latitude, longitude, height)");
-      if (!(f.v_N.array().isFinite().all() || f.v_N.array().isNaN().all()))
-        throw Error(where(label, t) + ": GNSS velocity is not finite");
       d.gnss.push_back(f);
     } else {
       ++skipped;
