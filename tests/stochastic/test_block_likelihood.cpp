@@ -124,3 +124,45 @@ TEST(BlockLikelihood, BadInputIsAnError) {
   EXPECT_THROW(blockLogLikelihood(m, y, 4, Eigen::MatrixXd::Ones(3, 2)), navimpact::Error);  // collinear
   EXPECT_THROW(blockMeans(y.data(), y.size(), 0), navimpact::Error);
 }
+
+// profileBlockLogLikelihood: at least the likelihood it starts from, and a
+// maximum over every term's variance (no +-20 % change of one variance gains
+// more than 1e-3), on random models, records and starting points (variances
+// off by up to 10x either way).
+TEST(BlockLikelihood, ProfileMaximisesOverEveryVariance) {
+  const std::uint64_t seed = 20261202;
+  std::cout << "[ block    ] seed " << seed << "\n";
+  std::mt19937_64 g(seed);
+  for (int r = 0; r < 12; ++r) {
+    Model truth;
+    truth.rate_hz = logU(g, 50, 1000);
+    truth.terms.push_back(Process::wn(logU(g, 1e-3, 1.0)));
+    if (g() % 2 == 0) truth.terms.push_back(Process::rw(truth.terms[0].sigma * logU(g, 1e-4, 1e-2)));
+    if (g() % 2 == 0) truth.terms.push_back(Process::gm(truth.terms[0].sigma * logU(g, 0.05, 1.0), logU(g, 0.1, 100.0)));
+    const std::size_t n = 1u << 15, block = 64;
+    const auto x = simulate(truth, n, g());
+    const auto y = blockMeans(x.data(), n, block);
+    const Eigen::MatrixXd X = Eigen::MatrixXd::Ones(static_cast<Eigen::Index>(y.size()), 1);
+    Model m = truth;
+    m.terms[0].sigma *= logU(g, 0.3, 3.0);
+    for (auto& p : m.terms) {
+      if (p.kind == ProcessKind::RW) p.gamma *= logU(g, 0.3, 3.0);
+      if (p.kind == ProcessKind::GM) p.sigma *= logU(g, 0.3, 3.0);
+    }
+    const double start = blockLogLikelihood(m, y, block, X).loglik;
+    const double best = profileBlockLogLikelihood(m, y, block, X);
+    const std::string what = formatTerms(truth.terms, 3) + " -> " + formatTerms(m.terms, 3);
+    EXPECT_GE(best, start - 1e-9) << what;
+    EXPECT_NEAR(blockLogLikelihood(m, y, block, X).loglik, best, 1e-9 * std::abs(best)) << what;
+    for (std::size_t i = 0; i < m.terms.size(); ++i)
+      for (double f : {0.8, 1.25}) {
+        Model q = m;
+        auto& p = q.terms[i];
+        const double r2 = std::sqrt(f);
+        if (p.kind == ProcessKind::WN) p.sigma *= r2;
+        if (p.kind == ProcessKind::RW) p.gamma *= r2;
+        if (p.kind == ProcessKind::GM) p.sigma *= r2;
+        EXPECT_LE(blockLogLikelihood(q, y, block, X).loglik, best + 1e-3) << what << " term " << i << " x" << f;
+      }
+  }
+}

@@ -23,6 +23,7 @@
 #include "navimpact/detect/step_test.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 #include "navimpact/gmwm/estimator.hpp"
+#include "navimpact/stochastic/block_likelihood.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/process_kind.hpp"
 #include "navimpact/stochastic/simulate.hpp"
@@ -1066,6 +1067,15 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   Model m_full = m0n, m_half = m0n;
   int added_params = 0;
   std::map<int, std::size_t> added_by;  ///< term index added here -> its finding
+  // Block means of the cleaned record for the exact likelihood that decides
+  // between the slow explanations (random walk, drift, long Gauss-Markov),
+  // which differ only at the coarsest WV scales where it has few dof.
+  const std::size_t blk = std::max<std::size_t>(1, n / 512);
+  const std::vector<double> yb = stochastic::blockMeans(x.data(), n, blk);
+  auto isSlow = [&](const Candidate& c) {
+    if (c.kind == ProcessKind::RW || c.kind == ProcessKind::DR) return true;
+    return c.kind == ProcessKind::GM && !c.retune && c.proc.T * rate >= 4.0 * static_cast<double>(blk);
+  };
   auto chk = chk_cl;
   for (int it = 0; it < opt.max_terms && countSignificant(chk) > 0; ++it) {
     // Cause chosen on the whole cleaned record (all scales: the coarsest
@@ -1096,11 +1106,52 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
       }
     }
     if (best < 0) break;
-    const Candidate& ch = cands[best];
     {
       const double cur = wvDeviance(full.nu, wvOf(m_full, full.tau), full.dof);
       if (!(best_crit < cur)) break;
     }
+    // Slow explanations compared by the exact Gaussian likelihood of the block
+    // means (every variance profiled, a drift's slope by GLS), AIC.
+    std::string exact_evidence;
+    if (isSlow(cands[best]) && yb.size() >= 16) {
+      std::vector<std::pair<double, int>> ranked;
+      for (std::size_t i = 0; i < cands.size(); ++i) {
+        if (!std::isfinite(crits[i]) || !isSlow(cands[i])) continue;
+        Model mc = withoutSin(applyCandidate(m_full, cands[i]));
+        const bool trend = mc.count(ProcessKind::DR) > 0;
+        Eigen::MatrixXd X(static_cast<Eigen::Index>(yb.size()), trend ? 2 : 1);
+        for (std::size_t k = 0; k < yb.size(); ++k) {
+          X(static_cast<Eigen::Index>(k), 0) = 1.0;
+          if (trend) X(static_cast<Eigen::Index>(k), 1) = (static_cast<double>(k) + 0.5) / static_cast<double>(yb.size()) - 0.5;
+        }
+        // Only the candidate's own term is profiled (a drift's slope is the
+        // GLS trend): each explanation gets one addition to the model.
+        int own = -1;
+        if (cands[i].retune) own = cands[i].term;
+        else if (cands[i].kind == ProcessKind::GM) own = static_cast<int>(mc.terms.size()) - 1;
+        else if (cands[i].kind == ProcessKind::RW)
+          for (std::size_t q = 0; q < mc.terms.size(); ++q)
+            if (mc.terms[q].kind == ProcessKind::RW) own = static_cast<int>(q);
+        try {
+          const double l = stochastic::profileBlockLogLikelihood(mc, yb, blk, X, {own});
+          ranked.push_back({-2.0 * l + 2.0 * cands[i].params + (cands[i].retune ? 4.0 : 0.0), static_cast<int>(i)});
+        } catch (const Error&) {
+        }
+      }
+      std::sort(ranked.begin(), ranked.end());
+      if (ranked.size() >= 2) {
+        const int wv_best = best;
+        best = ranked[0].second;
+        best_crit = crits[best];
+        second = ranked[1].second;
+        second_crit = crits[second];
+        exact_evidence = "; among the slow explanations the exact likelihood of " + std::to_string(yb.size()) +
+                         " block means (variances profiled) gives AIC " + fmtNum(ranked[0].first, 7) + " against " +
+                         fmtNum(ranked[1].first, 7) + " for " + candidateText(cands[second]) +
+                         (best != wv_best ? " (the WV alone preferred " + candidateText(cands[wv_best]) + ")" : std::string());
+      }
+    }
+    const Candidate& ch = cands[best];
     const Candidate cf = ch;
     // The same family fitted on the first half, for the held-out gain.
     const Candidate chh = (ch.retune && ch.term >= static_cast<int>(m_half.terms.size()))
@@ -1118,7 +1169,8 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     nf.p_value = std::min(1.0, pmin * J * sh.channels / 0.4);  // Bonferroni over scales and channels (WV share)
     nf.evidence = "AIC " + fmtNum(best_crit, 5) +
                   (second >= 0 ? " against " + fmtNum(second_crit, 5) + " for the runner-up, " + candidateText(cands[second])
-                               : std::string(" (no other family fits)"));
+                               : std::string(" (no other family fits)")) +
+                  exact_evidence;
     auto own = added_by.find(cf.retune ? cf.term : -1);
     if (cf.retune && own != added_by.end()) {
       Finding& old = cd.findings[own->second];

@@ -38,74 +38,6 @@ Eigen::MatrixXd regressors(std::size_t nb, std::size_t b, std::size_t n, bool tr
   return X;
 }
 
-/// Variance-like parameter of a random term, scaled by @p f (variance factor).
-void scaleVariance(stochastic::Process& p, double f) {
-  const double r = std::sqrt(f);
-  switch (p.kind) {
-    case stochastic::ProcessKind::WN: p.sigma *= r; break;
-    case stochastic::ProcessKind::QN: p.Q *= r; break;
-    case stochastic::ProcessKind::RW: p.gamma *= r; break;
-    case stochastic::ProcessKind::GM: p.sigma *= r; break;
-    default: break;
-  }
-}
-
-bool isRandom(const stochastic::Process& p) {
-  return p.kind == stochastic::ProcessKind::WN || p.kind == stochastic::ProcessKind::QN ||
-         p.kind == stochastic::ProcessKind::RW || p.kind == stochastic::ProcessKind::GM;
-}
-
-/// Block log-likelihood maximised over the variance of every random term of
-/// @p m (GM correlation times kept), by coordinate-wise search in the log of a
-/// variance factor per term (a grid of e^-12..e^4, then golden section; two
-/// sweeps until the log-likelihood gains less than 1e-4). @p m is updated
-/// to the maximiser.
-double profiledLoglik(stochastic::Model& m, const std::vector<double>& y, std::size_t b,
-                      const Eigen::MatrixXd& X) {
-  auto ll = [&](const stochastic::Model& mm) {
-    return stochastic::blockLogLikelihood(mm, y, b, X).loglik;
-  };
-  double best = ll(m);
-  for (int sweep = 0; sweep < 8; ++sweep) {
-    const double before = best;
-    for (std::size_t i = 0; i < m.terms.size(); ++i) {
-      if (!isRandom(m.terms[i])) continue;
-      const stochastic::Process p0 = m.terms[i];
-      auto at = [&](double lf) {
-        m.terms[i] = p0;
-        scaleVariance(m.terms[i], std::exp(lf));
-        return ll(m);
-      };
-      double bl = 0, bv = best;
-      for (int g = -12; g <= 4; ++g) {
-        if (g == 0) continue;
-        const double v = at(g);
-        if (v > bv) {
-          bv = v;
-          bl = g;
-        }
-      }
-      double a = bl - 1, c = bl + 1;
-      const double r = 0.5 * (std::sqrt(5.0) - 1.0);
-      double x1 = c - r * (c - a), x2 = a + r * (c - a), f1 = at(x1), f2 = at(x2);
-      for (int it = 0; it < 16; ++it) {
-        if (f1 > f2) {
-          c = x2; x2 = x1; f2 = f1; x1 = c - r * (c - a); f1 = at(x1);
-        } else {
-          a = x1; x1 = x2; f1 = f2; x2 = a + r * (c - a); f2 = at(x2);
-        }
-      }
-      if (f1 > bv) { bv = f1; bl = x1; }
-      if (f2 > bv) { bv = f2; bl = x2; }
-      m.terms[i] = p0;
-      scaleVariance(m.terms[i], std::exp(bl));
-      best = bv;
-    }
-    if (best - before < 1e-4) break;  // converged
-  }
-  return best;
-}
-
 }  // namespace
 
 StepTestResult testLevelShifts(const std::vector<double>& x, const stochastic::Model& m,
@@ -137,7 +69,7 @@ StepTestResult testLevelShifts(const std::vector<double>& x, const stochastic::M
     if (v > 0) m0.terms.push_back(stochastic::Process::rw(std::sqrt(v / static_cast<double>(b))));
   }
   auto loglik = [&](stochastic::Model& mm, const Eigen::MatrixXd& X) {
-    return opt.profile_variances ? profiledLoglik(mm, y, b, X) : stochastic::blockLogLikelihood(mm, y, b, X).loglik;
+    return opt.profile_variances ? stochastic::profileBlockLogLikelihood(mm, y, b, X) : stochastic::blockLogLikelihood(mm, y, b, X).loglik;
   };
   double l0 = loglik(m0, regressors(nb, b, used, trend, {}));
   stochastic::Model m_acc = m0;  // the noise model given the shifts accepted so far

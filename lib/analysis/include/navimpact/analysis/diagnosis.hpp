@@ -23,7 +23,9 @@
  *     those are fewer), Bonferroni over scales; the excess is matched against
  *     each process family (add WN, QN, RW, DR, GM with T <= record/5, or
  *     retune one term) by the chi-square (gamma) deviance on the FIRST half,
- *     chosen by AIC = deviance + 2 p; the runner-up is reported; a term that
+ *     chosen by AIC = deviance + 2 p; when the winner is slow (RW, DR, long
+ *     GM) the slow candidates are ranked again by AIC on the exact Gaussian
+ *     likelihood of ~512 block means; the runner-up is reported; a term that
  *     changes the WV by less than the CI width at every scale, or has a
  *     vanishing parameter, is not a finding;
  *  5. gain: the first-half extension and the user's model are judged on the

@@ -66,4 +66,15 @@ struct BlockLikelihood {
 BlockLikelihood blockLogLikelihood(const Model& m, const std::vector<double>& y, std::size_t block,
                                    const Eigen::MatrixXd& X, const std::vector<int>& columns = {});
 
+/**
+ * blockLogLikelihood() maximised over the variance of every random term of
+ * @p m (WN sigma^2, QN Q^2, RW gamma^2, GM sigma^2; GM correlation times and
+ * DR kept), by coordinate-wise search in the log of one variance factor per
+ * term (grid e^-12..e^4, then golden section; sweeps until the log-likelihood
+ * gains less than 1e-4). @p m is updated to the maximiser. @p terms: the
+ * indices of the terms to profile (empty: all; {-1}: none).
+ */
+double profileBlockLogLikelihood(Model& m, const std::vector<double>& y, std::size_t block,
+                                 const Eigen::MatrixXd& X, const std::vector<int>& terms = {});
+
 }  // namespace navimpact::stochastic
