@@ -61,3 +61,30 @@ navimpact_cli_fail(cli_import_repeated_time
 navimpact_cli_fail(cli_import_missing_manifest
   ARGS import --manifest ${_idir}/none.yaml --out ${_idir}/bad.rawlog
   REGEX "none.yaml: cannot open the manifest" NOOUT ${_idir}/bad.rawlog)
+
+# The same path for emulated and measured runs: the bundled emulated UAV rawlog
+# exported as CSV + manifest (datasets/uav_flight_260s_emulated/), imported and
+# replayed, gives the outage of the original rawlog's replay (to 2 micrometres).
+add_test(NAME cli_export_uav
+  COMMAND ${NI} export --rawlog ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog --out ${_idir}/uav_export --overwrite)
+set_tests_properties(cli_export_uav PROPERTIES
+  PASS_REGULAR_EXPRESSION "exported IMU 52000, GNSS 261, BARO 2601, reference 2601 records")
+navimpact_cli_fail(cli_export_not_a_rawlog
+  ARGS export --rawlog ${_kat}/gnss.csv --out ${_idir}/bad_export
+  REGEX "gnss.csv: entry 0" NOOUT ${_idir}/bad_export)
+add_test(NAME cli_import_uav_emulated
+  COMMAND ${NI} import --manifest ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_emulated/manifest.yaml
+          --out ${_idir}/uav.rawlog --overwrite)
+set_tests_properties(cli_import_uav_emulated PROPERTIES FIXTURES_SETUP import_uav
+  PASS_REGULAR_EXPRESSION "IMU 52000 samples, 259.995 s at 200 Hz.*GNSS 261 fixes \\(with velocity, with sigma\\).*BARO 2601.*reference 2601 samples \\(with attitude\\)")
+add_test(NAME cli_import_uav_replay
+  COMMAND ${NI} replay --rawlog ${_idir}/uav.rawlog --model ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref
+          --outage 200:60 --out ${_idir}/uav_replay --overwrite)
+set_tests_properties(cli_import_uav_replay PROPERTIES FIXTURES_REQUIRED import_uav FIXTURES_SETUP import_uav_replay)
+add_test(NAME cli_import_uav_replay_original
+  COMMAND ${NI} replay --rawlog ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog --outage 200:60
+          --out ${_idir}/uav_replay_original --overwrite)
+set_tests_properties(cli_import_uav_replay_original PROPERTIES FIXTURES_SETUP import_uav_replay)
+navimpact_cli_check(cli_import_uav_same_outage CHECK same_outage
+  DEFINES A=${_idir}/uav_replay/summary.json B=${_idir}/uav_replay_original/summary.json)
+set_tests_properties(cli_import_uav_same_outage PROPERTIES FIXTURES_REQUIRED import_uav_replay)

@@ -383,7 +383,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
                 ": YAML syntax: " + e.msg);
   }
   const Keys k{manifestPath, fs::path(manifestPath).parent_path()};
-  k.map(root, "", {"imu", "gnss", "baro", "reference", "time_offset_s", "time_zero_unix_s"}, {"imu"});
+  k.map(root, "", {"imu", "gnss", "baro", "reference", "time_offset_s", "time_zero_unix_s", "origin"}, {"imu"});
 
   double offset[4] = {0, 0, 0, 0};  // imu, gnss, baro, reference
   if (root["time_offset_s"]) {
@@ -398,6 +398,13 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
 
   Recording d;
   d.source = manifestPath;
+  std::optional<earth::Geodetic> origin;
+  if (const YAML::Node o = root["origin"]) {
+    k.map(o, "origin", {"lat_deg", "lon_deg", "height_m"}, {"lat_deg", "lon_deg", "height_m"});
+    origin = earth::Geodetic{k.number(o["lat_deg"], "origin.lat_deg", -90.0, 90.0, "deg") * kDeg,
+                             k.number(o["lon_deg"], "origin.lon_deg", -180.0, 360.0, "deg") * kDeg,
+                             k.number(o["height_m"], "origin.height_m", -12000.0, 1e6, "m")};
+  }
   ImportReport rep;
 
   // --- IMU ------------------------------------------------------------------
@@ -562,7 +569,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     const std::vector<double> t = streamTimes(s, tab, tc);
     std::vector<earth::Geodetic> pos(tab.rows());
     for (std::size_t i = 0; i < tab.rows(); ++i) pos[i] = positionAt(s, tab, ps, und, "reference.position", i);
-    d.origin = pos.front();
+    d.origin = origin ? *origin : pos.front();
     d.reference.resize(tab.rows());
     for (std::size_t i = 0; i < tab.rows(); ++i) {
       ReferenceRecord& e = d.reference[i];
@@ -574,6 +581,8 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       if (e.v_N && vs.sigma.present) e.sigma_v_N = sigmaAt(s, tab, vs.sigma, "reference.velocity.sigma", i);
     }
     rep.reference_file = s.file;
+  } else if (origin) {
+    d.origin = *origin;
   } else if (!d.gnss.empty()) {
     d.origin = d.gnss.front().pos;
   }
@@ -611,6 +620,10 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       y << YAML::Key << "gnss" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "lever_arm_B_m" << YAML::Value
         << YAML::Flow << YAML::BeginSeq << fmt17((*d.lever_arm_B)[0]) << fmt17((*d.lever_arm_B)[1])
         << fmt17((*d.lever_arm_B)[2]) << YAML::EndSeq << YAML::EndMap;
+    }
+    if (!d.baro.empty() && d.baro.front().sigma_m) {  // rawlogs keep the barometer's sigma here
+      y << YAML::Key << "baro" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "sigma_m" << YAML::Value
+        << fmt17(*d.baro.front().sigma_m) << YAML::EndMap;
     }
     y << YAML::EndMap;
     y << YAML::Key << "navimpact_import" << YAML::Value << YAML::BeginMap;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "entry_reader.hpp"
+#include "foreign_reader.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/imu_series.hpp"
 
@@ -35,11 +36,6 @@ constexpr double kTick = 1e-7;  // MRPT Clock resolution [s]
 mrpt::Clock::time_point stamp(long long startUnix, double tRel) {
   const auto base = mrpt::Clock::fromDouble(static_cast<double>(startUnix));
   return base + mrpt::Clock::duration(std::llround(tRel / kTick));
-}
-
-double seconds(const mrpt::Clock::time_point& ts, long long startUnix) {
-  const auto base = mrpt::Clock::fromDouble(static_cast<double>(startUnix));
-  return static_cast<double>((ts - base).count()) * kTick;
 }
 
 struct Entry {
@@ -208,9 +204,20 @@ void writeRawlog(const std::string& path, const Recording& d, const RawlogWriteO
   if (!std::filesystem::exists(path)) throw Error(path + ": rawlog was not written");
 }
 
-Recording readRawlog(const std::string& path) {
+Recording readRawlog(const std::string& path, const RawlogReadOptions& opt) {
   InputScope scope(path);
   if (!std::filesystem::exists(path)) throw Error(path + ": rawlog not found");
+  {
+    // navimpact's own rawlogs start with their comment; anything else is read
+    // as MRPT's drivers record (labels, sensor axes and sensorPose)
+    detail::EntryReader peek(path);
+    const auto first = peek.next();
+    const auto c = std::dynamic_pointer_cast<mrpt::obs::CObservationComment>(first);
+    if (first && !(c && (c->text.empty() || c->text.find("navimpact_scenario") != std::string::npos))) {
+      detail::EntryReader reader(path);
+      return detail::readForeignRawlog(reader, opt);
+    }
+  }
   // Entries through one 1 MiB buffer (MRPT's archive reads every field with its
   // own small Read() call), with the length caps and gzip checks of EntryReader.
   detail::EntryReader reader(path);

@@ -47,6 +47,12 @@ struct RawlogWriteOptions {
   int gzip_level = 6;      ///< 1 (fast) .. 9 (small)
 };
 
+/// Options of readRawlog() for rawlogs navimpact did not write.
+struct RawlogReadOptions {
+  std::string imu_label;   ///< label of the IMU entries; "": the only one present
+  std::string gnss_label;  ///< label of the GNSS entries; "": the only one present
+};
+
 /**
  * Write @p data to @p path (overwritten).
  * @throws navimpact::Error naming the file when it cannot be written.
@@ -54,7 +60,27 @@ struct RawlogWriteOptions {
 void writeRawlog(const std::string& path, const Recording& data, const RawlogWriteOptions& opt = {});
 
 /**
- * Read a rawlog with the labels above (any other entry is skipped, counted in
+ * Read a rawlog. A rawlog navimpact wrote (its first entry is the comment
+ * with navimpact_scenario, or an empty comment) is read with the labels above;
+ * any other is read as MRPT's drivers record (see "foreign rawlogs" below).
+ *
+ * Foreign rawlogs (observations or sensory frames): IMU from the
+ * CObservationIMU entries of @p opt.imu_label (default: the only label whose
+ * entries have angular rates and accelerations) in the sensor's axes, turned
+ * into body FRD by the rotation of their sensorPose (the mounting in MRPT's
+ * vehicle frame x forward, y left, z up); GNSS from the CObservationGPS
+ * entries of @p opt.gnss_label (default: the only one): TOPCON_PZS (ECEF
+ * position, velocity, covariances; else its lat/lon/height), else Novatel
+ * BESTPOS (height + undulation, lat/lon/height sigmas), else NMEA GGA
+ * (altitude + geoidal separation; fix quality > 0); velocity from PZS, else
+ * horizontal from NMEA RMC (status A) or VTG with assumed sigmas (kRmcSigmaH,
+ * and kRmcSigmaV for the unknown vertical, said in the notices); the antenna
+ * lever arm from the GNSS sensorPose. (MRPT 2.5 has no Novatel BESTVEL class.)
+ * Time zero is the first chosen entry; the origin the first fix.
+ * @throws navimpact::Error listing the labels when more than one could be
+ *         meant, or naming the label that is not there.
+ *
+ * Reading a rawlog navimpact wrote: the labels above (any other entry is skipped, counted in
  * the notices). Times are seconds since the scenario's start (start_unix_s
  * from the comment, t_start_s = 0), or since the first IMU/GNSS/BARO/GT entry
  * when the comment has no time base (then start_unix_s and t_start_s keep
@@ -68,6 +94,6 @@ void writeRawlog(const std::string& path, const Recording& data, const RawlogWri
  *         without a scenario origin or with only some of its velocity or
  *         attitude fields.
  */
-Recording readRawlog(const std::string& path);
+Recording readRawlog(const std::string& path, const RawlogReadOptions& opt = {});
 
 }  // namespace navimpact::rawlog

@@ -1,0 +1,189 @@
+// Rawlogs navimpact did not write, made with MRPT's own classes the way its
+// drivers fill them: IMU in sensor axes with the mounting in sensorPose (MRPT
+// vehicle frame x forward, y left, z up), GNSS as NMEA GGA + RMC, Novatel
+// BESTPOS or TOPCON PZS, sensory-frame or observation-only files, any labels.
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CObservationGPS.h>
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose3D.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cstdio>
+#include <random>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/rawlog/writer.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using navimpact::Recording;
+namespace gnss = mrpt::obs::gnss;
+constexpr double kDeg = M_PI / 180.0;
+
+struct Truth {
+  std::vector<Eigen::Vector3d> w_B, f_B;  // body FRD
+  Eigen::Matrix3d C_StoFRD;               // sensor axes -> body FRD
+};
+
+// An IMU mounted with a random attitude on the vehicle, recorded as a driver does:
+// values in sensor axes, the mounting in sensorPose; GNSS with label gnssLabel.
+Truth writeForeign(const std::string& path, std::uint64_t seed, bool sensoryFrames, const std::vector<std::string>& imuLabels,
+                   int gnssKind) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> N(0.0, 1.0);
+  std::uniform_real_distribution<double> U(-M_PI, M_PI);
+  const double yaw = U(rng), pitch = U(rng) / 2, roll = U(rng);
+  std::printf("seed %llu: mounting yaw %.3f pitch %.3f roll %.3f rad, %s, GNSS kind %d\n", (unsigned long long)seed, yaw,
+              pitch, roll, sensoryFrames ? "sensory frames" : "observations", gnssKind);
+  const mrpt::poses::CPose3D mount(0.1, 0.2, 0.3, yaw, pitch, roll);
+  Eigen::Matrix3d R;  // sensor -> vehicle FLU
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) R(a, b) = mount.getRotationMatrix()(a, b);
+  Truth t;
+  t.C_StoFRD = Eigen::Vector3d(1, -1, -1).asDiagonal() * R;
+  mrpt::io::CFileGZOutputStream out(path);
+  auto arch = mrpt::serialization::archiveFrom(out);
+  const auto t0 = mrpt::Clock::fromDouble(1.6e9 + 0.25);
+  for (int k = 0; k < 200; ++k) {
+    const auto ts = t0 + std::chrono::microseconds(10000 * k);
+    std::vector<mrpt::obs::CObservation::Ptr> obs;
+    const Eigen::Vector3d w(N(rng), N(rng), N(rng)), f(N(rng), N(rng), -9.8 + N(rng));
+    t.w_B.push_back(w);
+    t.f_B.push_back(f);
+    for (const auto& label : imuLabels) {
+      auto m = std::make_shared<mrpt::obs::CObservationIMU>();
+      m->sensorLabel = label;
+      m->timestamp = ts;
+      m->sensorPose = mount;
+      const Eigen::Vector3d ws = t.C_StoFRD.transpose() * w, fs = t.C_StoFRD.transpose() * f;
+      m->set(mrpt::obs::IMU_WX, ws[0]);
+      m->set(mrpt::obs::IMU_WY, ws[1]);
+      m->set(mrpt::obs::IMU_WZ, ws[2]);
+      m->set(mrpt::obs::IMU_X_ACC, fs[0]);
+      m->set(mrpt::obs::IMU_Y_ACC, fs[1]);
+      m->set(mrpt::obs::IMU_Z_ACC, fs[2]);
+      m->set(mrpt::obs::IMU_YAW, 0.3);  // drivers add their own orientation estimates: ignored
+      obs.push_back(m);
+    }
+    if (k % 20 == 5) {
+      auto g = std::make_shared<mrpt::obs::CObservationGPS>();
+      g->sensorLabel = "GPS";
+      g->timestamp = ts;
+      g->sensorPose = mrpt::poses::CPose3D(0.5, 0.25, 1.0, 0, 0, 0);  // antenna 0.5 fwd, 0.25 left, 1 up
+      const double lat = 46.5 + 1e-5 * k, lon = 6.6, msl = 400.0 + k, und = 47.25;
+      if (gnssKind == 0) {
+        gnss::Message_NMEA_GGA gga;
+        gga.fields.latitude_degrees = lat;
+        gga.fields.longitude_degrees = lon;
+        gga.fields.altitude_meters = msl;
+        gga.fields.geoidal_distance = und;
+        gga.fields.fix_quality = 1;
+        g->setMsg(gga);
+        gnss::Message_NMEA_RMC rmc;
+        rmc.fields.validity_char = 'A';
+        rmc.fields.speed_knots = 10.0;
+        rmc.fields.direction_degrees = 30.0;
+        g->setMsg(rmc);
+      } else if (gnssKind == 1) {
+        gnss::Message_NV_OEM6_BESTPOS b;
+        b.fields.solution_stat = gnss::nv_oem6_solution_status::SOL_COMPUTED;
+        b.fields.lat = lat;
+        b.fields.lon = lon;
+        b.fields.hgt = msl;
+        b.fields.undulation = static_cast<float>(und);
+        b.fields.lat_sigma = 0.5f;
+        b.fields.lon_sigma = 0.75f;
+        b.fields.hgt_sigma = 1.5f;
+        g->setMsg(b);
+      } else {
+        gnss::Message_TOPCON_PZS p;
+        p.latitude_degrees = lat;
+        p.longitude_degrees = lon;
+        p.height_meters = msl + und;
+        p.Fix = 1;
+        g->setMsg(p);
+      }
+      obs.push_back(g);
+    }
+    if (sensoryFrames) {
+      mrpt::obs::CSensoryFrame sf;
+      for (auto& o : obs) sf.insert(o);
+      arch << sf;
+    } else {
+      for (auto& o : obs) arch << *o;
+    }
+  }
+  return t;
+}
+
+std::string errorOf(const std::string& path, const navimpact::rawlog::RawlogReadOptions& opt) {
+  try {
+    navimpact::rawlog::readRawlog(path, opt);
+  } catch (const navimpact::Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST(ForeignRawlog, ImuInSensorAxesWithItsMountingComesBackInBodyFrd) {
+  for (int kind = 0; kind < 3; ++kind)
+    for (bool frames : {false, true}) {
+      const auto p = (navimpact::test::tempDir() / ("f" + std::to_string(kind) + (frames ? "sf" : "obs") + ".rawlog")).string();
+      const Truth t = writeForeign(p, 4200 + 2 * kind + frames, frames, {"XSENS"}, kind);
+      const Recording d = navimpact::rawlog::readRawlog(p);
+      ASSERT_EQ(d.imu.size(), t.w_B.size());
+      for (std::size_t k = 0; k < d.imu.size(); ++k) {
+        EXPECT_LT((d.imu[k].w_IB_B - t.w_B[k]).norm(), 1e-12) << k;
+        EXPECT_LT((d.imu[k].f_B - t.f_B[k]).norm(), 1e-12) << k;
+        EXPECT_NEAR(d.imu[k].t - d.imu[0].t, 0.01 * k, 1e-9);
+      }
+      EXPECT_NEAR(d.imu_rate_hz, 100.0, 1e-6);
+      EXPECT_NEAR(double(d.start_unix_s) - d.t_start_s, 1.6e9 + 0.25, 1e-6);  // time zero = first entry
+      ASSERT_EQ(d.gnss.size(), 10u);
+      const auto& f = d.gnss[0];
+      EXPECT_NEAR(f.t, 0.05, 1e-9);
+      EXPECT_NEAR(f.pos.lat, (46.5 + 5e-5) * kDeg, 1e-12);
+      EXPECT_NEAR(f.pos.h, 405.0 + 47.25, 1e-6);  // ellipsoidal: MSL + undulation
+      ASSERT_TRUE(d.lever_arm_B);
+      EXPECT_LT((*d.lever_arm_B - Eigen::Vector3d(0.5, -0.25, -1.0)).norm(), 1e-15);
+      if (kind == 0) {  // RMC: 10 kn at 30 deg, horizontal only
+        ASSERT_TRUE(f.v_N && f.cov_vel_N);
+        EXPECT_NEAR((*f.v_N)[0], 10 * 1852.0 / 3600 * std::cos(30 * kDeg), 1e-12);
+        EXPECT_NEAR((*f.v_N)[1], 10 * 1852.0 / 3600 * std::sin(30 * kDeg), 1e-12);
+        EXPECT_GE((*f.cov_vel_N)(2, 2), 1e4);
+        EXPECT_FALSE(f.cov_pos_N);
+      } else if (kind == 1) {  // BESTPOS sigmas
+        ASSERT_TRUE(f.cov_pos_N);
+        EXPECT_NEAR((*f.cov_pos_N)(1, 1), 0.75 * 0.75, 1e-7);
+        EXPECT_FALSE(f.v_N);
+      } else {
+        EXPECT_FALSE(f.v_N);
+      }
+    }
+}
+
+TEST(ForeignRawlog, SeveralImuLabelsNeedAChoiceListingThem) {
+  const auto p = (navimpact::test::tempDir() / "two.rawlog").string();
+  const Truth t = writeForeign(p, 4300, false, {"IMU_A", "IMU_B"}, 0);
+  const std::string e = errorOf(p, {});
+  EXPECT_NE(e.find("two.rawlog: several IMU labels: IMU_A (200), IMU_B (200); choose one with --imu-label"),
+            std::string::npos) << e;
+  const Recording d = navimpact::rawlog::readRawlog(p, {"IMU_B", ""});
+  ASSERT_EQ(d.imu.size(), 200u);
+  EXPECT_LT((d.imu[7].w_IB_B - t.w_B[7]).norm(), 1e-12);
+  const std::string e2 = errorOf(p, {"IMU_C", ""});
+  EXPECT_NE(e2.find("no IMU entries with label 'IMU_C' (labels found: IMU_A (200), IMU_B (200))"), std::string::npos) << e2;
+  const std::string e3 = errorOf(p, {"IMU_A", "GNSS"});
+  EXPECT_NE(e3.find("no GNSS entries with label 'GNSS' (labels found: GPS (10))"), std::string::npos) << e3;
+}
+
+// A rawlog navimpact wrote keeps its own convention (FRD data, identity sensorPose).
+TEST(ForeignRawlog, NavimpactRawlogsAreNotTurned) {
+  const Recording b = navimpact::rawlog::readRawlog(navimpact::test::sourcePath("datasets/uav_flight_260s_ref.rawlog"));
+  ASSERT_EQ(b.imu.size(), 52000u);
+  EXPECT_LT(b.imu[0].f_B[2], -3.0);  // specific force points up: negative along body down (not turned to FLU)
+}
