@@ -12,7 +12,7 @@
 namespace {
 
 struct Opts {
-  std::string rawlog, config, model, out;
+  std::string rawlog, config, model, out, imu_label, gnss_label;
   std::vector<std::string> outages;
   int propagate_every = 0;
   bool overwrite = false;
@@ -33,6 +33,10 @@ navimpact::cli::Registrar reg({
                      "replaces the configuration's outages");
       app.add_option("--propagate-every", o->propagate_every,
                      "propagate the covariance every k IMU samples (default 10)");
+      app.add_option("--imu-label", o->imu_label,
+                     "IMU label of a rawlog navimpact did not write (default: the only one present)");
+      app.add_option("--gnss-label", o->gnss_label,
+                     "GNSS label of a rawlog navimpact did not write (default: the only one present)");
       app.add_option("--out", o->out, "output folder")->required();
       navimpact::cli::addOverwriteFlag(app, o->overwrite);
       return [o]() -> int {
@@ -41,6 +45,8 @@ navimpact::cli::Registrar reg({
         if (!o->config.empty()) cfg = navimpact::analysis::loadReplayConfig(o->config);
         if (!o->rawlog.empty()) cfg.rawlog = o->rawlog;
         if (!o->model.empty()) cfg.model_spec = o->model;
+        if (!o->imu_label.empty()) cfg.imu_label = o->imu_label;
+        if (!o->gnss_label.empty()) cfg.gnss_label = o->gnss_label;
         if (!o->outages.empty()) {
           cfg.outages.clear();
           for (const auto& s : o->outages) cfg.outages.push_back(navimpact::analysis::parseOutage(s));

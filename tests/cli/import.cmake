@@ -88,3 +88,9 @@ set_tests_properties(cli_import_uav_replay_original PROPERTIES FIXTURES_SETUP im
 navimpact_cli_check(cli_import_uav_same_outage CHECK same_outage
   DEFINES A=${_idir}/uav_replay/summary.json B=${_idir}/uav_replay_original/summary.json)
 set_tests_properties(cli_import_uav_same_outage PROPERTIES FIXTURES_REQUIRED import_uav_replay)
+
+# A rawlog navimpact did not write (an Xsens driver's IMU label): a label that is
+# not there is named with the labels found.
+navimpact_cli_fail(cli_replay_missing_imu_label
+  ARGS replay --rawlog ${CMAKE_SOURCE_DIR}/tests/data/imu_label_xsens.rawlog --imu-label NOPE --out ${_idir}/nolabel
+  REGEX "imu_label_xsens.rawlog: no IMU entries with label 'NOPE' \\(labels found: XSENS \\(64\\)\\)" NOOUT ${_idir}/nolabel)

@@ -251,7 +251,7 @@ ins::NavState initialWithoutTruth(const Recording& d, const ReplayConfig& cfg, d
 ReplayResult runReplay(const ReplayConfig& cfg) {
   if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
   const std::clock_t c0 = std::clock();
-  Recording d = rawlog::readRawlog(cfg.rawlog);
+  Recording d = rawlog::readRawlog(cfg.rawlog, {cfg.imu_label, cfg.gnss_label});
   ReplayResult r;
   r.read_s = double(std::clock() - c0) / CLOCKS_PER_SEC;
   r.cfg = cfg;

@@ -59,6 +59,7 @@ ReplayOutage parseOutage(const std::string& text);
 struct ReplayConfig {
   std::string config_file;
   std::string rawlog;
+  std::string imu_label, gnss_label;            ///< of a rawlog navimpact did not write; "" = the only one
   std::string model_spec;                       ///< "" = the rawlog scenario's model
   std::vector<ReplayOutage> outages;
   int propagate_every = 10;                     ///< covariance propagation every k IMU samples
