@@ -2,7 +2,8 @@
 // on a measured static recording, the cause, the extended model and its gain.
 //   navimpact diagnose --input STATIC.csv[.gz]|STATIC.rawlog [--rate HZ] [--gyro-unit U]
 //                      [--acc-unit U] [--axes SPEC] [--label IMU]
-//                      --model FILE[:NAME] | fit:SPEC  --out DIR
+//                      [--time-column NAME] [--start S] [--end S]
+//                      --model FILE[:NAME] | fit:SPEC | fit:auto [--robust [--eff E]]  --out DIR
 //                      [--trajectory FILE --outage START:DURATION ... [--nav-runs R]]
 //                      [--simulations N] [--seed S] [--alpha A] [--threads N]
 #include <cmath>
@@ -40,12 +41,16 @@ struct Opts {
   double alpha = 0.01;
   int threads = 0;
   bool overwrite = false;
+  bool robust = false;  ///< fit:SPEC: robust GMWM
+  double eff = 0.6;
 };
 
 /// `fit:SPEC`: the options of fitting SPEC to every channel of the data first (GMWM).
-navimpact::gmwm::RecordingFitOptions fitOptions(const std::string& spec) {
+navimpact::gmwm::RecordingFitOptions fitOptions(const std::string& spec, const Opts& o) {
   navimpact::gmwm::RecordingFitOptions f;
   f.structure = spec;
+  f.robust = o.robust;
+  f.eff = o.eff;
   f.intervals = "asymptotic";
   return f;
 }
@@ -86,7 +91,8 @@ int run(const Opts& o) {
   // Model file problems are reported before the (long) data read.
   const bool fit = o.model.rfind("fit:", 0) == 0;
   st::ImuModel model;
-  if (fit) navimpact::gmwm::checkRecordingFitOptions(fitOptions(o.model.substr(4)));
+  if (!fit && o.robust) throw navimpact::Error("--robust applies to --model fit:SPEC (a robust GMWM fit of the data)");
+  if (fit) navimpact::gmwm::checkRecordingFitOptions(fitOptions(o.model.substr(4), o));
   else model = st::loadImuModel(o.model);
   navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
 
@@ -105,7 +111,7 @@ int run(const Opts& o) {
     plan = na::prepareNavGain(nopt, data.rate_hz, data.size());
   }
   if (fit) {
-    model = navimpact::gmwm::fitRecording(data, fitOptions(o.model.substr(4))).model;
+    model = navimpact::gmwm::fitRecording(data, fitOptions(o.model.substr(4), o)).model;
     model.source = o.model;
   }
 
@@ -139,6 +145,11 @@ int run(const Opts& o) {
                        {"simulations", o.simulations},
                        {"alpha", o.alpha}};
   if (fmt == navimpact::cli::InputFormat::Rawlog) in["label"] = o.in.label;
+  in.update(navimpact::cli::inputSelectionJson(o.in));
+  if (o.robust) {
+    in["robust"] = true;
+    in["eff"] = o.eff;
+  }
   if (!o.trajectory.empty()) {
     in["trajectory"] = o.trajectory;
     in["outages"] = o.outages;
@@ -165,8 +176,14 @@ navimpact::cli::Registrar reg(
        navimpact::cli::addInputOptions(app, o->in);
        app.add_option("--model", o->model,
                       "model simulated today: FILE[:NAME], or fit:SPEC (e.g. fit:WN+GM) to fit "
-                      "that structure to the data first")
+                      "that structure to the data first, or fit:auto (the structure chosen by the WIC "
+                      "per channel, as fit --structure auto)")
            ->required();
+       auto* robust = app.add_flag("--robust", o->robust,
+                                   "with fit:SPEC: robust GMWM (fit the robust WV, Tukey biweight)");
+       app.add_option("--eff", o->eff, "--robust: efficiency of the robust WV at the Gaussian, in (0, 1)")
+           ->capture_default_str()
+           ->needs(robust);
        app.add_option("--trajectory", o->trajectory,
                       "trajectory CSV for the navigation gain (columns time_s, lat_rad, lon_rad, "
                       "alt_m, roll_rad, pitch_rad, yaw_rad as datasets/uav_flight_260s.csv.gz)");

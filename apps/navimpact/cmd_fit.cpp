@@ -2,7 +2,7 @@
 //   navimpact fit --input FILE [--rate HZ] [--gyro-unit U] [--acc-unit U] [--axes SPEC]
 //                 [--label L] [--channels gyro_x,...] --structure SPEC|auto
 //                 [--max-gm N] [--bootstrap N] [--intervals profile|asymptotic]
-//                 [--weights r|model|efficient] [--seed S] --out DIR
+//                 [--weights r|model|efficient] [--robust [--eff E]] [--seed S] --out DIR
 // Writes DIR/model.yaml (stochastic::loadImuModel reads it back), DIR/fit.json
 // (estimates, intervals, WV and model WV per channel) and one WV figure per
 // sensor (fit_gyroscope.png, fit_accelerometer.png), all or nothing.
@@ -50,13 +50,14 @@ int run(Opts o) {
   const gm::RecordingFit f = gm::fitRecording(s, o.fit, [&prog](std::size_t done, std::size_t) { prog.update(done); });
   prog.finish();
 
-  const nlohmann::json input = {{"file", o.in.input},
+  nlohmann::json input = {{"file", o.in.input},
                                 {"format", fmt == navimpact::cli::InputFormat::Rawlog ? "rawlog" : "csv"},
                                 {"rate_hz", s.rate_hz},
                                 {"samples", s.size()},
                                 {"units", navimpact::cli::inputUnitsNote(o.in, fmt)},
                                 {"axes", o.in.axes},
                                 {"label", o.in.label}};
+  input.update(navimpact::cli::inputSelectionJson(o.in));
   navimpact::report::writeFitOutputs(f, input.dump(), NAVIMPACT_VERSION, outs);
   outs.commit();
 
@@ -84,6 +85,12 @@ navimpact::cli::Registrar reg({
       app.add_option("--weights", o->fit.weights,
                      "GMWM weights: r (default, the R package's 1/(CI_hi-CI_lo)^2), model (iterated "
                      "model-based diagonal) or efficient (inverse of the full WV covariance)");
+      auto* robust = app.add_flag("--robust", o->fit.robust,
+                   "robust GMWM: fit the robust WV (Tukey biweight M-scale, Guerrier, Molinari & "
+                   "Victoria-Feser 2014) with its own CI and weights; for records with outliers");
+      app.add_option("--eff", o->fit.eff, "--robust: efficiency of the robust WV at the Gaussian, in (0, 1)")
+          ->capture_default_str()
+          ->needs(robust);
       app.add_option("--seed", o->fit.seed, "seed of the bootstrap");
       app.add_option("--out", o->out, "output directory (model.yaml, fit.json, fit_*.png)")->required();
       navimpact::cli::addOverwriteFlag(app, o->overwrite);

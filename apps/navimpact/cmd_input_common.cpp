@@ -67,6 +67,12 @@ void addInputOptions(CLI::App& app, InputOpts& o) {
                  "sensor-to-body FRD axes, e.g. x,-y,-z for a forward-left-up sensor");
   app.add_option("--label", o.label, "rawlog sensor label of the IMU observations")
       ->capture_default_str();
+  app.add_option("--time-column", o.time_column,
+                 "CSV: name of the time column in seconds (default: t, time_s or time)");
+  app.add_option("--start", o.start_s,
+                 "use the record from this time on [s from its first sample, >= 0]");
+  app.add_option("--end", o.end_s,
+                 "use the record up to this time [s from its first sample, after --start, within the record]");
 }
 
 ImuSeries loadInput(const InputOpts& o, InputFormat* format) {
@@ -77,14 +83,21 @@ ImuSeries loadInput(const InputOpts& o, InputFormat* format) {
   if (std::filesystem::file_size(o.input) == 0) throw Error(o.input + ": empty file");
   const bool raw = rawlog::isRawlogFile(o.input);
   if (format) *format = raw ? InputFormat::Rawlog : InputFormat::Csv;
+  auto window = [&o](ImuSeries s) {
+    if (o.start_s || o.end_s) cutWindow(s, o.start_s.value_or(0.0), o.end_s);
+    return s;
+  };
   if (!raw) {
     CsvImuOptions c;
     c.rate_hz = o.rate_hz;
     c.gyro_unit = o.gyro_unit;
     c.acc_unit = o.acc_unit;
     c.axes = o.axes;
-    return readImuCsv(o.input, c);
+    c.time_column = o.time_column;
+    return window(readImuCsv(o.input, c));
   }
+  if (!o.time_column.empty())
+    throw Error(o.input + ": --time-column applies to CSV input; a rawlog's times are its observation timestamps");
   if (!isSi(units::Quantity::AngularRate, o.gyro_unit) ||
       !isSi(units::Quantity::SpecificForce, o.acc_unit))
     throw Error(o.input + ": rawlog IMU data are SI (rad/s, m/s^2); --gyro-unit/--acc-unit "
@@ -103,7 +116,15 @@ ImuSeries loadInput(const InputOpts& o, InputFormat* format) {
       throw Error(o.input + ": --axes: " + e.what());
     }
   }
-  return s;
+  return window(std::move(s));
+}
+
+nlohmann::json inputSelectionJson(const InputOpts& o) {
+  nlohmann::json j = nlohmann::json::object();
+  if (!o.time_column.empty()) j["time_column"] = o.time_column;
+  if (o.start_s) j["start_s"] = *o.start_s;
+  if (o.end_s) j["end_s"] = *o.end_s;
+  return j;
 }
 
 std::string inputUnitsNote(const InputOpts& o, InputFormat f) {

@@ -36,11 +36,12 @@ int run(const Opts& o) {
   wo.eff = o.eff;
   const gm::RecordingWv w = gm::recordingWv(s, wo, o.allan);
 
-  const nlohmann::ordered_json input = {{"file", o.in.input},
+  nlohmann::ordered_json input = {{"file", o.in.input},
                                         {"format", fmt == navimpact::cli::InputFormat::Rawlog ? "rawlog" : "csv"},
                                         {"rate_hz", s.rate_hz},
                                         {"samples", s.size()},
                                         {"units", navimpact::cli::inputUnitsNote(o.in, fmt)}};
+  for (const auto& [k, v] : navimpact::cli::inputSelectionJson(o.in).items()) input[k] = v;
   navimpact::report::writeWvOutputs(w, input.dump(), outs);
   outs.commit();
 

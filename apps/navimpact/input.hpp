@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "navimpact/core/imu_series.hpp"
 
 namespace navimpact::cli {
@@ -19,9 +21,13 @@ struct InputOpts {
   std::string acc_unit;           ///< CSV accelerometer unit ("" = from the header)
   std::string axes;               ///< sensor -> body FRD remap, e.g. "x,-y,-z"
   std::string label = "IMU";      ///< rawlog sensor label
+  std::string time_column;        ///< CSV time column name ("" = t, time_s or time)
+  std::optional<double> start_s;  ///< window start [s from the record's first sample]
+  std::optional<double> end_s;    ///< window end (exclusive) [s from the record's first sample]
 };
 
-/// Declare --input (required), --rate, --gyro-unit, --acc-unit, --axes, --label on @p app.
+/// Declare --input (required), --rate, --gyro-unit, --acc-unit, --axes, --label,
+/// --time-column, --start, --end on @p app.
 void addInputOptions(CLI::App& app, InputOpts& o);
 
 /// What loadInput read.
@@ -37,5 +43,9 @@ ImuSeries loadInput(const InputOpts& o, InputFormat* format = nullptr);
 
 /// Short human description of the units the input was read with (for reports).
 std::string inputUnitsNote(const InputOpts& o, InputFormat f);
+
+/// The input options that select data (time column, window) as JSON members
+/// for the commands' "input" records: time_column, start_s, end_s when given.
+nlohmann::json inputSelectionJson(const InputOpts& o);
 
 }  // namespace navimpact::cli

@@ -81,3 +81,14 @@ navimpact_cli_fail(cli_diagnose_power_bad_cause EXIT 1 NOOUT ${_dg_out}/bad10
 navimpact_cli_fail(cli_diagnose_power_bad_snr EXIT 1 NOOUT ${_dg_out}/bad11
   ARGS diagnose-power --out ${_dg_out}/bad11 --snr 5
   REGEX "^navimpact: --snr '5': expected LO:HI")
+
+# --model fit:auto: each channel's structure chosen by the WIC first (on the
+# first 600 s of the excerpt, --end); --robust applies to fit:SPEC only.
+navimpact_cli_check(cli_diagnose_fit_auto CHECK run_json
+  ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:auto --end 600 --simulations 2 --out ${_dg_out}/auto
+  DEFINES OUT=${_dg_out}/auto JSON_FILE=diagnosis.json QUIET=1
+  JSON "input/model=^fit:auto$" "input/end_s=^600(\\.0*)?$"
+  FILES report.md model_extended.yaml)
+navimpact_cli_fail(cli_diagnose_robust_needs_fit EXIT 1 NOOUT ${_dg_out}/bad_robust
+  ARGS ${_dg_short_args} --robust --out ${_dg_out}/bad_robust
+  REGEX "^navimpact: --robust applies to --model fit:SPEC")

@@ -77,3 +77,66 @@ set_tests_properties(cli_fit_negligible_term PROPERTIES
   FIXTURES_SETUP fit_neg)
 navimpact_cli_check(cli_fit_negligible_json CHECK fit_negligible DEFINES DIR=${_fdir}/neg)
 set_tests_properties(cli_fit_negligible_json PROPERTIES FIXTURES_REQUIRED fit_neg)
+
+# Real-record input: a time window of the record (--start/--end, seconds from
+# its first sample), a named time column, the robust GMWM.
+navimpact_cli_check(cli_fit_window CHECK run_json
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GM --channels gyro_x
+       --start 100 --end 1100 --out ${_fdir}/window
+  DEFINES OUT=${_fdir}/window JSON_FILE=fit.json QUIET=1
+  JSON "input/samples=^100000$" "input/start_s=^100(\\.0*)?$" "input/end_s=^1100(\\.0*)?$" "estimator/wv=^classical"
+  FILES model.yaml)
+navimpact_cli_fail(cli_fit_start_beyond_record EXIT 1 NOOUT ${_fdir}/bad_start
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --start 3000 --out ${_fdir}/bad_start
+  REGEX "^navimpact: .*adis16405_static_excerpt.csv.gz: --start 3000 s is not before the end of the record \\(the record has 262144 samples, 0 to 2621.44 s at 100 Hz\\)")
+navimpact_cli_fail(cli_fit_end_beyond_record EXIT 1 NOOUT ${_fdir}/bad_end
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --end 2700 --out ${_fdir}/bad_end
+  REGEX "^navimpact: .*: --end 2700 s is beyond the end of the record \\(the record has 262144 samples")
+navimpact_cli_fail(cli_fit_end_before_start EXIT 1 NOOUT ${_fdir}/bad_order
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --start 10 --end 5 --out ${_fdir}/bad_order
+  REGEX "^navimpact: .*: --end 5 s must be after --start 10")
+navimpact_cli_fail(cli_fit_time_column_missing EXIT 1 NOOUT ${_fdir}/bad_tcol
+  ARGS fit --input ${_fdata} --gyro-unit deg/s --acc-unit g --structure WN --time-column stamp --out ${_fdir}/bad_tcol
+  REGEX "^navimpact: .*adis16405_static_excerpt.csv.gz:1: no time column 'stamp' \\(--time-column\\) in header 'gyro_x,")
+
+# A 200 Hz record whose time column is 'stamp' (and whose 't' column is not a time).
+set(_tcsv "t,stamp,gyro_x[rad/s],acc_z[m/s2]\n")
+foreach(i RANGE 0 4199)
+  math(EXPR a "(${i} * 7919) % 97")
+  math(EXPR b "(${i} * 104729) % 89")
+  math(EXPR ms "${i} * 5")
+  math(EXPR sec "${ms} / 1000")
+  math(EXPR frac "${ms} % 1000")
+  string(LENGTH "${frac}" _fl)
+  if(_fl EQUAL 1)
+    set(frac "00${frac}")
+  elseif(_fl EQUAL 2)
+    set(frac "0${frac}")
+  endif()
+  string(APPEND _tcsv "${a},${sec}.${frac},0.0${a},9.8${b}\n")
+endforeach()
+file(WRITE ${_fdir}/stamp.csv "${_tcsv}")
+navimpact_cli_check(cli_fit_time_column CHECK run_json
+  ARGS fit --input ${_fdir}/stamp.csv --time-column stamp --structure WN --out ${_fdir}/tcol
+  DEFINES OUT=${_fdir}/tcol JSON_FILE=fit.json
+  JSON "input/rate_hz=^200(\\.0*)?$" "input/samples=^4200$" "input/time_column=^stamp$"
+  FILES model.yaml)
+
+# Robust GMWM: the estimator is recorded; --eff needs --robust.
+navimpact_cli_check(cli_fit_robust CHECK run_json
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+GM --channels gyro_x,acc_z
+       --robust --eff 0.8 --end 1000 --out ${_fdir}/robust
+  DEFINES OUT=${_fdir}/robust JSON_FILE=fit.json QUIET=1
+  JSON "estimator/wv=^robust" "estimator/eff=^0.8" "channels/0/name=^gyro_x$"
+  FILES model.yaml)
+navimpact_cli_fail(cli_fit_eff_without_robust EXIT 2 NOOUT ${_fdir}/bad_eff
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --eff 0.8 --out ${_fdir}/bad_eff
+  REGEX "^navimpact: .*--eff requires --robust")
+
+# The automatic selection (about 40 GMWM fits per channel through Ceres) on the
+# whole excerpt writes nothing to stderr: no solver or logging lines.
+navimpact_cli_check(cli_fit_auto_quiet CHECK run_json
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure auto --out ${_fdir}/auto_quiet
+  DEFINES OUT=${_fdir}/auto_quiet JSON_FILE=fit.json QUIET=1
+  JSON "structure=^auto"
+  FILES model.yaml)

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -154,4 +155,85 @@ TEST(CsvReader, ValuesBeyondAnyImuAreErrorsAtTheirLine) {
   }
   // The limit itself is a value (57,000 deg/s; 10,000 g).
   EXPECT_EQ(errorOf(writeFile("edge.csv", "gyro_x,acc_x\n1000,100000\n-1000,-100000\n"), o), "");
+}
+
+// --time-column NAME: the named column is the time base, the default names
+// become ordinary columns; a missing name or two time columns are errors.
+TEST(CsvReader, NamedTimeColumn) {
+  // 't' steps unevenly (it is not a time here); 'stamp' steps 0.004 s.
+  const auto f = writeFile("stamp.csv", "t,stamp,gyro_x[rad/s]\n0,10.000,1\n7,10.004,2\n8,10.008,3\n30,10.012,4\n");
+  CsvImuOptions o;
+  o.time_column = "stamp";
+  const ImuSeries s = readImuCsv(f, o);
+  EXPECT_NEAR(s.rate_hz, 250.0, 1e-9);
+  EXPECT_DOUBLE_EQ(s.t0_s, 10.0);
+  EXPECT_EQ(s.channel("gyro_x").x, (std::vector<double>{1, 2, 3, 4}));
+  // Without the option 't' is the time column and its gap is an error.
+  EXPECT_NE(errorOf(f, CsvImuOptions{}).find("stamp.csv:3"), std::string::npos) << errorOf(f, CsvImuOptions{});
+  o.time_column = "time_ns";
+  const std::string m = errorOf(f, o);
+  EXPECT_NE(m.find("stamp.csv:1: no time column 'time_ns' (--time-column)"), std::string::npos) << m;
+  const std::string two = errorOf(writeFile("two.csv", "t,time_s,gyro_x[rad/s]\n0,0,1\n0.01,0.01,2\n"), CsvImuOptions{});
+  EXPECT_NE(two.find("two.csv:1: column 2 'time_s': a second time column (the first is column 1)"), std::string::npos)
+      << two;
+}
+
+// cutWindow keeps the samples at k / rate in [start, end) and moves t0; the
+// window is drawn at random (seeded, printed) over the record; a window outside
+// the record names the source, the flag and the record's extent.
+TEST(ImuSeriesWindow, KeepsTheSamplesInsideTheWindow) {
+  std::mt19937_64 g(60221);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int r = 0; r < 200; ++r) {
+    ImuSeries s;
+    s.source = "rec.csv";
+    s.rate_hz = 10.0 + 990.0 * u(g);
+    s.t0_s = 5.0 * u(g);
+    const std::size_t n = 10 + static_cast<std::size_t>(5000 * u(g));
+    ImuChannel c{"gyro_x", units::Quantity::AngularRate, {}};
+    for (std::size_t k = 0; k < n; ++k) c.x.push_back(static_cast<double>(k));
+    s.channels = {c, c};
+    s.channels[1].name = "acc_z";
+    const double dur = n / s.rate_hz;
+    const double a = dur * u(g) * 0.9, b = a + (dur - a) * (0.05 + 0.95 * u(g));
+    const bool open_end = u(g) < 0.3;
+    std::printf("record %d: %zu samples at %.6g Hz, window [%.9g, %.9g)%s\n", r, n, s.rate_hz, a, b,
+                open_end ? " open" : "");
+    const std::size_t k0 = static_cast<std::size_t>(std::ceil(a * s.rate_hz - 1e-6));
+    const std::size_t k1 = open_end ? n : static_cast<std::size_t>(std::ceil(b * s.rate_hz - 1e-6));
+    if (k1 < k0 + 2) continue;
+    ImuSeries w = s;
+    cutWindow(w, a, open_end ? std::nullopt : std::optional<double>(b));
+    ASSERT_EQ(w.size(), k1 - k0);
+    for (const auto& ch : w.channels) {
+      EXPECT_EQ(ch.x.front(), static_cast<double>(k0));
+      EXPECT_EQ(ch.x.back(), static_cast<double>(k1 - 1));
+      // every kept sample's time lies in the window, its neighbours outside
+      EXPECT_GE(ch.x.front() / s.rate_hz, a - 1e-6 / s.rate_hz);
+      if (k0 > 0) EXPECT_LT((k0 - 1) / s.rate_hz, a);
+      if (!open_end) EXPECT_LT(ch.x.back() / s.rate_hz, b);
+    }
+    EXPECT_NEAR(w.t0_s, s.t0_s + k0 / s.rate_hz, 1e-9);
+  }
+  ImuSeries s;
+  s.source = "rec.csv";
+  s.rate_hz = 100.0;
+  s.channels = {{"gyro_x", units::Quantity::AngularRate, std::vector<double>(1000, 0.5)}};
+  auto err = [&](double a, std::optional<double> b) {
+    ImuSeries w = s;
+    try {
+      cutWindow(w, a, b);
+    } catch (const Error& e) {
+      EXPECT_EQ(w.size(), 1000u) << "a refused window must not cut";
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(err(-1, std::nullopt), "rec.csv: --start -1 s must be a time >= 0 (the record has 1000 samples, 0 to 10 s at 100 Hz)");
+  EXPECT_NE(err(10, std::nullopt).find("--start 10 s is not before the end of the record"), std::string::npos);
+  EXPECT_NE(err(2, 1.0).find("--end 1 s must be after --start"), std::string::npos);
+  EXPECT_NE(err(2, 10.5).find("--end 10.5 s is beyond the end of the record"), std::string::npos);
+  EXPECT_NE(err(2, 2.005).find("leaves fewer than 2 samples"), std::string::npos);
+  EXPECT_NE(err(NAN, std::nullopt).find("--start"), std::string::npos);
+  EXPECT_EQ(err(0, 10.0), "");  // the whole record
 }

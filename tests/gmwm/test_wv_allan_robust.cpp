@@ -115,3 +115,49 @@ TEST(RobustWv, BadInput) {
   EXPECT_THROW(gmwm::robustWaveletVariance(x.data(), x.size(), 1.0, 1.5), Error);
   EXPECT_THROW(gmwm::robustWaveletVariance(x.data(), 3, 1.0), Error);
 }
+
+// Where isolated spikes touch more Haar coefficients than the biweight
+// tolerates (tau * fraction grows with the scale) its scale equation has no
+// root; the robust WV then uses the MAD scale (median |w| / 0.6745)^2 at that
+// scale, lists it in mad_scales and widens its CI by 1/sqrt(0.3674). Spike
+// fraction in [0.5, 2] % and amplitude in [15, 40] sigma drawn at random (seeded, printed).
+TEST(RobustWv, BeyondBreakdownTheMadScaleHolds) {
+  const std::size_t n = 1 << 14;
+  std::mt19937_64 g(1618);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int fallbacks = 0;
+  for (int r = 0; r < 12; ++r) {
+    const double eps = 0.005 * std::pow(4.0, u(g)), amp = 15.0 * std::pow(40.0 / 15.0, u(g));
+    auto x = whiteNoise(n, 1.0, 500 + r);
+    for (auto& v : x)
+      if (u(g) < eps) v += u(g) < 0.5 ? amp : -amp;
+    const auto cl = gmwm::waveletVariance(x.data(), n, 100.0);
+    const auto rb = gmwm::robustWaveletVariance(x.data(), n, 100.0);
+    std::printf("record %d: spikes %.3g of the samples at %.3g sigma: MAD at %zu scales\n", r, eps, amp,
+                rb.mad_scales.size());
+    fallbacks += static_cast<int>(rb.mad_scales.size());
+    std::vector<double> cs(n + 1, 0.0);
+    for (std::size_t i = 0; i < n; ++i) cs[i + 1] = cs[i] + x[i];
+    for (int j : rb.mad_scales) {
+      // Haar MODWT coefficients at tau = 2^(j+1): (second half sum - first half sum) / tau.
+      const std::size_t tau = std::size_t(2) << j, h = tau / 2;
+      std::vector<double> w;
+      double ss = 0;
+      for (std::size_t k = 0; k + tau <= n; ++k) {
+        w.push_back(((cs[k + tau] - cs[k + h]) - (cs[k + h] - cs[k])) / double(tau));
+        ss += w.back() * w.back();
+      }
+      ASSERT_NEAR(ss / w.size(), cl.wv[j], 1e-9 * cl.wv[j]) << "coefficients as the classical WV's";
+      for (auto& v : w) v = std::fabs(v);
+      std::nth_element(w.begin(), w.begin() + w.size() / 2, w.end());
+      const double mad = w[w.size() / 2] / 0.6744897501960817;
+      EXPECT_NEAR(rb.wv[j], mad * mad, 1e-12 * mad * mad) << "record " << r << " j=" << j + 1;
+      double lo1, hi1;
+      gmwm::wvConfidenceInterval(1.0, rb.eta[j], 0.05, lo1, hi1);
+      EXPECT_NEAR(rb.ci_high[j], rb.wv[j] * (1.0 + (hi1 - 1.0) / std::sqrt(0.3674)), 1e-12 * rb.ci_high[j]);
+    }
+    for (int j = 0; j < rb.scales(); ++j) EXPECT_TRUE(std::isfinite(rb.wv[j]) && rb.wv[j] > 0.0);
+  }
+  std::printf("MAD scale used at %d scales over 12 records\n", fallbacks);
+  EXPECT_GT(fallbacks, 0) << "no record broke the biweight: the fallback went untested";
+}

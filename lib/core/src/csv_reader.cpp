@@ -79,7 +79,11 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
       n = trim(n.substr(0, lb));
     }
     const std::string name(n);
-    if (name == "t" || name == "time_s" || name == "time") {
+    if (opt.time_column.empty() ? (name == "t" || name == "time_s" || name == "time") : name == opt.time_column) {
+      if (timeCol >= 0)
+        throw fileError(path, 1, "column " + std::to_string(c + 1) + " '" + printable(name) +
+                                     "': a second time column (the first is column " + std::to_string(timeCol + 1) +
+                                     ")");
       timeCol = static_cast<int>(c);
       cols[c].channel = -2;
       continue;
@@ -104,6 +108,10 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
     }
     cols[c].channel = idx;
   }
+  if (!opt.time_column.empty() && timeCol < 0)
+    throw fileError(path, 1,
+                    "no time column '" + printable(opt.time_column) + "' (--time-column) in header '" +
+                        printable(trim(header), 120) + "'");
   if (std::all_of(std::begin(present), std::end(present), [](int p) { return p < 0; }))
     throw fileError(path, 1,
                     "no IMU column in header '" + printable(trim(header), 120) +
@@ -196,7 +204,7 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
     out.t0_s = times[0];
   } else {
     if (!opt.rate_hz)
-      throw fileError(path, 1, "no time column 't': the sampling rate must be given (--rate HZ)");
+      throw fileError(path, 1, "no time column (t, time_s, time or --time-column NAME): the sampling rate must be given (--rate HZ)");
     if (!(*opt.rate_hz > 0.0) || !std::isfinite(*opt.rate_hz))
       throw Error("rate must be a positive number of Hz");
     out.rate_hz = *opt.rate_hz;

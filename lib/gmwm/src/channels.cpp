@@ -102,6 +102,8 @@ void checkRecordingFitOptions(const RecordingFitOptions& opt) {
   if (opt.structure != "auto") stochastic::parseStructure(opt.structure);
   if (opt.bootstrap < 0) throw Error("--bootstrap must be >= 0, got " + std::to_string(opt.bootstrap));
   if (opt.max_gm < 0 || opt.max_gm > 3) throw Error("--max-gm must be in 0..3");
+  if (!(opt.eff > 0.0 && opt.eff < 1.0))
+    throw Error("--eff must be in (0, 1), got " + std::to_string(opt.eff));
   weightingOf(opt.weights);
   intervalsOf(opt.intervals);
   for (const auto& n : opt.channels)
@@ -142,7 +144,12 @@ RecordingFit fitRecording(const ImuSeries& s, const RecordingFitOptions& opt,
     ChannelFit& c = r.channels[i];
     c.name = chans[i]->name;
     c.quantity = chans[i]->quantity;
-    c.wv = waveletVariance(chans[i]->x.data(), chans[i]->x.size(), s.rate_hz);
+    try {
+      c.wv = opt.robust ? robustWaveletVariance(chans[i]->x.data(), chans[i]->x.size(), s.rate_hz, opt.eff)
+                        : waveletVariance(chans[i]->x.data(), chans[i]->x.size(), s.rate_hz);
+    } catch (const Error& e) {
+      throw Error(s.source + ": channel " + c.name + ": " + e.what());
+    }
     FitOptions fi = fo;
     fi.seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(channelIndex(c.name)));
     try {

@@ -187,6 +187,7 @@ struct Data {
   Eigen::MatrixXd w_full;
   double rate = 0;
   double n = 0;
+  double eff = 1.0;  ///< WaveletVariance::eff: Var(nu_hat_j) = 2 nu_j^2 / (eta_j eff)
   int J = 0;
 };
 
@@ -208,6 +209,8 @@ Data makeData(const WaveletVariance& wv) {
   d.omega = wv.weights();
   d.w_obj = d.omega.cwiseSqrt();
   d.rate = wv.rate_hz;
+  if (!(wv.eff > 0.0 && wv.eff <= 1.0)) throw Error("GMWM fit: the wavelet variance's efficiency is not in (0, 1]");
+  d.eff = wv.eff;
   d.n = wv.n > 0 ? double(wv.n) : std::pow(2.0, d.J + 1);
   d.eta.resize(d.J);
   for (int j = 0; j < d.J; ++j)
@@ -257,6 +260,14 @@ void clampToBounds(Eigen::VectorXd& th, const Layout& L, const Data& d) {
 double solve(const Layout& L, Eigen::VectorXd& th, const Data& d, const Weights& w,
              bool* converged = nullptr, int fixed = -1,
              const std::vector<std::pair<double, double>>* bands = nullptr) {
+  // Ceres reports through glog; library code prints nothing, so its messages
+  // below FATAL (line-search or bound warnings) are dropped, once per process.
+  static const bool quiet_glog = [] {
+    FLAGS_minloglevel = google::GLOG_FATAL;
+    FLAGS_stderrthreshold = google::GLOG_FATAL;
+    return true;
+  }();
+  (void)quiet_glog;
   clampToBounds(th, L, d);
   if (bands)
     for (int k = 0; k < L.p; ++k) th[k] = std::clamp(th[k], (*bands)[k].first, (*bands)[k].second);
@@ -804,7 +815,7 @@ void setModelWeights(const Layout& L, const Eigen::VectorXd& th, Data& d) {
   for (int j = 0; j < d.J; ++j) {
     // Guard against a model WV of ~0 at a scale (a term pinned at a bound).
     const double v = std::max(nu[j], 1e-6 * d.nu_hat[j]);
-    d.omega[j] = d.eta[j] / (2.0 * v * v);
+    d.omega[j] = d.eff * d.eta[j] / (2.0 * v * v);
   }
   d.w_obj = d.omega.cwiseSqrt();
 }
@@ -825,11 +836,12 @@ void setEfficientWeights(const Layout& L, const Eigen::VectorXd& th, Data& d, do
   wv.tau = d.tau;
   wv.n = static_cast<std::size_t>(d.n);
   wv.rate_hz = d.rate;
-  Eigen::MatrixXd V = wvCovariance(m, wv);
+  // A robust WV's covariance is the classical one over its efficiency (at the Gaussian).
+  Eigen::MatrixXd V = wvCovariance(m, wv) / d.eff;
   const Eigen::VectorXd nu = detail::wvOf(L, th, d.tau);
   for (int j = 0; j < d.J; ++j) {
     const double v = std::max(nu[j], 1e-6 * d.nu_hat[j]);
-    const double chi = 2.0 * v * v / d.eta[j];
+    const double chi = 2.0 * v * v / (d.eta[j] * d.eff);
     if (d.eta[j] < min_eta || !(V(j, j) > 0.0) || !std::isfinite(V(j, j))) {
       V.row(j).setZero();
       V.col(j).setZero();
@@ -1040,7 +1052,7 @@ Eigen::MatrixXd sandwich(const Layout& L, const Eigen::VectorXd& th, const Wavel
   Eigen::VectorXd V(wv.scales());
   for (int j = 0; j < wv.scales(); ++j) {
     const double eta = (wv.eta.size() == wv.scales() && wv.eta[j] > 0) ? wv.eta[j] : 1.0;
-    V[j] = 2.0 * nu[j] * nu[j] / eta;  // chi-square variance of nu_hat_j (eta dof)
+    V[j] = 2.0 * nu[j] * nu[j] / (eta * wv.eff);  // chi-square variance of nu_hat_j (eta dof; robust: over eff)
   }
   const Eigen::MatrixXd B = A.transpose() * om.asDiagonal() * A;
   const Eigen::MatrixXd Bi = pinvSym(B);
@@ -1087,7 +1099,9 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
     for (int b = 0; b < opt.bootstrap; ++b) {
       const std::vector<double> x =
           stochastic::simulate(r.model, n, stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(b)));
-      const WaveletVariance wb = waveletVariance(x.data(), n, wv.rate_hz, 0.05, wv.scales());
+      // The same estimator as the data's WV (a robust fit bootstraps the robust WV).
+      const WaveletVariance wb = wv.robust ? robustWaveletVariance(x.data(), n, wv.rate_hz, wv.eff)
+                                           : waveletVariance(x.data(), n, wv.rate_hz, 0.05, wv.scales());
       Data db = makeData(wb);
       Eigen::VectorXd t = th;
       solve(L, t, db, objW(db));

@@ -87,7 +87,8 @@ double robustScale(const double* w, std::size_t m, double eff) {
   return robustScale(w, m, c, consistencyA(c));
 }
 
-double robustScale(const double* w, std::size_t m, double c, double a) {
+double robustScale(const double* w, std::size_t m, double c, double a, bool* mad_fallback) {
+  if (mad_fallback) *mad_fallback = false;
   if (m == 0) throw Error("robust scale: no values");
   if (m == 1) return w[0] * w[0];  // a single coefficient: nothing to down-weight
   // Classical variance (two-pass) to standardise.
@@ -112,6 +113,17 @@ double robustScale(const double* w, std::size_t m, double c, double a) {
     return Error("robust wavelet variance: the biweight scale equation has no root (too many "
                  "identical wavelet coefficients?)");
   };
+  // Beyond the biweight's breakdown point mean chi(t x) stays below a for
+  // every t: the median absolute value (zero-mean coefficients) still holds.
+  const auto madScale = [&]() {
+    std::vector<double> ab(m);
+    for (std::size_t i = 0; i < m; ++i) ab[i] = std::fabs(w[i]);
+    std::nth_element(ab.begin(), ab.begin() + m / 2, ab.end());
+    const double s = ab[m / 2] / 0.6744897501960817;
+    if (!(s > 0.0)) throw noRoot();
+    if (mad_fallback) *mad_fallback = true;
+    return s * s;
+  };
   double lo = 1.0, hi = 1.0;
   const double g1 = g(1.0);
   int k = 0;
@@ -121,14 +133,14 @@ double robustScale(const double* w, std::size_t m, double c, double a) {
     while (g(hi) < 0.0) {
       lo = hi;
       hi *= 2.0;
-      if (++k > 100) throw noRoot();
+      if (++k > 100) return madScale();
     }
   } else {
     if (g1 < 0.0) {
       // Falling branch beyond the maximum: move left into the bump first.
       while (g(hi) < 0.0) {
         hi *= 0.5;
-        if (++k > 100) throw noRoot();
+        if (++k > 100) return madScale();
       }
     }
     // Now g(hi) >= 0: move left until below the first root.
@@ -164,7 +176,7 @@ WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rat
   r.rate_hz = rate_hz;
   r.n = n;
   r.robust = true;
-  const double inflate = 1.0 / std::sqrt(eff);
+  r.eff = eff;
   const double c = biweightConstant(eff);
   const double a = consistencyA(c);
   double min_low = std::numeric_limits<double>::infinity();
@@ -174,8 +186,12 @@ WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rat
     r.tau[i] = tau;
     r.n_coef[i] = static_cast<double>(m);
     r.eta[i] = std::max(static_cast<double>(m) / tau, 1.0);
-    const double nu = detail::robustScale(w, m, c, a);
+    bool mad = false;
+    const double nu = detail::robustScale(w, m, c, a, &mad);
     r.wv[i] = nu;
+    if (mad) r.mad_scales.push_back(i);
+    // The MAD scale has its own (lower) efficiency: a wider interval.
+    const double inflate = 1.0 / std::sqrt(mad ? detail::kMadEfficiency : eff);
     // gmwm_formulas.md §2 (ci_eta3_robust): the classical relative half-widths,
     // inflated by 1/sqrt(eff), around the robust estimate.
     double lo1, hi1;

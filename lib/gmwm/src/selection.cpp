@@ -81,7 +81,7 @@ double optimism(const FitResult& f, const WaveletVariance& wv) {
   Eigen::VectorXd V(J);
   for (int j = 0; j < J; ++j) {
     const double eta = (wv.eta.size() == J && wv.eta[j] > 0) ? wv.eta[j] : 1.0;
-    V[j] = 2.0 * nu[j] * nu[j] / eta;
+    V[j] = 2.0 * nu[j] * nu[j] / (eta * wv.eff);
   }
   const Eigen::MatrixXd B = A.transpose() * om.asDiagonal() * A;
   // D_kl = sum_j d2nu_j/dth_k dth_l * Omega_jj (nu_j - nu_hat_j): second

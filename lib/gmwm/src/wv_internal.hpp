@@ -24,7 +24,14 @@ double sumSquares(const double* w, std::size_t m);
 double robustScale(const double* w, std::size_t m, double eff);
 
 /// Same with the biweight constant @p c and its consistency constant @p a = E[chi(Z)].
-double robustScale(const double* w, std::size_t m, double c, double a);
+/// When the biweight scale equation has no root (more outlying values than its
+/// breakdown point, e.g. isolated spikes spread over tau coefficients at scale tau),
+/// returns the median-absolute-value scale (median |w| / 0.6745)^2 and sets
+/// @p mad_fallback (Gaussian efficiency of that estimator: kMadEfficiency).
+double robustScale(const double* w, std::size_t m, double c, double a, bool* mad_fallback = nullptr);
+
+/// Asymptotic Gaussian efficiency of the MAD scale (Hampel et al. 1986): 0.3674.
+constexpr double kMadEfficiency = 0.3674;
 
 /**
  * Sums of squares of the kept Haar MODWT coefficients of levels 1..J

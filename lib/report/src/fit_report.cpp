@@ -102,6 +102,11 @@ std::string fitJson(const gm::RecordingFit& f, const std::string& input_json) {
   j["input"] = json::parse(input_json);
   j["seed"] = f.options.seed;
   j["weights"] = f.options.weights;
+  j["estimator"] = f.options.robust
+                       ? json{{"wv", "robust (Tukey biweight M-scale of the wavelet coefficients)"},
+                              {"eff", f.options.eff},
+                              {"reference", "Guerrier, Molinari & Victoria-Feser (2014), robust GMWM"}}
+                       : json{{"wv", "classical (mean of squares)"}};
   {
     std::ostringstream rule;
     rule << "a term is negligible when its WV is below " << gm::kNegligibleFraction
@@ -240,7 +245,8 @@ std::string fitSummary(const gm::RecordingFit& f) {
   for (const auto& c : f.channels) {
     os << c.name << ": " << st::formatTerms(c.fit.model.terms) << "   [" << units::siUnit(c.quantity)
        << ", per sample at " << f.rate_hz << " Hz]\n";
-    os << "    objective " << c.fit.objective << " (" << gm::weightingName(c.fit.weighting) << " weights"
+    os << "    objective " << c.fit.objective << " (" << (f.options.robust ? "robust WV, " : "")
+       << gm::weightingName(c.fit.weighting) << " weights"
        << (c.fit.weighting == gm::Weighting::Fast ? "" : ", R objective " + std::to_string(c.fit.objective_fast))
        << ")  (" << c.fit.ci_method << " 95 % intervals in fit.json)\n";
     for (std::size_t i = 0; i < c.negligible.size(); ++i)

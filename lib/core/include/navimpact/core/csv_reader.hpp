@@ -4,8 +4,8 @@
  *
  * Format: one header line naming the columns, comma separated. Recognised
  * columns are the canonical channels `gyro_x gyro_y gyro_z acc_x acc_y acc_z`
- * and an optional time column `t` (or `time_s`) in seconds; other columns are
- * ignored. A column name may carry its unit in brackets, e.g. `gyro_x[deg/s]`,
+ * and an optional time column in seconds: `t`, `time_s` or `time`, or the one
+ * named by CsvImuOptions::time_column; other columns are ignored. A column name may carry its unit in brackets, e.g. `gyro_x[deg/s]`,
  * which overrides the option. Without a time column, the rate must be given.
  */
 #pragma once
@@ -32,6 +32,10 @@ struct CsvImuOptions {
    * sensor mounted forward-left-up. Empty: identity.
    */
   std::string axes;
+  /// Name of the time column [s] (its header name without a [unit] part).
+  /// Empty: `t`, `time_s` or `time` when present. Set: that column must exist
+  /// and the default names are ordinary (ignored) columns.
+  std::string time_column;
   /// Largest accepted relative deviation of a time step from the median step.
   double max_dt_deviation = 0.01;
 };

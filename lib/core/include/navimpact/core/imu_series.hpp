@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,5 +54,17 @@ struct ImuSeries {
   const ImuChannel& channel(const std::string& name) const;
   bool has(const std::string& name) const;
 };
+
+/**
+ * Cut @p s to the time window [start_s, end_s) in seconds from its first
+ * sample: sample k (at k / rate_hz from the start) is kept when
+ * start_s <= k / rate_hz < end_s (to 1e-6 of a sample). t0_s moves to the
+ * first kept sample. Without @p end_s the window runs to the end.
+ * @throws navimpact::Error "SOURCE: --start ..." / "--end ..." naming the
+ *         record's duration when start_s is negative, not finite or not
+ *         before the end of the record, end_s is not after start_s or beyond
+ *         the end of the record, or fewer than 2 samples remain.
+ */
+void cutWindow(ImuSeries& s, double start_s, std::optional<double> end_s);
 
 }  // namespace navimpact

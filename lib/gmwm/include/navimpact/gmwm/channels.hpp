@@ -54,6 +54,10 @@ struct RecordingFitOptions {
   int max_gm = 3;                     ///< auto: most GM terms among the candidates, 0..3
   std::string weights = "r";          ///< "r" (the R package's), "model" or "efficient"
   std::string intervals = "profile";  ///< 95 % intervals without bootstrap: "profile" or "asymptotic"
+  /// Robust GMWM (Guerrier, Molinari & Victoria-Feser 2014): fit the robust
+  /// WV (Tukey biweight M-scale at efficiency eff) with its own CI and weights.
+  bool robust = false;
+  double eff = 0.6;                   ///< robust: efficiency of the robust WV, in (0, 1)
   int bootstrap = 0;                  ///< parametric bootstrap replicates, >= 0
   std::uint64_t seed = 20190101;      ///< root seed; channel c uses deriveSeed(seed, channelIndex(c))
 };

@@ -28,6 +28,13 @@ struct WaveletVariance {
   double rate_hz = 0.0;      ///< to express tau in seconds: tau / rate_hz
   std::size_t n = 0;         ///< samples used
   bool robust = false;
+  /// Asymptotic efficiency of the estimator relative to the classical WV at
+  /// the Gaussian (1 classical; robust: its eff): Var(wv_j) = 2 wv_j^2 / (eta_j eff).
+  /// The GMWM's model-based and efficient weights and its asymptotic intervals use it.
+  double eff = 1.0;
+  /// Robust: scales (indices) where the biweight broke down (more outlying
+  /// coefficients than it tolerates) and the MAD scale was used instead.
+  std::vector<int> mad_scales;
 
   int scales() const { return static_cast<int>(tau.size()); }
   Eigen::VectorXd tauSeconds() const { return tau / rate_hz; }
@@ -50,6 +57,10 @@ WaveletVariance waveletVariance(const double* x, std::size_t n, double rate_hz,
 /**
  * Robust WV: Tukey-biweight M-estimator of scale of the wavelet coefficients
  * at efficiency @p eff (0.6 as in the R package), CI inflated by 1/sqrt(eff).
+ * Where the biweight breaks down (its scale equation has no root: isolated
+ * spikes touch tau coefficients at scale tau, so their share grows with the
+ * scale) the MAD scale (median |w| / 0.6745)^2 is used, CI inflated by
+ * 1/sqrt(0.3674), and the scale is listed in mad_scales.
  */
 WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rate_hz,
                                       double eff = 0.6, double alpha = 0.05);
