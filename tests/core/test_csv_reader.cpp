@@ -169,7 +169,9 @@ TEST(CsvReader, NamedTimeColumn) {
   EXPECT_DOUBLE_EQ(s.t0_s, 10.0);
   EXPECT_EQ(s.channel("gyro_x").x, (std::vector<double>{1, 2, 3, 4}));
   // Without the option 't' is the time column and its gap is an error.
-  EXPECT_NE(errorOf(f, CsvImuOptions{}).find("stamp.csv:3"), std::string::npos) << errorOf(f, CsvImuOptions{});
+  const std::string uneven = errorOf(f, CsvImuOptions{});
+  EXPECT_NE(uneven.find("stamp.csv:"), std::string::npos) << uneven;
+  EXPECT_NE(uneven.find("time step"), std::string::npos) << uneven;
   o.time_column = "time_ns";
   const std::string m = errorOf(f, o);
   EXPECT_NE(m.find("stamp.csv:1: no time column 'time_ns' (--time-column)"), std::string::npos) << m;
