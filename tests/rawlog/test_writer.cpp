@@ -6,6 +6,7 @@
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/obs/CObservationGPS.h>
+#include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -229,7 +230,7 @@ TEST(RawlogWriter, ReferenceIsAnMrptPoseAndLeverArmTheGnssSensorPose) {
   // yawed by psi (clockwise from north) has MRPT yaw pi/2 - psi (anticlockwise from east)
   mrpt::io::CFileGZInputStream in(p);
   auto arch = mrpt::serialization::archiveFrom(in);
-  std::size_t k = 0, gps = 0;
+  std::size_t k = 0, gps = 0, imuSeen = 0;
   for (;;) {
     mrpt::serialization::CSerializable::Ptr o;
     try {
@@ -238,6 +239,14 @@ TEST(RawlogWriter, ReferenceIsAnMrptPoseAndLeverArmTheGnssSensorPose) {
       break;
     }
     if (!o) break;
+    if (auto m = std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o); m && m->sensorLabel == "IMU") {
+      // FRD values, mounted as a half turn about x in MRPT's FLU vehicle frame: exactly diag(1, -1, -1)
+      const auto& R = m->sensorPose.getRotationMatrix();
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) EXPECT_EQ(R(a, b), a != b ? 0.0 : a == 0 ? 1.0 : -1.0);
+      EXPECT_EQ(m->sensorPose.x(), 0.0);
+      ++imuSeen;
+    }
     if (auto g = std::dynamic_pointer_cast<mrpt::obs::CObservationGPS>(o)) {
       EXPECT_DOUBLE_EQ(g->sensorPose.x(), 0.25);
       EXPECT_DOUBLE_EQ(g->sensorPose.y(), 0.5);   // right -> left
@@ -255,6 +264,7 @@ TEST(RawlogWriter, ReferenceIsAnMrptPoseAndLeverArmTheGnssSensorPose) {
   }
   EXPECT_EQ(k, d.reference.size());
   EXPECT_EQ(gps, d.gnss.size());
+  EXPECT_EQ(imuSeen, d.imu.size());
 
   // a level body: MRPT yaw = pi/2 - psi
   Recording lv = sample();

@@ -94,6 +94,17 @@ void writeRawlog(const std::string& path, const Recording& d, const RawlogWriteO
 
   CObservationIMU imu, baro, gtVel;
   imu.sensorLabel = "IMU";
+  {  // the values are body FRD: the IMU's mounting in MRPT's vehicle frame (x forward, y left, z up)
+    // is a half turn about x, written exactly (readers that apply sensorPose get FLU values)
+    mrpt::math::CMatrixDouble33 rot;
+    rot.setZero();
+    rot(0, 0) = 1.0;
+    rot(1, 1) = -1.0;
+    rot(2, 2) = -1.0;
+    mrpt::math::CVectorFixedDouble<3> zero;
+    zero[0] = zero[1] = zero[2] = 0.0;
+    imu.sensorPose = mrpt::poses::CPose3D(rot, zero);
+  }
   baro.sensorLabel = "BARO";
   gtVel.sensorLabel = "GT_VEL";
   mrpt::obs::CObservationRobotPose gt;
