@@ -12,6 +12,7 @@
 
 #include "cli_common.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/stochastic/datasheet.hpp"
@@ -21,6 +22,7 @@
 namespace {
 
 namespace st = navimpact::stochastic;
+using navimpact::formatNumber;
 
 struct Opts {
   std::string spec;
@@ -29,12 +31,6 @@ struct Opts {
   std::string out;
   bool overwrite = false;
 };
-
-std::string fmtRate(double hz) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g Hz", hz);
-  return buf;
-}
 
 /// Print one group of axes sharing a model: its text and datasheet figures.
 void printGroup(std::ostream& os, const std::string& label, const st::Model& m,
@@ -49,7 +45,7 @@ void printGroup(std::ostream& os, const std::string& label, const st::Model& m,
 
 int runShow(const Opts& o) {
   const st::ImuModel m = st::loadImuModel(o.spec);
-  std::cout << "model " << m.source << " (parameters per sample at " << fmtRate(m.rate_hz)
+  std::cout << "model " << m.source << " (parameters per sample at " << formatNumber(m.rate_hz) << " Hz"
             << ")\n";
   for (int s = 0; s < 2; ++s) {  // gyroscope axes 0..2, accelerometer axes 3..5
     const int a0 = 3 * s;
@@ -73,7 +69,7 @@ int runList(const Opts& o) {
   const auto names = st::listModels(o.file);
   if (names.empty()) {
     const st::ImuModel m = st::loadImuModel(o.file);
-    std::cout << o.file << ": single model (rate " << fmtRate(m.rate_hz) << ")\n";
+    std::cout << o.file << ": single model (rate " << formatNumber(m.rate_hz) << " Hz" << ")\n";
     return 0;
   }
   for (const auto& n : names) {
@@ -90,7 +86,7 @@ int runConvert(const Opts& o) {
   if (!o.out.empty()) set.emplace(navimpact::OutputSet::singleFile(o.out, navimpact::cli::overwriteMode(o.overwrite)));
   const st::ImuModel m = st::loadImuModel(o.spec);
   const st::ImuModel c = st::convertRate(m, o.rate_hz);
-  const std::string note = "converted from " + fmtRate(m.rate_hz) + " to " + fmtRate(o.rate_hz);
+  const std::string note = "converted from " + formatNumber(m.rate_hz) + " Hz to " + formatNumber(o.rate_hz) + " Hz";
   const std::string yaml = st::toYaml(c, "navimpact model convert: " + m.source + ", " + note +
                                              "\n(exact: same noise densities and continuous processes)");
   if (o.out.empty()) {

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/emulation/trajectory.hpp"

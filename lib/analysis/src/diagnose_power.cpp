@@ -16,6 +16,7 @@
 
 #include "diagnosis_internal.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/detect/null_model.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
@@ -140,7 +141,7 @@ Case drawCase(const std::vector<Cause>& causes, const DrawRanges& rg, double snr
   c.model.source = "drawn";
   const int first = channels == 1 ? static_cast<int>(rng.next() % 6) : 0;
   std::ostringstream txt;
-  txt << "rate=" << fmtNum(rate, 5) << " Hz n=" << n << " (" << fmtNum(record, 4) << " s)";
+  txt << "rate=" << formatNumber(rate, 5) << " Hz n=" << n << " (" << formatNumber(record, 4) << " s)";
   for (int q = 0; q < channels; ++q) {
     const int ci = channels == 1 ? first : q;
     stochastic::Model& m = c.model.axis[ci];
@@ -287,10 +288,10 @@ Case drawCase(const std::vector<Cause>& causes, const DrawRanges& rg, double snr
       }
     }
     if (!last) continue;
-    txt << " | hidden " << causeName(h.cause) << " at " << fmtNum(snr_factor, 3) << "x limit";
+    txt << " | hidden " << causeName(h.cause) << " at " << formatNumber(snr_factor, 3) << "x limit";
     if (causes.size() > 1) txt << " (with the other effect as noise)";
     txt << ":";
-    for (const auto& kv : h.truth) txt << " " << kv.first << "=" << fmtNum(kv.second, 4);
+    for (const auto& kv : h.truth) txt << " " << kv.first << "=" << formatNumber(kv.second, 4);
     c.hidden.push_back(h);
   }
   noise_of = noise_now;
@@ -304,7 +305,7 @@ std::string describe(const Diagnosis& d) {
   for (const auto& c : d.channels)
     for (const auto& f : c.findings) {
       s += " [" + c.name + " " + causeName(f.cause);
-      for (const auto& kv : f.params) s += " " + kv.first + "=" + fmtNum(kv.second, 4);
+      for (const auto& kv : f.params) s += " " + kv.first + "=" + formatNumber(kv.second, 4);
       s += "]";
     }
   return s;

@@ -16,6 +16,7 @@
 
 #include "diagnosis_internal.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/detect/change_points.hpp"
 #include "navimpact/detect/lines.hpp"
 #include "navimpact/detect/null_model.hpp"
@@ -53,13 +54,6 @@ double Finding::get(const std::string& key) const {
   for (const auto& kv : params)
     if (kv.first == key) return kv.second;
   return std::numeric_limits<double>::quiet_NaN();
-}
-
-std::string fmtNum(double v, int digits) {
-  std::ostringstream os;
-  os.precision(digits);
-  os << v;
-  return os.str();
 }
 
 std::string channelUnit(const std::string& channel) {
@@ -466,8 +460,8 @@ struct Shared {
 };
 
 std::string scaleRange(double lo, double hi) {
-  if (!(hi > lo * 1.0001)) return "tau = " + fmtNum(lo, 3) + " s";
-  return "tau = " + fmtNum(lo, 3) + "–" + fmtNum(hi, 3) + " s";
+  if (!(hi > lo * 1.0001)) return "tau = " + formatNumber(lo, 3) + " s";
+  return "tau = " + formatNumber(lo, 3) + "–" + formatNumber(hi, 3) + " s";
 }
 
 /// Largest |WV change| of a model change relative to the CI width of the
@@ -530,7 +524,7 @@ Finding broadbandFinding(const std::string& ch, const Candidate& c, const Model&
   const bool above = ratio >= 1;
   f.direction = (c.retune && c.scale < 1) ? "overstated" : "missing";
   if (count > 0)
-    ex << "the measured WV is " << fmtNum(above ? ratio : 1.0 / ratio, 2) << "x "
+    ex << "the measured WV is " << formatNumber(above ? ratio : 1.0 / ratio, 2) << "x "
        << (above ? "above" : "below") << " the model at " << scaleRange(lo, hi) << " ("
        << count << " scale" << (count > 1 ? "s" : "") << " outside the 95 % CI); ";
   switch (c.kind) {
@@ -555,11 +549,11 @@ Finding broadbandFinding(const std::string& ch, const Candidate& c, const Model&
   } else {
     ex << "the excess " << shapeWords(c.kind);
     if (c.kind == ProcessKind::GM)
-      ex << " with T = " << fmtNum(p.T, 3) << " s (95 % interval " << fmtNum(c.T_lo, 3) << "–"
-         << fmtNum(c.T_hi, 3) << " s), sigma = " << fmtNum(p.sigma, 3) << " " << unit;
+      ex << " with T = " << formatNumber(p.T, 3) << " s (95 % interval " << formatNumber(c.T_lo, 3) << "–"
+         << formatNumber(c.T_hi, 3) << " s), sigma = " << formatNumber(p.sigma, 3) << " " << unit;
     else
       ex << ": " << stochastic::formatTerms({p}, 3) << " (" << unit << ", per sample at "
-         << fmtNum(rate, 4) << " Hz)";
+         << formatNumber(rate, 4) << " Hz)";
   }
   ex << ".";
   f.explanation = ex.str();
@@ -638,10 +632,10 @@ Model gmwmRefit(const Model& start, const gmwm::WaveletVariance& wv, const WvDat
                  rc.terms.end());
   const double dev1 = wvDeviance(d.nu, wvOf(rc, d.tau), d.dof);
   if (dev1 <= dev0 + 1e-9 * std::abs(dev0)) {
-    *how = "gmwm (deviance " + fmtNum(dev0, 4) + " -> " + fmtNum(dev1, 4) + ")";
+    *how = "gmwm (deviance " + formatNumber(dev0, 4) + " -> " + formatNumber(dev1, 4) + ")";
     return refit;
   }
-  *how = "start kept (GMWM refit raised the deviance " + fmtNum(dev0, 4) + " -> " + fmtNum(dev1, 4) + ")";
+  *how = "start kept (GMWM refit raised the deviance " + formatNumber(dev0, 4) + " -> " + formatNumber(dev1, 4) + ")";
   return start;
 }
 
@@ -763,9 +757,9 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
                                     boost::math::cdf(boost::math::complement(boost::math::normal(), maxz)));
       const bool heavy = orr.events.size() > std::max<std::size_t>(20, n / 5000);
       std::ostringstream ex;
-      ex << orr.events.size() << " outlier event(s)" << (longest > 1.5 / rate ? " (bursts up to " + fmtNum(longest, 2) + " s count once)" : "")
-         << ", up to " << fmtNum(maxa, 3) << " " << unit << " from the local level, " << fmtNum(maxz, 3)
-         << " sd of the second difference (threshold " << fmtNum(orr.threshold, 3) << ").";
+      ex << orr.events.size() << " outlier event(s)" << (longest > 1.5 / rate ? " (bursts up to " + formatNumber(longest, 2) + " s count once)" : "")
+         << ", up to " << formatNumber(maxa, 3) << " " << unit << " from the local level, " << formatNumber(maxz, 3)
+         << " sd of the second difference (threshold " << formatNumber(orr.threshold, 3) << ").";
       f.explanation = ex.str();
       f.evidence = heavy ? "so many events throughout the record point to heavy-tailed noise rather than isolated outliers"
                          : "Gaussian noise of the model exceeds this threshold anywhere in the record with probability below the outlier share of alpha; a step would leave the level changed, these return to it";
@@ -824,24 +818,24 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
       f.threshold = lt.threshold;
       f.p_value = L.p_value;
       std::ostringstream ex;
-      ex << "a spectral line at " << fmtNum(L.freq_hz, 6) << " Hz, amplitude " << fmtNum(L.amplitude, 3) << " " << unit
-         << " (" << fmtNum(L.ratio, 3) << "x the background; threshold " << fmtNum(lt.threshold, 3) << "x)";
+      ex << "a spectral line at " << formatNumber(L.freq_hz, 6) << " Hz, amplitude " << formatNumber(L.amplitude, 3) << " " << unit
+         << " (" << formatNumber(L.ratio, 3) << "x the background; threshold " << formatNumber(lt.threshold, 3) << "x)";
       if (!f.harmonics_hz.empty()) {
         ex << ", with harmonic(s) at";
-        for (double h : f.harmonics_hz) ex << " " << fmtNum(h, 5);
+        for (double h : f.harmonics_hz) ex << " " << formatNumber(h, 5);
         ex << " Hz";
       }
       {
         std::string nearby;
         for (std::size_t q = 0; q < lines.size(); ++q)
-          if (near_of[q] == static_cast<int>(i)) nearby += " " + fmtNum(lines[q].freq_hz, 6);
+          if (near_of[q] == static_cast<int>(i)) nearby += " " + formatNumber(lines[q].freq_hz, 6);
         if (!nearby.empty()) ex << "; its frequency wanders (also at" << nearby << " Hz)";
       }
       ex << ".";
       f.explanation = ex.str();
       std::ostringstream ev;
-      ev << "peak " << fmtNum(L.local_ratio, 3) << "x its own spectral neighbourhood: a Gauss-Markov process has a smooth spectrum and cannot make it; amplitude "
-         << fmtNum(L.amp_half[0], 3) << " / " << fmtNum(L.amp_half[1], 3) << " " << unit << " in the two halves";
+      ev << "peak " << formatNumber(L.local_ratio, 3) << "x its own spectral neighbourhood: a Gauss-Markov process has a smooth spectrum and cannot make it; amplitude "
+         << formatNumber(L.amp_half[0], 3) << " / " << formatNumber(L.amp_half[1], 3) << " " << unit << " in the two halves";
       f.evidence = ev.str();
       f.action = "add SIN(amp, freq) per line (a two-state oscillator in the filter), or notch it out if it is a vibration of the test set-up";
       cd.findings.push_back(f);
@@ -951,7 +945,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
       const std::string how = "generalised likelihood ratio, every variance profiled and a random walk allowed; exact Gaussian likelihood of " +
                               std::to_string(st.blocks) + " block means of " + std::to_string(st.block) +
                               " sample(s); chi2_1 at a fixed time, Bonferroni over the " +
-                              fmtNum(boundaries, 6) + " block boundaries: threshold " + fmtNum(lr_thr, 4);
+                              formatNumber(boundaries, 6) + " block boundaries: threshold " + formatNumber(lr_thr, 4);
       if (best_k > 0) {
         x_after_pre_changed = true;
         double lr_rest = 0;  // strongest candidate left out
@@ -975,25 +969,25 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
           f.statistic = t.lr;
           f.threshold = lr_thr;
           f.p_value = t.p_value;
-          f.explanation = "a level shift of " + fmtNum(size, 3) + " " + unit + " at t = " + fmtNum(tt, 6) +
-                          " s (" + fmtNum(std::abs(size) / std::max(se, 1e-300), 3) + " standard errors; found by the model's " +
-                          fmtNum(c.half_width / rate, 3) + " s window contrast at " + fmtNum(c.z, 3) + " sd).";
-          f.evidence = "likelihood ratio " + fmtNum(t.lr, 4) + " for a shift here against the best stochastic explanation without shifts, " +
-                       ext0 + " (" + how + "; p = " + fmtNum(t.p_value, 3) + ")";
-          f.action = "segment the record at t = " + fmtNum(tt, 6) +
+          f.explanation = "a level shift of " + formatNumber(size, 3) + " " + unit + " at t = " + formatNumber(tt, 6) +
+                          " s (" + formatNumber(std::abs(size) / std::max(se, 1e-300), 3) + " standard errors; found by the model's " +
+                          formatNumber(c.half_width / rate, 3) + " s window contrast at " + formatNumber(c.z, 3) + " sd).";
+          f.evidence = "likelihood ratio " + formatNumber(t.lr, 4) + " for a shift here against the best stochastic explanation without shifts, " +
+                       ext0 + " (" + how + "; p = " + formatNumber(t.p_value, 3) + ")";
+          f.action = "segment the record at t = " + formatNumber(tt, 6) +
                      " s (estimate the model on each part) or remove the step; a stationary filter state cannot represent a one-off jump";
           cd.findings.push_back(f);
         }
         if (best_k < K)
           cd.notes.push_back(std::to_string(K - best_k) + " weaker candidate level shift(s) are not significant given the " +
-                             std::to_string(best_k) + " found (likelihood ratio up to " + fmtNum(lr_rest, 4) +
-                             " below " + fmtNum(lr_thr, 4) + "): left to the wavelet-variance analysis");
+                             std::to_string(best_k) + " found (likelihood ratio up to " + formatNumber(lr_rest, 4) +
+                             " below " + formatNumber(lr_thr, 4) + "): left to the wavelet-variance analysis");
       } else if (!failed.empty()) {
         cd.notes.push_back(std::to_string(K) + " candidate level shift(s) not tested (" + failed +
                            "): left to the wavelet-variance analysis");
       } else {
         cd.notes.push_back(std::to_string(K) + " candidate level shift(s) are explained as well by " + ext0 +
-                           " (likelihood ratio up to " + fmtNum([&] {
+                           " (likelihood ratio up to " + formatNumber([&] {
                              double v = 0;
                              for (const auto& t : st.tests) v = std::max(v, t.lr);
                              return v;
@@ -1146,8 +1140,8 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
         second = ranked[1].second;
         second_crit = crits[second];
         exact_evidence = "; among the slow explanations the exact likelihood of " + std::to_string(yb.size()) +
-                         " block means (variances profiled) gives AIC " + fmtNum(ranked[0].first, 7) + " against " +
-                         fmtNum(ranked[1].first, 7) + " for " + candidateText(cands[second]) +
+                         " block means (variances profiled) gives AIC " + formatNumber(ranked[0].first, 7) + " against " +
+                         formatNumber(ranked[1].first, 7) + " for " + candidateText(cands[second]) +
                          (best != wv_best ? " (the WV alone preferred " + candidateText(cands[wv_best]) + ")" : std::string());
       }
     }
@@ -1167,8 +1161,8 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     nf.statistic = pmin;
     nf.threshold = p_thr;
     nf.p_value = std::min(1.0, pmin * J * sh.channels / 0.4);  // Bonferroni over scales and channels (WV share)
-    nf.evidence = "AIC " + fmtNum(best_crit, 5) +
-                  (second >= 0 ? " against " + fmtNum(second_crit, 5) + " for the runner-up, " + candidateText(cands[second])
+    nf.evidence = "AIC " + formatNumber(best_crit, 5) +
+                  (second >= 0 ? " against " + formatNumber(second_crit, 5) + " for the runner-up, " + candidateText(cands[second])
                                : std::string(" (no other family fits)")) +
                   exact_evidence;
     auto own = added_by.find(cf.retune ? cf.term : -1);
@@ -1336,8 +1330,8 @@ Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
   d.model_before = model;
   if (std::abs(model.rate_hz - data.rate_hz) > 1e-9 * data.rate_hz) {
     d.model_before = stochastic::convertRate(model, data.rate_hz);
-    d.notices.push_back("model " + model.source + " is at " + fmtNum(model.rate_hz, 6) +
-                        " Hz, the data at " + fmtNum(data.rate_hz, 6) +
+    d.notices.push_back("model " + model.source + " is at " + formatNumber(model.rate_hz, 6) +
+                        " Hz, the data at " + formatNumber(data.rate_hz, 6) +
                         " Hz: converted exactly to the data rate (same continuous-time "
                         "processes)");
   }

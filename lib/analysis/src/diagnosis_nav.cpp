@@ -18,6 +18,7 @@
 #include "navimpact/analysis/diagnosis.hpp"
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/filter/error_model.hpp"
@@ -57,16 +58,16 @@ std::shared_ptr<const NavGainPlan> prepareNavGain(const NavGainOptions& opt, dou
   const double duration = plan->t1 - plan->t0;
   for (const auto& o : opt.outages) {
     if (!(o.start >= 0.0 && o.end > o.start))
-      throw Error("--outage " + fmtNum(o.start, 6) + ":" + fmtNum(o.end - o.start, 6) + " is invalid");
+      throw Error("--outage " + formatNumber(o.start, 6) + ":" + formatNumber(o.end - o.start, 6) + " is invalid");
     if (o.end > duration + 1e-9)
-      throw Error("--outage " + fmtNum(o.start, 6) + ":" + fmtNum(o.end - o.start, 6) + " ends at " +
-                  fmtNum(o.end, 6) + " s, after the end of the trajectory " + opt.trajectory.file + " (" +
-                  fmtNum(duration, 6) + " s)");
+      throw Error("--outage " + formatNumber(o.start, 6) + ":" + formatNumber(o.end - o.start, 6) + " ends at " +
+                  formatNumber(o.end, 6) + " s, after the end of the trajectory " + opt.trajectory.file + " (" +
+                  formatNumber(duration, 6) + " s)");
     plan->outages.push_back({plan->t0 + o.start, plan->t0 + o.end});
   }
   if (n > samples)
-    throw Error("static recording too short for the navigation gain: " + fmtNum(samples / rate, 6) +
-                " s available, " + fmtNum(duration, 6) + " s needed for the trajectory " +
+    throw Error("static recording too short for the navigation gain: " + formatNumber(samples / rate, 6) +
+                " s available, " + formatNumber(duration, 6) + " s needed for the trajectory " +
                 opt.trajectory.file);
   plan->perfect = emulation::perfectImu(tr, rate, plan->t0, plan->t1);
   if (plan->perfect.size() != n)
@@ -154,7 +155,7 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
   g.duration_s = p.t1 - p.t0;
   g.runs = opt.runs;
   g.seed = opt.seed;
-  g.trajectory = opt.trajectory.file + " (" + fmtNum(g.duration_s, 6) + " s used)";
+  g.trajectory = opt.trajectory.file + " (" + formatNumber(g.duration_s, 6) + " s used)";
 
   // Held-out windows: the second half of the recording, which the extension
   // (first-half fit) has not seen, when it holds the emulation.
@@ -185,7 +186,7 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
     if (replaced > 0)
       g.filter_note = std::to_string(replaced) +
                       " Gauss-Markov term(s) with T at most the covariance propagation interval (" +
-                      fmtNum(t_min, 3) + " s) entered the filter as white noise of the same long-run variance sigma^2 (1 + phi) / (1 - phi), "
+                      formatNumber(t_min, 3) + " s) entered the filter as white noise of the same long-run variance sigma^2 (1 + phi) / (1 - phi), "
                       "phi = exp(-dt/T) (the EKF cannot carry them), alike before and after";
   }
   g.filter_after = held_out
@@ -194,8 +195,8 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
                        : "the whole-record extension (model_after): the second half of the record is "
                          "shorter than the emulation, so truth windows and fit share data (in-sample)";
   if (!held_out)
-    d.notices.push_back("navigation gain is in-sample: the held-out half (" + fmtNum((N - nh) / p.rate, 6) +
-                        " s) is shorter than the trajectory (" + fmtNum(g.duration_s, 6) + " s)");
+    d.notices.push_back("navigation gain is in-sample: the held-out half (" + formatNumber((N - nh) / p.rate, 6) +
+                        " s) is shorter than the trajectory (" + formatNumber(g.duration_s, 6) + " s)");
   // Evenly spaced window offsets over the available span.
   const std::size_t avail = rec.size() - n;
   std::vector<std::size_t> offs;
@@ -205,21 +206,21 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
     offs.push_back(off);
     g.window_offsets_s.push_back(double(first + off) / p.rate);
   }
-  g.truth = "measured static recording " + data.source + ": run r takes the " + fmtNum(g.duration_s, 6) +
+  g.truth = "measured static recording " + data.source + ": run r takes the " + formatNumber(g.duration_s, 6) +
             " s window starting at offset r/(R-1) of the " + (held_out ? "second half" : "whole record") +
             " (R = " + std::to_string(opt.runs) + "), window mean removed per axis";
   {
     std::ostringstream st;
-    st << "IMU " << fmtNum(p.rate, 6) << " Hz; GNSS " << fmtNum(opt.gnss.rate_hz, 4)
-       << " Hz, position sigma " << fmtNum(opt.gnss.sigma_pos_h_m, 4) << " m horizontal / "
-       << fmtNum(opt.gnss.sigma_pos_v_m, 4) << " m vertical, velocity sigma "
-       << fmtNum(opt.gnss.sigma_vel_h_mps, 4) << " / " << fmtNum(opt.gnss.sigma_vel_v_mps, 4)
-       << " m/s; barometer " << fmtNum(opt.baro.rate_hz, 4) << " Hz, sigma " << fmtNum(opt.baro.sigma_m, 4)
+    st << "IMU " << formatNumber(p.rate, 6) << " Hz; GNSS " << formatNumber(opt.gnss.rate_hz, 4)
+       << " Hz, position sigma " << formatNumber(opt.gnss.sigma_pos_h_m, 4) << " m horizontal / "
+       << formatNumber(opt.gnss.sigma_pos_v_m, 4) << " m vertical, velocity sigma "
+       << formatNumber(opt.gnss.sigma_vel_h_mps, 4) << " / " << formatNumber(opt.gnss.sigma_vel_v_mps, 4)
+       << " m/s; barometer " << formatNumber(opt.baro.rate_hz, 4) << " Hz, sigma " << formatNumber(opt.baro.sigma_m, 4)
        << " m, " << (opt.baro_in_outage ? "kept" : "off") << " during outages; EKF covariance every "
-       << p.nav.ekf.propagate_every << " IMU samples; initial error sigmas " << fmtNum(opt.initial_sigma(0), 3)
-       << " m, " << fmtNum(opt.initial_sigma(3), 3) << " m/s, roll/pitch "
-       << fmtNum(opt.initial_sigma(6) / units::kDeg, 3) << " deg, yaw "
-       << fmtNum(opt.initial_sigma(8) / units::kDeg, 3) << " deg (drawn per run, same for both models)";
+       << p.nav.ekf.propagate_every << " IMU samples; initial error sigmas " << formatNumber(opt.initial_sigma(0), 3)
+       << " m, " << formatNumber(opt.initial_sigma(3), 3) << " m/s, roll/pitch "
+       << formatNumber(opt.initial_sigma(6) / units::kDeg, 3) << " deg, yaw "
+       << formatNumber(opt.initial_sigma(8) / units::kDeg, 3) << " deg (drawn per run, same for both models)";
     g.settings = st.str();
   }
 

@@ -9,19 +9,13 @@
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 
 namespace navimpact::analysis {
 
 namespace {
-
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(10);
-  s << x;
-  return s.str();
-}
 
 template <int N>
 double blockNees(const Eigen::Matrix<double, N, 1>& e, const Eigen::Matrix<double, N, N>& P) {
@@ -52,7 +46,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
   const TruthSeries noTruth;
   const bool hasTruth = in.truth != nullptr;
   if (!hasTruth && !(opt.record_interval_s > 0.0 && std::isfinite(opt.record_interval_s)))
-    throw Error("navigation run: record interval must be > 0 s without truth, got " + num(opt.record_interval_s));
+    throw Error("navigation run: record interval must be > 0 s without truth, got " + formatNumber(opt.record_interval_s, 10));
   const auto& imu = *in.imu;
   const auto& truth = hasTruth ? *in.truth : noTruth;
   if (truth.t.size() != truth.x.size())
@@ -60,7 +54,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
                 std::to_string(truth.x.size()) + " states");
   for (const auto& o : opt.outages)
     if (!(o.end > o.start))
-      throw Error("navigation run: outage (" + num(o.start) + ", " + num(o.end) + "] is empty");
+      throw Error("navigation run: outage (" + formatNumber(o.start, 10) + ", " + formatNumber(o.end, 10) + "] is empty");
 
   const auto t_start = std::chrono::steady_clock::now();
   filter::ErrorStateEkf ekf(in.x0, opt.P0_nav, model, opt.ekf);
@@ -81,11 +75,11 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       const GnssFix& f = (*in.gnss)[ig++];
       if (f.t < in.x0.t - half_dt) continue;  // before the run
       if (inOutage(f.t, opt.outages)) continue;
-      if (!f.cov_pos_N) throw Error("navigation run: GNSS fix at " + num(f.t) + " s has no position covariance");
+      if (!f.cov_pos_N) throw Error("navigation run: GNSS fix at " + formatNumber(f.t, 10) + " s has no position covariance");
       const Eigen::Vector3d sp = f.cov_pos_N->diagonal().cwiseSqrt();
       ekf.updateGnssPosition(f.pos, sp, opt.lever_arm_B);
       if (opt.use_gnss_velocity && f.v_N) {
-        if (!f.cov_vel_N) throw Error("navigation run: GNSS fix at " + num(f.t) + " s has no velocity covariance");
+        if (!f.cov_vel_N) throw Error("navigation run: GNSS fix at " + formatNumber(f.t, 10) + " s has no velocity covariance");
         const Eigen::Vector3d sv = f.cov_vel_N->diagonal().cwiseSqrt();
         ekf.updateGnssVelocity(*f.v_N, sv, opt.lever_arm_B);
       }
@@ -95,7 +89,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       const BaroSample& b = (*in.baro)[ib++];
       if (b.t < in.x0.t - half_dt) continue;
       if (!opt.baro_in_outage && inOutage(b.t, opt.outages)) continue;
-      if (!b.sigma_m) throw Error("navigation run: baro sample at " + num(b.t) + " s has no sigma");
+      if (!b.sigma_m) throw Error("navigation run: baro sample at " + formatNumber(b.t, 10) + " s has no sigma");
       ekf.updateBaro(b.h, *b.sigma_m);
       ++res.baro_updates;
     }
@@ -119,8 +113,8 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
     }
     while (it < truth.t.size() && truth.t[it] <= t_now + half_dt) {
       if (std::abs(truth.t[it] - t_now) > half_dt)
-        throw Error("navigation run: truth epoch " + num(truth.t[it]) +
-                    " s does not fall on an IMU sample (nearest " + num(t_now) + " s)");
+        throw Error("navigation run: truth epoch " + formatNumber(truth.t[it], 10) +
+                    " s does not fall on an IMU sample (nearest " + formatNumber(t_now, 10) + " s)");
       ekf.flushPropagation();
       NavEpoch e;
       e.t = truth.t[it];
@@ -139,8 +133,8 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
   double t_prev = in.x0.t;
   for (const ins::ImuSample& s : imu) {
     if (!(s.dt > 0.0) || std::abs(s.t - s.dt - t_prev) > 1e-6 * (1.0 + std::abs(t_prev)))
-      throw Error("navigation run: IMU sample at " + num(s.t) + " s (dt " + num(s.dt) +
-                  " s) does not follow the previous one at " + num(t_prev) + " s");
+      throw Error("navigation run: IMU sample at " + formatNumber(s.t, 10) + " s (dt " + formatNumber(s.dt, 10) +
+                  " s) does not follow the previous one at " + formatNumber(t_prev, 10) + " s");
     ekf.predict(s);
     ++res.steps;
     applyAiding(s.t, 0.5 * s.dt);

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/rawlog/writer.hpp"
@@ -27,12 +28,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-
-std::string num(double x) {
-  std::ostringstream o;
-  o << std::setprecision(10) << x;
-  return o.str();
-}
 
 std::string resolve(const fs::path& dir, const std::string& p) {
   if (p.empty() || fs::path(p).is_absolute() || dir.empty()) return p;
@@ -163,7 +158,7 @@ ins::NavState initialWithoutTruth(const Recording& d, const ReplayConfig& cfg, d
     }
   if (!fix)
     throw Error(cfg.rawlog + ": no ground truth (label GT) and no GNSS fix at the start of the IMU data (t = " +
-                num(t_zero) + " s) to initialise the filter from");
+                formatNumber(t_zero, 10) + " s) to initialise the filter from");
   if (!fix->v_N)
     throw Error(cfg.rawlog + ": no ground truth and the first GNSS fix has no velocity (GGA only)");
   Eigen::Vector3d rpy;
@@ -181,7 +176,7 @@ ins::NavState initialWithoutTruth(const Recording& d, const ReplayConfig& cfg, d
     const Eigen::Vector3d& v0 = *fix->v_N;
     const double vh = v0.head<2>().norm();
     if (vh < 1.0)
-      throw Error(cfg.rawlog + ": no ground truth and a horizontal GNSS speed of " + num(vh) +
+      throw Error(cfg.rawlog + ": no ground truth and a horizontal GNSS speed of " + formatNumber(vh, 10) +
                   " m/s at the start, too slow for a course: give initial_attitude_deg: [roll, pitch, yaw]");
     rpy[2] = std::atan2(v0.y(), v0.x());
     const GnssFix* fix1 = nullptr;
@@ -242,7 +237,7 @@ ins::NavState initialWithoutTruth(const Recording& d, const ReplayConfig& cfg, d
   P0.block<3, 3>(3, 3) = fix->cov_vel_N->diagonal().asDiagonal();
   P0.diagonal().tail<3>() << rp * rp, rp * rp, yw * yw;
   notices.push_back("no ground truth in the rawlog: filter initialised from the GNSS fix at time zero, " + how +
-                    " (initial sigmas " + num(rp / kDeg) + " deg roll/pitch, " + num(yw / kDeg) +
+                    " (initial sigmas " + formatNumber(rp / kDeg, 10) + " deg roll/pitch, " + formatNumber(yw / kDeg, 10) +
                     " deg yaw); errors and NEES are not available");
   return x;
 }
@@ -303,8 +298,8 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   for (const auto& o : cfg.outages) {
     const double a = r.t_zero + o.start_s, b = a + o.duration_s;
     if (b > t_last + 1e-6)
-      throw Error("outage " + num(o.start_s) + ":" + num(o.duration_s) + " ends at " + num(o.start_s + o.duration_s) +
-                  " s, after the data (IMU data span 0.." + num(t_last - r.t_zero) + " s)");
+      throw Error("outage " + formatNumber(o.start_s, 10) + ":" + formatNumber(o.duration_s, 10) + " ends at " + formatNumber(o.start_s + o.duration_s, 10) +
+                  " s, after the data (IMU data span 0.." + formatNumber(t_last - r.t_zero, 10) + " s)");
     opt.outages.push_back({a, b});
   }
 
@@ -327,7 +322,7 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
     if (cfg.sigma_vel_h_mps) sv.head<2>().setConstant(*cfg.sigma_vel_h_mps);
     if (cfg.sigma_vel_v_mps) sv[2] = *cfg.sigma_vel_v_mps;
     if (!sp.allFinite() || (f.v_N && !sv.allFinite()))
-      throw Error(cfg.rawlog + ": GNSS fix at t = " + num(f.t) + " s has no covariance: set the noise.* sigmas");
+      throw Error(cfg.rawlog + ": GNSS fix at t = " + formatNumber(f.t, 10) + " s has no covariance: set the noise.* sigmas");
     f.cov_pos_N = Eigen::Matrix3d(sp.cwiseAbs2().asDiagonal());
     if (sv.allFinite()) f.cov_vel_N = Eigen::Matrix3d(sv.cwiseAbs2().asDiagonal());
   }
@@ -345,13 +340,13 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   for (const auto& g : d.reference) {
     if (g.t < r.t_zero - 0.5 * dt || g.t > t_last + 0.5 * dt) continue;
     if (!g.v_N || !g.q_BtoN)
-      throw Error(cfg.rawlog + ": the reference (GT) at t = " + num(g.t) +
+      throw Error(cfg.rawlog + ": the reference (GT) at t = " + formatNumber(g.t, 10) +
                   " s has no velocity or attitude; a replay scores against a full reference");
     truth.t.push_back(g.t);
     truth.x.push_back(ins::navStateOf(g, d.origin));
   }
   if (hasTruth && (truth.t.empty() || std::abs(truth.t.front() - r.t_zero) > 0.5 * dt))
-    throw Error(cfg.rawlog + ": no GT entry at the start of the IMU data (t = " + num(r.t_zero) +
+    throw Error(cfg.rawlog + ": no GT entry at the start of the IMU data (t = " + formatNumber(r.t_zero, 10) +
                 " s) to initialise the filter from");
 
   NavRunInput in;

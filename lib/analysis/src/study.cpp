@@ -19,6 +19,7 @@
 #include "navimpact/core/build_info.hpp"
 #include "navimpact/core/csv_reader.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
@@ -33,13 +34,6 @@ namespace navimpact::analysis {
 using nlohmann::json;
 
 namespace {
-
-std::string num(double x, int prec = 6) {
-  std::ostringstream s;
-  s.precision(prec);
-  s << x;
-  return s.str();
-}
 
 /// Text of the six axis models, compact when the axes of a sensor agree.
 std::string describeModel(const stochastic::ImuModel& m) {
@@ -162,8 +156,8 @@ namespace {
 
 stochastic::ImuModel atRate(const stochastic::ImuModel& m, double rate, std::vector<std::string>& notices) {
   if (std::abs(m.rate_hz - rate) <= 1e-9 * rate) return m;
-  notices.push_back("model " + m.source + " given at " + num(m.rate_hz) + " Hz, converted exactly to " +
-                    num(rate) + " Hz");
+  notices.push_back("model " + m.source + " given at " + formatNumber(m.rate_hz) + " Hz, converted exactly to " +
+                    formatNumber(rate) + " Hz");
   return stochastic::convertRate(m, rate);
 }
 
@@ -226,15 +220,15 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
   meta.t0 = plan->t0;
   meta.duration_s = duration;
   meta.imu_rate_hz = rate;
-  meta.trajectory = cfg.trajectory.file + " (" + num(duration) + " s used)";
+  meta.trajectory = cfg.trajectory.file + " (" + formatNumber(duration) + " s used)";
 
   // Outages inside the trajectory.
   for (const auto& o : cfg.outages) {
     if (!(o.start >= 0.0 && o.end > o.start))
-      throw Error("outage (" + num(o.start) + ", " + num(o.end) + "] s is invalid");
+      throw Error("outage (" + formatNumber(o.start) + ", " + formatNumber(o.end) + "] s is invalid");
     if (o.end > duration + 1e-9)
-      throw Error("outage (" + num(o.start) + ", " + num(o.end) + "] s ends after the trajectory (" +
-                  num(duration) + " s of " + cfg.trajectory.file + ")");
+      throw Error("outage (" + formatNumber(o.start) + ", " + formatNumber(o.end) + "] s ends after the trajectory (" +
+                  formatNumber(duration) + " s of " + cfg.trajectory.file + ")");
     meta.outages.push_back({plan->t0 + o.start, plan->t0 + o.end});
   }
 
@@ -248,15 +242,15 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
     const ImuSeries& rec = *plan->recording;
     const double ratio = rec.rate_hz / rate, m_real = std::round(ratio);
     if (m_real < 1.0 || std::abs(ratio - m_real) > 1e-6 * ratio)
-      throw Error(cfg.truth.recording.file + ": static recording is at " + num(rec.rate_hz) + " Hz, emulation at " +
-                  num(rate) + " Hz (set imu.rate_hz to the recording's rate or an integer divisor of it)");
+      throw Error(cfg.truth.recording.file + ": static recording is at " + formatNumber(rec.rate_hz) + " Hz, emulation at " +
+                  formatNumber(rate) + " Hz (set imu.rate_hz to the recording's rate or an integer divisor of it)");
     plan->rec_block = static_cast<std::size_t>(m_real);
     if (n * plan->rec_block > rec.size())
-      throw Error(cfg.truth.recording.file + ": static recording too short: " + num(rec.size() / rec.rate_hz) +
-                  " s available, " + num(duration) + " s needed");
+      throw Error(cfg.truth.recording.file + ": static recording too short: " + formatNumber(rec.size() / rec.rate_hz) +
+                  " s available, " + formatNumber(duration) + " s needed");
     meta.truth_description = "measured static recording " + cfg.truth.recording.file + " (" +
-                             num(rec.size() / rec.rate_hz) + " s at " + num(rec.rate_hz) +
-                             " Hz): each run takes a " + num(duration) +
+                             formatNumber(rec.size() / rec.rate_hz) + " s at " + formatNumber(rec.rate_hz) +
+                             " Hz): each run takes a " + formatNumber(duration) +
                              " s window chosen by its seed, mean removed per axis" +
                              (plan->rec_block > 1 ? ", block means of " + std::to_string(plan->rec_block) : "");
   }
@@ -304,19 +298,19 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
   meta.plot_before_s = cfg.plot_before_s;
   meta.plot_after_s = cfg.plot_after_s;
   std::ostringstream st;
-  st << "IMU " << num(rate) << " Hz; GNSS " << num(cfg.gnss.rate_hz) << " Hz, position sigma "
-     << num(cfg.gnss.sigma_pos_h_m) << " m horizontal / " << num(cfg.gnss.sigma_pos_v_m)
-     << " m vertical, velocity sigma " << num(cfg.gnss.sigma_vel_h_mps) << " / " << num(cfg.gnss.sigma_vel_v_mps)
+  st << "IMU " << formatNumber(rate) << " Hz; GNSS " << formatNumber(cfg.gnss.rate_hz) << " Hz, position sigma "
+     << formatNumber(cfg.gnss.sigma_pos_h_m) << " m horizontal / " << formatNumber(cfg.gnss.sigma_pos_v_m)
+     << " m vertical, velocity sigma " << formatNumber(cfg.gnss.sigma_vel_h_mps) << " / " << formatNumber(cfg.gnss.sigma_vel_v_mps)
      << " m/s\n"
-     << (cfg.use_baro ? "barometer " + num(cfg.baro.rate_hz) + " Hz, sigma " + num(cfg.baro.sigma_m) + " m, " +
+     << (cfg.use_baro ? "barometer " + formatNumber(cfg.baro.rate_hz) + " Hz, sigma " + formatNumber(cfg.baro.sigma_m) + " m, " +
                             (cfg.baro_in_outage ? "kept during GNSS outages" : "off during GNSS outages")
                       : std::string("no barometer"))
      << "\n"
      << "EKF: covariance propagated every " << cfg.ekf.propagate_every << " IMU samples ("
      << (cfg.ekf.discretization == filter::Discretization::Series ? "series" : "Van Loan")
-     << " discretisation); initial error sigmas " << num(cfg.initial_sigma(0)) << " m, "
-     << num(cfg.initial_sigma(3)) << " m/s, roll/pitch " << num(cfg.initial_sigma(6) / units::kDeg)
-     << " deg, yaw " << num(cfg.initial_sigma(8) / units::kDeg) << " deg (drawn per run, same for all models)";
+     << " discretisation); initial error sigmas " << formatNumber(cfg.initial_sigma(0)) << " m, "
+     << formatNumber(cfg.initial_sigma(3)) << " m/s, roll/pitch " << formatNumber(cfg.initial_sigma(6) / units::kDeg)
+     << " deg, yaw " << formatNumber(cfg.initial_sigma(8) / units::kDeg) << " deg (drawn per run, same for all models)";
   meta.settings = st.str();
   return plan;
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 
@@ -67,12 +68,6 @@ long long parseUtc(const std::string& s, const Ctx& c) {
   in >> std::get_time(&tm, "%Y-%m-%dT%H:%M:%S");
   if (in.fail()) throw keyError(c.file, "output.start_utc", "'" + s + "' is not YYYY-MM-DDTHH:MM:SSZ");
   return static_cast<long long>(timegm(&tm));
-}
-
-std::string fmt(double x) {
-  std::ostringstream o;
-  o << std::setprecision(17) << x;
-  return o.str();
 }
 
 std::string quote(const std::string& s) {
@@ -266,24 +261,24 @@ Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
        " BARO: \"IMU_ALTITUDE m above the WGS84 ellipsoid\","
        " GNSS: \"GGA lat/lon deg, altitude_meters ellipsoidal, geoidal_distance 0; TOPCON_PZS ECEF m, m/s, covariances m^2, m^2/s^2\","
        " GT: \"IMU_X..IMU_Z m (tangent NED at origin), IMU_X_VEL..IMU_Z_VEL m/s (local NED), IMU_ORI_QUAT_X..W of C_BtoN\"}\n"
-    << "  origin: {lat_deg: " << fmt(d.origin.lat * 180 / M_PI) << ", lon_deg: " << fmt(d.origin.lon * 180 / M_PI)
-    << ", height_m: " << fmt(d.origin.h) << "}\n"
+    << "  origin: {lat_deg: " << formatNumber(d.origin.lat * 180 / M_PI, 17) << ", lon_deg: " << formatNumber(d.origin.lon * 180 / M_PI, 17)
+    << ", height_m: " << formatNumber(d.origin.h, 17) << "}\n"
     << "  time: {start_utc: " << quote(cfg.start_utc) << ", start_unix_s: " << startUnix
-    << ", trajectory_time_at_start_s: " << fmt(t0) << ", duration_s: " << fmt(t1 - t0) << "}\n"
+    << ", trajectory_time_at_start_s: " << formatNumber(t0, 17) << ", duration_s: " << formatNumber(t1 - t0, 17) << "}\n"
     << "  trajectory: {file: " << quote(cfg.trajectory.file) << ", system: " << cfg.trajectory.system
-    << ", position_cutoff_hz: " << fmt(cfg.smoothing.position_cutoff_hz)
-    << ", attitude_cutoff_hz: " << fmt(cfg.smoothing.attitude_cutoff_hz)
-    << ", knot_step_s: " << fmt(cfg.smoothing.knot_step_s) << ", penalty_order: " << cfg.smoothing.penalty_order << "}\n"
-    << "  imu: {rate_hz: " << fmt(cfg.imu_rate_hz) << ", errors: " << cfg.imu_errors
+    << ", position_cutoff_hz: " << formatNumber(cfg.smoothing.position_cutoff_hz, 17)
+    << ", attitude_cutoff_hz: " << formatNumber(cfg.smoothing.attitude_cutoff_hz, 17)
+    << ", knot_step_s: " << formatNumber(cfg.smoothing.knot_step_s, 17) << ", penalty_order: " << cfg.smoothing.penalty_order << "}\n"
+    << "  imu: {rate_hz: " << formatNumber(cfg.imu_rate_hz, 17) << ", errors: " << cfg.imu_errors
     << ", model: " << quote(cfg.model_spec) << ", seed: " << cfg.imu_seed
     << ", description: " << quote(err.description) << "}\n"
-    << "  gnss: {rate_hz: " << fmt(g.rate_hz) << ", sigma_pos_h_m: " << fmt(g.sigma_pos_h_m)
-    << ", sigma_pos_v_m: " << fmt(g.sigma_pos_v_m) << ", sigma_vel_h_mps: " << fmt(g.sigma_vel_h_mps)
-    << ", sigma_vel_v_mps: " << fmt(g.sigma_vel_v_mps) << ", lever_arm_B_m: [" << fmt(g.lever_arm_B[0]) << ", "
-    << fmt(g.lever_arm_B[1]) << ", " << fmt(g.lever_arm_B[2]) << "], seed: " << g.seed << "}\n"
-    << "  baro: {rate_hz: " << fmt(cfg.baro.rate_hz) << ", sigma_m: " << fmt(cfg.baro.sigma_m)
+    << "  gnss: {rate_hz: " << formatNumber(g.rate_hz, 17) << ", sigma_pos_h_m: " << formatNumber(g.sigma_pos_h_m, 17)
+    << ", sigma_pos_v_m: " << formatNumber(g.sigma_pos_v_m, 17) << ", sigma_vel_h_mps: " << formatNumber(g.sigma_vel_h_mps, 17)
+    << ", sigma_vel_v_mps: " << formatNumber(g.sigma_vel_v_mps, 17) << ", lever_arm_B_m: [" << formatNumber(g.lever_arm_B[0], 17) << ", "
+    << formatNumber(g.lever_arm_B[1], 17) << ", " << formatNumber(g.lever_arm_B[2], 17) << "], seed: " << g.seed << "}\n"
+    << "  baro: {rate_hz: " << formatNumber(cfg.baro.rate_hz, 17) << ", sigma_m: " << formatNumber(cfg.baro.sigma_m, 17)
     << ", seed: " << cfg.baro.seed << "}\n"
-    << "  ground_truth: {rate_hz: " << fmt(cfg.truth_rate_hz) << "}\n"
+    << "  ground_truth: {rate_hz: " << formatNumber(cfg.truth_rate_hz, 17) << "}\n"
     << "  notices:\n";
   for (const auto& nline : d.notices) y << "    - " << quote(nline) << "\n";
   if (d.notices.empty()) y << "    []\n";

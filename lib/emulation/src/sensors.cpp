@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
@@ -11,11 +12,6 @@
 namespace navimpact::emulation {
 
 namespace {
-std::string num(double x) {
-  std::ostringstream o;
-  o << x;
-  return o.str();
-}
 }  // namespace
 
 std::vector<double> standardNormal(std::size_t n, std::uint64_t seed) {
@@ -30,15 +26,15 @@ ImuErrors modelImuErrors(const stochastic::ImuModel& model, double imu_rate_hz, 
   ImuErrors e;
   stochastic::ImuModel m = model;
   if (std::abs(m.rate_hz - imu_rate_hz) > 1e-9 * imu_rate_hz) {
-    e.notices.push_back("IMU error model '" + model.source + "' is given at " + num(model.rate_hz) +
-                        " Hz; converted exactly to the IMU rate " + num(imu_rate_hz) + " Hz");
+    e.notices.push_back("IMU error model '" + model.source + "' is given at " + formatNumber(model.rate_hz) +
+                        " Hz; converted exactly to the IMU rate " + formatNumber(imu_rate_hz) + " Hz");
     m = stochastic::convertRate(model, imu_rate_hz);
   }
   for (std::size_t i = 0; i < 6; ++i) {
     e.axis[i].assign(n, 0.0);
     if (!m.axis[i].empty()) stochastic::simulateAdd(m.axis[i], stochastic::deriveSeed(seed, i), e.axis[i].data(), n);
   }
-  e.description = "simulated from model " + model.source + " at " + num(imu_rate_hz) + " Hz, seed " +
+  e.description = "simulated from model " + model.source + " at " + formatNumber(imu_rate_hz) + " Hz, seed " +
                   std::to_string(seed) + " (axis i: deriveSeed(seed, i))";
   return e;
 }
@@ -52,31 +48,31 @@ ImuErrors staticImuErrors(const ImuSeries& rec, const StaticRecordingSpec& spec,
   const double ratio = rec.rate_hz / imu_rate_hz;
   const double m_real = std::round(ratio);
   if (m_real < 1.0 || std::abs(ratio - m_real) > 1e-6 * ratio)
-    throw Error(spec.file + ": static recording is at " + num(rec.rate_hz) + " Hz, emulation at " +
-                num(imu_rate_hz) + " Hz (the recording's rate must equal the IMU rate or be an exact integer multiple of it)");
+    throw Error(spec.file + ": static recording is at " + formatNumber(rec.rate_hz) + " Hz, emulation at " +
+                formatNumber(imu_rate_hz) + " Hz (the recording's rate must equal the IMU rate or be an exact integer multiple of it)");
   const std::size_t m = static_cast<std::size_t>(m_real);
   const std::size_t need = n * m, have = rec.size();
   if (need > have)
-    throw Error(spec.file + ": static recording too short: " + num(have / rec.rate_hz) + " s available, " +
-                num(need / rec.rate_hz) + " s needed for " + std::to_string(n) + " IMU samples");
+    throw Error(spec.file + ": static recording too short: " + formatNumber(have / rec.rate_hz) + " s available, " +
+                formatNumber(need / rec.rate_hz) + " s needed for " + std::to_string(n) + " IMU samples");
   std::size_t start = 0;
   ImuErrors e;
   if (spec.offset_s) {
     if (*spec.offset_s < 0.0) throw Error(spec.file + ": static recording offset must be >= 0 s");
     start = static_cast<std::size_t>(std::llround(*spec.offset_s * rec.rate_hz));
     if (start + need > have)
-      throw Error(spec.file + ": offset " + num(*spec.offset_s) + " s leaves " +
-                  num((have > start ? have - start : 0) / rec.rate_hz) + " s of the recording, " +
-                  num(need / rec.rate_hz) + " s needed");
+      throw Error(spec.file + ": offset " + formatNumber(*spec.offset_s) + " s leaves " +
+                  formatNumber((have > start ? have - start : 0) / rec.rate_hz) + " s of the recording, " +
+                  formatNumber(need / rec.rate_hz) + " s needed");
   } else {
     const std::uint64_t r = stochastic::deriveSeed(spec.seed, 0);
     start = static_cast<std::size_t>(r % (have - need + 1));
     e.notices.push_back("static recording window chosen by seed " + std::to_string(spec.seed) + ": offset " +
-                        num(start / rec.rate_hz) + " s");
+                        formatNumber(start / rec.rate_hz) + " s");
   }
   if (m > 1)
-    e.notices.push_back("static recording at " + num(rec.rate_hz) + " Hz decimated by " + std::to_string(m) +
-                        " (block means) to the IMU rate " + num(imu_rate_hz) + " Hz");
+    e.notices.push_back("static recording at " + formatNumber(rec.rate_hz) + " Hz decimated by " + std::to_string(m) +
+                        " (block means) to the IMU rate " + formatNumber(imu_rate_hz) + " Hz");
   for (std::size_t i = 0; i < 6; ++i) {
     auto& out = e.axis[i];
     out.assign(n, 0.0);
@@ -95,7 +91,7 @@ ImuErrors staticImuErrors(const ImuSeries& rec, const StaticRecordingSpec& spec,
     mean /= double(n);
     for (auto& v : out) v -= mean;
   }
-  e.description = "measured static recording " + spec.file + ", window from " + num(start / rec.rate_hz) +
+  e.description = "measured static recording " + spec.file + ", window from " + formatNumber(start / rec.rate_hz) +
                   " s, mean removed per axis";
   return e;
 }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::filter {
 
@@ -81,12 +82,6 @@ const ErrorStateEkf::Cache::Blocks& ErrorStateEkf::Cache::blocksFor(
 }
 
 namespace {
-std::string tstr(double t) {
-  std::ostringstream s;
-  s.precision(9);
-  s << t;
-  return s.str();
-}
 bool sameState(const ins::NavState& a, const ins::NavState& b) {
   return a.lat == b.lat && a.lon == b.lon && a.h == b.h && a.v_N == b.v_N &&
          a.q_BtoN.coeffs() == b.q_BtoN.coeffs();
@@ -107,7 +102,7 @@ ErrorStateEkf::ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
     throw Error("propagate_every must be >= 1, got " + std::to_string(cfg.propagate_every));
   if (!(cfg.gate_probability >= 0.0 && cfg.gate_probability < 1.0))
     throw Error("gate_probability must be in [0, 1) (0 = gate off), got " +
-                tstr(cfg.gate_probability));
+                formatNumber(cfg.gate_probability, 9));
   if (!P0_nav.allFinite() || (P0_nav - P0_nav.transpose()).cwiseAbs().maxCoeff() >
                                  1e-12 * (1.0 + P0_nav.cwiseAbs().maxCoeff()) ||
       (P0_nav.diagonal().array() < 0.0).any())
@@ -440,15 +435,15 @@ void ErrorStateEkf::checkP(const char* where) const {
   const double scale = d.cwiseAbs().maxCoeff();
   for (int i = 0; i < d.size(); ++i) {
     if (!std::isfinite(d(i)) || d(i) < -1e-12 * (1.0 + scale))
-      throw Error("filter covariance is not positive definite at t = " + tstr(state().t) +
+      throw Error("filter covariance is not positive definite at t = " + formatNumber(state().t, 9) +
                   " s after " + where + " (state " + layout_.names()[i] + " variance " +
-                  tstr(d(i)) + ")");
+                  formatNumber(d(i), 9) + ")");
   }
 }
 
 void ErrorStateEkf::predict(const ins::ImuSample& raw) {
   if (!(raw.dt > 0.0) || !std::isfinite(raw.dt))
-    throw Error("IMU sample at t = " + tstr(raw.t) + " s has non-positive interval dt");
+    throw Error("IMU sample at t = " + formatNumber(raw.t, 9) + " s has non-positive interval dt");
   if (pending_ > 0) applyTransition();  // left over from predictCovariance()
   // Corrected output = raw - estimated error (closed loop, Groves 14.? feedback).
   const Eigen::Matrix<double, 6, 1> e = sensorErrors();
@@ -519,7 +514,7 @@ void ErrorStateEkf::predict(const ins::ImuSample& raw) {
 void ErrorStateEkf::predictCovariance(const ins::NavState& nominal, const Vector3d& w_IB_B,
                                       const Vector3d& f_B, double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt))
-    throw Error("covariance propagation at t = " + tstr(nominal.t) + " s: dt must be > 0");
+    throw Error("covariance propagation at t = " + formatNumber(nominal.t, 9) + " s: dt must be > 0");
   applyInterval();  // left over from predict()
   Cache& c = *cache_;
   const bool same = c.nominal_valid && c.nominal_dt == dt && c.w == w_IB_B && c.f == f_B &&
@@ -611,7 +606,7 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
   res.innovation = dz;
   Eigen::LLT<MatrixXd> llt(res.S);
   if (llt.info() != Eigen::Success || !res.S.allFinite())
-    throw Error("innovation covariance not positive definite at t = " + tstr(res.t) + " s");
+    throw Error("innovation covariance not positive definite at t = " + formatNumber(res.t, 9) + " s");
   res.nis = dz.dot(llt.solve(dz));
   if (cfg_.gate_probability > 0.0) {
     const boost::math::chi_squared chi2(mz);
@@ -653,7 +648,7 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
   Pc.diagonal().array() += 1e-9;
   c.llt.compute(Pc);
   if (c.llt.info() != Eigen::Success || !Pc.allFinite())
-    throw Error("filter covariance is not positive definite at t = " + tstr(res.t) +
+    throw Error("filter covariance is not positive definite at t = " + formatNumber(res.t, 9) +
                 " s after update");
   last_ = res;
   return res;
@@ -674,7 +669,7 @@ VectorXd ErrorStateEkf::residualGnssPosition(const earth::Geodetic& z, const Vec
 UpdateResult ErrorStateEkf::updateGnssPosition(const earth::Geodetic& z, const Vector3d& sigma,
                                                const Vector3d& lever_B, double dt_meas) {
   if (!(sigma.array() > 0.0).all() || !sigma.allFinite())
-    throw Error("GNSS position sigma must be > 0 at t = " + tstr(state().t) + " s");
+    throw Error("GNSS position sigma must be > 0 at t = " + formatNumber(state().t, 9) + " s");
   flushPropagation();
   const VectorXd dz = residualGnssPosition(z, lever_B, dt_meas);
   const MatrixXd R = sigma.cwiseAbs2().asDiagonal();
@@ -699,7 +694,7 @@ VectorXd ErrorStateEkf::residualGnssVelocity(const Vector3d& z_N, const Vector3d
 UpdateResult ErrorStateEkf::updateGnssVelocity(const Vector3d& z_N, const Vector3d& sigma,
                                                const Vector3d& lever_B, double dt_meas) {
   if (!(sigma.array() > 0.0).all() || !sigma.allFinite())
-    throw Error("GNSS velocity sigma must be > 0 at t = " + tstr(state().t) + " s");
+    throw Error("GNSS velocity sigma must be > 0 at t = " + formatNumber(state().t, 9) + " s");
   flushPropagation();
   const VectorXd dz = residualGnssVelocity(z_N, lever_B, dt_meas);
   const MatrixXd R = sigma.cwiseAbs2().asDiagonal();
@@ -736,7 +731,7 @@ UpdateResult ErrorStateEkf::updateNonHolonomic(double sigma_lat, double sigma_ve
 
 UpdateResult ErrorStateEkf::updateBaro(double h_meas, double sigma) {
   if (!(sigma > 0.0) || !std::isfinite(sigma))
-    throw Error("barometer sigma must be > 0 at t = " + tstr(state().t) + " s");
+    throw Error("barometer sigma must be > 0 at t = " + formatNumber(state().t, 9) + " s");
   VectorXd dz(1);
   dz(0) = state().h - h_meas;
   return update(dz, H_baro(), MatrixXd::Constant(1, 1, sigma * sigma));

@@ -5,18 +5,12 @@
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 
 namespace navimpact::filter {
 
 namespace {
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(4);
-  s << v;
-  return s.str();
-}
-
 // A GM with T <= t_max becomes white noise of the same long-run variance
 // (AR(1) spectrum at f = 0: sigma^2 (1 + phi) / (1 - phi) per sample), merged
 // into the axis' WN term (or added as one).
@@ -30,8 +24,8 @@ stochastic::Model whiteShortGms(const stochastic::Model& in, double t_max, const
     if (p.kind == stochastic::ProcessKind::GM && p.T <= t_max) {
       const double phi = std::exp(-1.0 / (in.rate_hz * p.T));
       add += p.sigma * p.sigma * (1.0 + phi) / (1.0 - phi);
-      notes.push_back(ch + ": GM(sigma=" + fmt(p.sigma) + ", T=" + fmt(p.T) +
-                      ") is shorter than the covariance propagation interval (" + fmt(t_max) +
+      notes.push_back(ch + ": GM(sigma=" + formatNumber(p.sigma, 4) + ", T=" + formatNumber(p.T, 4) +
+                      ") is shorter than the covariance propagation interval (" + formatNumber(t_max, 4) +
                       " s) and enters as white noise of the same long-run variance");
     } else {
       out.terms.push_back(p);
@@ -58,7 +52,7 @@ StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuError
     if (opt.turn_on_bias) {
       const double s = opt.turn_on_sigma[c];
       if (!(std::isfinite(s) && s > 0.0))
-        throw Error("turn-on bias sigma of " + ch + " must be finite and > 0, got " + fmt(s));
+        throw Error("turn-on bias sigma of " + ch + " must be finite and > 0, got " + formatNumber(s, 4));
       ProcessBlock b;
       b.channel = c;
       b.offset = static_cast<int>(L.names_.size());
@@ -68,7 +62,7 @@ StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuError
       b.ss.H = Eigen::RowVectorXd::Ones(1);
       b.ss.P0 = Eigen::MatrixXd::Constant(1, 1, s * s);
       b.ss.names = {"turn-on bias"};
-      L.names_.push_back(ch + ".TOB(sigma=" + fmt(s) + ")");
+      L.names_.push_back(ch + ".TOB(sigma=" + formatNumber(s, 4) + ")");
       L.blocks_.push_back(b);
     }
     if (model.axis[c].empty()) continue;

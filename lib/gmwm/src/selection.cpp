@@ -10,6 +10,7 @@
 
 #include "fit_internal.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
@@ -63,12 +64,6 @@ bool oneLess(const std::vector<ProcessKind>& a, const std::vector<ProcessKind>& 
   return diff == 1;
 }
 
-std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
-
 }  // namespace
 
 double optimism(const FitResult& f, const WaveletVariance& wv) {
@@ -107,7 +102,7 @@ double optimism(const FitResult& f, const WaveletVariance& wv) {
 
 std::vector<bool> negligibleTerms(const Model& m, const WaveletVariance& wv, double fraction) {
   if (!(fraction > 0.0 && fraction <= 1.0))
-    throw Error("negligibleTerms: fraction " + fmt(fraction) + " outside (0, 1]");
+    throw Error("negligibleTerms: fraction " + formatNumber(fraction, 4) + " outside (0, 1]");
   std::vector<bool> out(m.terms.size(), true);
   for (std::size_t i = 0; i < m.terms.size(); ++i)
     for (int j = 0; j < wv.scales() && out[i]; ++j)
@@ -234,10 +229,10 @@ std::vector<RankedModel> selectModel(const std::vector<std::vector<ProcessKind>>
     const RankedModel& b = out.front();
     const auto bk = kindsOf(b.fit.model);
     std::ostringstream os;
-    os << "picked " << stochastic::formatStructure(bk) << ": criterion " << fmt(b.criterion)
-       << " (objective " << fmt(b.fit.objective) << " + optimism " << fmt(b.optimism) << ")";
+    os << "picked " << stochastic::formatStructure(bk) << ": criterion " << formatNumber(b.criterion, 4)
+       << " (objective " << formatNumber(b.fit.objective, 4) << " + optimism " << formatNumber(b.optimism, 4) << ")";
     if (!dropped.empty())
-      os << " [preferred over a lower criterion with a term below " << fmt(kNegligibleFraction)
+      os << " [preferred over a lower criterion with a term below " << formatNumber(kNegligibleFraction, 4)
          << " of the WV's 95 % CI width at every scale: " << dropped << "]";
     // Best simpler neighbour (one term less) and best richer one (one term more).
     for (const auto& r : out) {
@@ -245,9 +240,9 @@ std::vector<RankedModel> selectModel(const std::vector<std::vector<ProcessKind>>
       const auto rk = kindsOf(r.fit.model);
       if (oneLess(rk, bk, &extra)) {
         os << "; without " << stochastic::kindName(extra) << " (" << stochastic::formatStructure(rk)
-           << ") the criterion is " << fmt(r.criterion) << ": the objective rises by "
-           << fmt(r.fit.objective - b.fit.objective) << " while the optimism falls only by "
-           << fmt(b.optimism - r.optimism);
+           << ") the criterion is " << formatNumber(r.criterion, 4) << ": the objective rises by "
+           << formatNumber(r.fit.objective - b.fit.objective, 4) << " while the optimism falls only by "
+           << formatNumber(b.optimism - r.optimism, 4);
         break;
       }
     }
@@ -265,15 +260,15 @@ std::vector<RankedModel> selectModel(const std::vector<std::vector<ProcessKind>>
     if (rich && b.fit.objective - rich->fit.objective > 1e-9 * b.fit.objective)
       os << "; adding " << stochastic::kindName(rich_extra) << " ("
          << stochastic::formatStructure(kindsOf(rich->fit.model)) << ") lowers the objective by "
-         << fmt(b.fit.objective - rich->fit.objective) << " but costs " << fmt(rich->optimism - b.optimism)
-         << " in optimism (criterion " << fmt(rich->criterion) << ")";
+         << formatNumber(b.fit.objective - rich->fit.objective, 4) << " but costs " << formatNumber(rich->optimism - b.optimism, 4)
+         << " in optimism (criterion " << formatNumber(rich->criterion, 4) << ")";
     else if (rich)
       os << "; no added term lowers the objective";
     // Runner-up: the best candidate with a different criterion value.
     for (std::size_t q = 1; q < out.size(); ++q)
       if (key(out[q]) != key(b)) {
         os << "; runner-up " << stochastic::formatStructure(kindsOf(out[q].fit.model)) << " at "
-           << fmt(out[q].criterion);
+           << formatNumber(out[q].criterion, 4);
         break;
       }
     *why = os.str();

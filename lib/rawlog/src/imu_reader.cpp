@@ -20,22 +20,11 @@
 
 #include "entry_reader.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::rawlog {
 
 namespace {
-
-std::string fmtG(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
-
-std::string fmtTime(double t) {
-  std::ostringstream os;
-  os << std::fixed << std::setprecision(6) << t;
-  return os.str();
-}
 
 struct Sample {
   double t;
@@ -71,15 +60,15 @@ ImuSeries readImuRawlog(const std::string& path, const std::string& label) {
     s.entry = entry;
     for (int k = 0; k < 6; ++k) {
       if (!imu->has(idx[k]))
-        throw Error(path + ": entry " + std::to_string(entry) + " (t = " + fmtTime(s.t) +
+        throw Error(path + ": entry " + std::to_string(entry) + " (t = " + formatFixed(s.t, 6) +
                     " s): CObservationIMU '" + label + "' has no " + names[k] + " value");
       s.v[k] = imu->rawMeasurements[idx[k]];
       if (!std::isfinite(s.v[k]))
-        throw Error(path + ": entry " + std::to_string(entry) + " (t = " + fmtTime(s.t) + " s): " +
+        throw Error(path + ": entry " + std::to_string(entry) + " (t = " + formatFixed(s.t, 6) + " s): " +
                     names[k] + " is not finite");
       if (std::abs(s.v[k]) > (k < 3 ? kMaxAbsAngularRate : kMaxAbsSpecificForce))
-        throw Error(path + ": entry " + std::to_string(entry) + " (t = " + fmtTime(s.t) + " s): " + names[k] +
-                    " = " + fmtG(s.v[k]) + " is beyond any IMU (|value| <= " +
+        throw Error(path + ": entry " + std::to_string(entry) + " (t = " + formatFixed(s.t, 6) + " s): " + names[k] +
+                    " = " + formatNumber(s.v[k]) + " is beyond any IMU (|value| <= " +
                     (k < 3 ? "1000 rad/s" : "1e5 m/s^2") + ")");
     }
     samples.push_back(s);
@@ -114,8 +103,8 @@ ImuSeries readImuRawlog(const std::string& path, const std::string& label) {
     dt[i - 1] = samples[i].t - samples[i - 1].t;
     if (!(dt[i - 1] > 0.0))
       throw Error(path + ": entry " + std::to_string(samples[i].entry) + ": IMU timestamp " +
-                  fmtTime(samples[i].t) + " s does not increase (previous " +
-                  fmtTime(samples[i - 1].t) + " s at entry " +
+                  formatFixed(samples[i].t, 6) + " s does not increase (previous " +
+                  formatFixed(samples[i - 1].t, 6) + " s at entry " +
                   std::to_string(samples[i - 1].entry) + ")");
   }
   std::vector<double> sorted = dt;
@@ -125,7 +114,7 @@ ImuSeries readImuRawlog(const std::string& path, const std::string& label) {
     if (std::fabs(dt[i] - med) > 0.01 * med) {
       std::ostringstream os;
       os << path << ": entry " << samples[i + 1].entry << ": IMU time step " << dt[i]
-         << " s at t = " << fmtTime(samples[i + 1].t) << " s differs from the median step " << med
+         << " s at t = " << formatFixed(samples[i + 1].t, 6) << " s differs from the median step " << med
          << " s by more than 1 % (gap or jitter; the series must be uniformly sampled)";
       throw Error(os.str());
     }

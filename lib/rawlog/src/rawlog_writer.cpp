@@ -22,6 +22,7 @@
 #include "entry_reader.hpp"
 #include "foreign_reader.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 
 namespace navimpact::rawlog {
@@ -337,11 +338,9 @@ Recording readRawlog(const std::string& path, const RawlogReadOptions& opt) {
       };
       auto rate = [&](mrpt::obs::TIMUDataIndex i, const char* name, double lim, const char* limText) {
         const double v = need(i, name);
-        if (std::abs(v) > lim) {
-          char b[32];
-          std::snprintf(b, sizeof b, "%g", v);
-          throw Error(where(label, t) + ": " + name + " = " + b + " is beyond any IMU (|value| <= " + limText + ")");
-        }
+        if (std::abs(v) > lim)
+          throw Error(where(label, t) + ": " + name + " = " + formatNumber(v) + " is beyond any IMU (|value| <= " +
+                      limText + ")");
         return v;
       };
       if (label == "IMU") {

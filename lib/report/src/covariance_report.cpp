@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/plot/figure.hpp"
 
@@ -35,15 +36,10 @@ void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStud
     csv << "time_s,model_set,model";
     for (const char* c : kCols) csv << "," << c;
     csv << "\n";
-    char buf[64];
     for (const CovarianceRun& r : res.runs) {
       for (std::size_t i = 0; i < r.t.size(); ++i) {
-        std::snprintf(buf, sizeof buf, "%.6g", r.t[i]);
-        csv << buf << "," << r.model_set << "," << r.model;
-        for (double v : r.sigma[i]) {
-          std::snprintf(buf, sizeof buf, ",%.9g", v);
-          csv << buf;
-        }
+        csv << formatNumber(r.t[i], 6) << "," << r.model_set << "," << r.model;
+        for (double v : r.sigma[i]) csv << "," << formatNumber(v, 9);
         csv << "\n";
       }
     }

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "navimpact/analysis/diagnosis.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
 #include "navimpact/report/diagnosis_report.hpp"
 #include "navimpact/stochastic/model_file.hpp"
@@ -191,11 +192,11 @@ std::string paramText(const Finding& f, const std::string& key, double v) {
   else if (key == "omega") u = " " + unit + "/sample";
   else if (key != "count") u = " " + unit;
   std::string name = key == "t_s" ? "t" : key == "freq_hz" ? "f" : key;
-  std::string s = name + " = " + fmtNum(v, key == "t_s" || key == "freq_hz" ? 6 : 3);
+  std::string s = name + " = " + formatNumber(v, key == "t_s" || key == "freq_hz" ? 6 : 3);
   for (const auto& kv : f.intervals)
     if (kv.first == key) {
-      const std::string lo = fmtNum(kv.second.first, 2), hi = fmtNum(kv.second.second, 2);
-      if (lo == hi) s += " ± " + fmtNum(0.5 * (kv.second.second - kv.second.first), 1);
+      const std::string lo = formatNumber(kv.second.first, 2), hi = formatNumber(kv.second.second, 2);
+      if (lo == hi) s += " ± " + formatNumber(0.5 * (kv.second.second - kv.second.first), 1);
       else s += " (" + lo + "–" + hi + ")";
     }
   return s + u;
@@ -218,7 +219,7 @@ std::string shortAction(const Finding& f) {
 std::string strength(double p) {
   if (!(p >= 0)) return "—";
   if (p < 1e-12) return "p < 1e-12";
-  return "p = " + fmtNum(p, 2);
+  return "p = " + formatNumber(p, 2);
 }
 
 }  // namespace
@@ -226,8 +227,8 @@ std::string strength(double p) {
 std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& figures) {
   std::ostringstream r;
   r << "# IMU error model diagnosis\n\n";
-  r << "`" << d.source << "`: " << d.samples << " samples at " << fmtNum(d.rate_hz, 6) << " Hz ("
-    << fmtNum(d.samples / d.rate_hz, 5) << " s); model `" << d.model_before.source << "`.\n\n";
+  r << "`" << d.source << "`: " << d.samples << " samples at " << formatNumber(d.rate_hz, 6) << " Hz ("
+    << formatNumber(d.samples / d.rate_hz, 5) << " s); model `" << d.model_before.source << "`.\n\n";
   int bad = 0, nf = 0;
   for (const auto& c : d.channels) {
     bad += c.adequate ? 0 : 1;
@@ -237,10 +238,10 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
   if (d.adequate)
     r << " — every channel is consistent with simulations of the model (outliers, spectral lines, level "
          "shifts, wavelet variance; family-wise false-alarm level "
-      << fmtNum(d.options.alpha * 100, 3) << " % for the whole record).\n\n";
+      << formatNumber(d.options.alpha * 100, 3) << " % for the whole record).\n\n";
   else
     r << " — " << bad << " of " << d.channels.size() << " channels, " << nf
-      << " finding(s) (family-wise level " << fmtNum(d.options.alpha * 100, 3) << " %).\n\n";
+      << " finding(s) (family-wise level " << formatNumber(d.options.alpha * 100, 3) << " %).\n\n";
   for (const auto& n : d.notices) r << "> " << n << "\n\n";
   if (!d.adequate) {
     // One row per channel and cause (several lines or shifts of a channel share it).
@@ -264,10 +265,10 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
           std::string one;
           for (const auto& kv : f.params) {
             if (f.cause == Cause::Outliers && kv.first == "count") {
-              one = fmtNum(kv.second, 4) + " event(s)";
+              one = formatNumber(kv.second, 4) + " event(s)";
               if (!f.times_s.empty()) {
-                one += " at t = " + fmtNum(f.times_s[0], 6);
-                for (std::size_t q = 1; q < std::min<std::size_t>(3, f.times_s.size()); ++q) one += ", " + fmtNum(f.times_s[q], 6);
+                one += " at t = " + formatNumber(f.times_s[0], 6);
+                for (std::size_t q = 1; q < std::min<std::size_t>(3, f.times_s.size()); ++q) one += ", " + formatNumber(f.times_s[q], 6);
                 one += f.times_s.size() > 3 ? ", … s" : " s";
               }
               continue;
@@ -293,8 +294,8 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
     r << "**Events on several channels** (each is one event, listed above under every channel it touches):\n\n";
     for (std::size_t i = 0; i < d.events.size(); ++i) {
       const auto& e = d.events[i];
-      r << i + 1 << ". t = " << fmtNum(e.t_s, 6) << " s";
-      if (e.duration_s > 0) r << " (" << fmtNum(e.duration_s, 2) << " s)";
+      r << i + 1 << ". t = " << formatNumber(e.t_s, 6) << " s";
+      if (e.duration_s > 0) r << " (" << formatNumber(e.duration_s, 2) << " s)";
       r << ": " << causeName(e.cause) << " on";
       for (const auto& ch : e.channels) r << " " << ch;
       r << "\n";
@@ -309,9 +310,9 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
     for (const auto& c : d.channels) {
       if (c.adequate) continue;
       const auto& g = c.gain;
-      r << "| " << c.name << " | " << fmtNum(g.objective_before, 4) << " → " << fmtNum(g.objective_after, 4) << " | "
-        << fmtNum(g.deviance_before, 4) << " → " << fmtNum(g.deviance_after, 4) << " | z = " << fmtNum(g.z, 3)
-        << ", p = " << fmtNum(g.p_value, 2) << (g.basis == "second_half" ? "" : " (whole record)") << " | "
+      r << "| " << c.name << " | " << formatNumber(g.objective_before, 4) << " → " << formatNumber(g.objective_after, 4) << " | "
+        << formatNumber(g.deviance_before, 4) << " → " << formatNumber(g.deviance_after, 4) << " | z = " << formatNumber(g.z, 3)
+        << ", p = " << formatNumber(g.p_value, 2) << (g.basis == "second_half" ? "" : " (whole record)") << " | "
         << (g.significant ? "significant, better" : "not significant, " + g.direction) << " |\n";
     }
     r << "\n";
@@ -319,12 +320,12 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
   if (d.navigation) {
     const NavGain& g = *d.navigation;
     for (const auto& o : g.outages)
-      r << "**Navigation** (" << g.runs << " paired runs, outage " << fmtNum(o.start_s, 5) << " s + "
-        << fmtNum(o.duration_s, 4) << " s): horizontal error at the end " << fmtNum(o.mean_h_before, 3) << " → "
-        << fmtNum(o.mean_h_after, 3) << " m, position ANEES " << fmtNum(o.anees_before, 3) << " → "
-        << fmtNum(o.anees_after, 3) << " (band " << fmtNum(o.nees_band.first, 3) << "–"
-        << fmtNum(o.nees_band.second, 3) << "); extension better in " << o.wins << " of " << g.runs << " runs: "
-        << (o.significant ? "significant" : "not significant") << " (sign test p = " << fmtNum(o.sign_p, 2)
+      r << "**Navigation** (" << g.runs << " paired runs, outage " << formatNumber(o.start_s, 5) << " s + "
+        << formatNumber(o.duration_s, 4) << " s): horizontal error at the end " << formatNumber(o.mean_h_before, 3) << " → "
+        << formatNumber(o.mean_h_after, 3) << " m, position ANEES " << formatNumber(o.anees_before, 3) << " → "
+        << formatNumber(o.anees_after, 3) << " (band " << formatNumber(o.nees_band.first, 3) << "–"
+        << formatNumber(o.nees_band.second, 3) << "); extension better in " << o.wins << " of " << g.runs << " runs: "
+        << (o.significant ? "significant" : "not significant") << " (sign test p = " << formatNumber(o.sign_p, 2)
         << ").\n\n";
   }
   r << "The extended model is in `model_extended.yaml`; the evidence follows below.\n\n";
@@ -347,8 +348,8 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
       r << "\n| tau [s] | measured WV | model WV | 95 % CI | ratio | significant |\n|---|---|---|---|---|---|\n";
       for (const auto& s : c.scales)
         if (s.outside95)
-          r << "| " << fmtNum(s.tau_s, 4) << " | " << fmtNum(s.measured, 3) << " | " << fmtNum(s.model, 3) << " | "
-            << fmtNum(s.ci_low, 3) << "–" << fmtNum(s.ci_high, 3) << " | " << fmtNum(s.ratio, 3) << " | "
+          r << "| " << formatNumber(s.tau_s, 4) << " | " << formatNumber(s.measured, 3) << " | " << formatNumber(s.model, 3) << " | "
+            << formatNumber(s.ci_low, 3) << "–" << formatNumber(s.ci_high, 3) << " | " << formatNumber(s.ratio, 3) << " | "
             << (s.significant ? "yes" : "no") << " |\n";
     }
     r << "\n";
@@ -362,12 +363,12 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
       << "| outage | horizontal error at end [m] | vertical [m] | max horizontal drift [m] | position ANEES (95 % band) | runs better | sign test p | paired t p |\n"
          "|---|---|---|---|---|---|---|---|\n";
     for (const auto& o : g.outages)
-      r << "| " << fmtNum(o.start_s, 5) << " s + " << fmtNum(o.duration_s, 4) << " s | " << fmtNum(o.mean_h_before, 3)
-        << " → " << fmtNum(o.mean_h_after, 3) << " | " << fmtNum(o.mean_v_before, 3) << " → " << fmtNum(o.mean_v_after, 3)
-        << " | " << fmtNum(o.mean_drift_before, 3) << " → " << fmtNum(o.mean_drift_after, 3) << " | "
-        << fmtNum(o.anees_before, 3) << " → " << fmtNum(o.anees_after, 3) << " (" << fmtNum(o.nees_band.first, 3) << "–"
-        << fmtNum(o.nees_band.second, 3) << ") | " << o.wins << " of " << g.runs << " | " << fmtNum(o.sign_p, 2) << " | "
-        << fmtNum(o.t_p, 2) << " |\n";
+      r << "| " << formatNumber(o.start_s, 5) << " s + " << formatNumber(o.duration_s, 4) << " s | " << formatNumber(o.mean_h_before, 3)
+        << " → " << formatNumber(o.mean_h_after, 3) << " | " << formatNumber(o.mean_v_before, 3) << " → " << formatNumber(o.mean_v_after, 3)
+        << " | " << formatNumber(o.mean_drift_before, 3) << " → " << formatNumber(o.mean_drift_after, 3) << " | "
+        << formatNumber(o.anees_before, 3) << " → " << formatNumber(o.anees_after, 3) << " (" << formatNumber(o.nees_band.first, 3) << "–"
+        << formatNumber(o.nees_band.second, 3) << ") | " << o.wins << " of " << g.runs << " | " << formatNumber(o.sign_p, 2) << " | "
+        << formatNumber(o.t_p, 2) << " |\n";
     r << "\nA navigation gain is significant only when the extension gives the smaller horizontal error at the outage "
          "end in significantly more runs than chance (exact sign test, p < 0.05); the runs share one recording.\n\n";
   }

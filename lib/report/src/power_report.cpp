@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "navimpact/core/format.hpp"
+
 namespace navimpact::report {
 
 using namespace analysis;
@@ -15,7 +17,7 @@ std::string powerTable(const PowerResult& r) {
   t << "| cause |";
   const auto& b = r.bins;
   for (std::size_t i = 0; i < b.size(); ++i)
-    t << " SNR " << fmtNum(b[i], 3) << "–" << (i + 1 < b.size() ? fmtNum(b[i + 1], 3) : std::string("")) << " |";
+    t << " SNR " << formatNumber(b[i], 3) << "–" << (i + 1 < b.size() ? formatNumber(b[i + 1], 3) : std::string("")) << " |";
   t << "\n|---|";
   for (std::size_t i = 0; i < b.size(); ++i) t << "---|";
   t << "\n";
@@ -35,7 +37,7 @@ std::string powerTable(const PowerResult& r) {
     t << "\n";
   }
   t << "\nCells: detected / runs (right cause and parameter). Null records (six channels, drawn from the model): "
-    << r.null_alarms << " of " << r.null_runs << " called inadequate at alpha " << fmtNum(r.options.alpha, 3) << ".\n";
+    << r.null_alarms << " of " << r.null_runs << " called inadequate at alpha " << formatNumber(r.options.alpha, 3) << ".\n";
   return t.str();
 }
 

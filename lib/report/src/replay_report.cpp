@@ -11,6 +11,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
 
 namespace navimpact::report {
@@ -20,12 +21,6 @@ using namespace analysis;
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-
-std::string num(double x) {
-  std::ostringstream o;
-  o << std::setprecision(10) << x;
-  return o.str();
-}
 
 /// Roll, pitch, yaw [rad] errors of est w.r.t. truth (yaw wrapped).
 Eigen::Vector3d eulerError(const ins::NavState& est, const ins::NavState& truth) {
@@ -114,8 +109,8 @@ void writeReplayFigures(const ReplayResult& r, OutputSet& out) {
     const double a = std::max(0.0, o.start_s - 0.1 * o.duration_s);
     const double b = std::min(tEnd, o.start_s + 1.1 * o.duration_s);
     const std::string name = "errors_outage_" + std::to_string(i + 1) + ".png";
-    plot::savePng(figure(a, b, "GNSS outage " + std::to_string(i + 1) + ": " + num(o.duration_s) + " s from " +
-                                   num(o.start_s) + " s — errors and ±1σ"),
+    plot::savePng(figure(a, b, "GNSS outage " + std::to_string(i + 1) + ": " + formatNumber(o.duration_s, 10) + " s from " +
+                                   formatNumber(o.start_s, 10) + " s — errors and ±1σ"),
                   out.stage(name).string());
   }
 }

@@ -9,6 +9,7 @@
 
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/plot/figure.hpp"
 #include "navimpact/report/study_report.hpp"
@@ -26,22 +27,6 @@ const char* kComp[9] = {"pos_N", "pos_E", "pos_D", "vel_N", "vel_E", "vel_D", "a
 const char* kBlock[4] = {"pos", "vel", "att", "all"};
 const int kDof[4] = {3, 3, 3, 9};
 
-std::string fmt(double x, int prec = 3) {
-  if (!std::isfinite(x)) return "n/a";
-  std::ostringstream s;
-  const double a = std::abs(x);
-  if (a != 0.0 && (a < 1e-3 || a >= 1e5))
-    s << std::scientific << std::setprecision(prec - 1) << x;
-  else
-    s << std::setprecision(prec) << x;
-  return s.str();
-}
-std::string fixed(double x, int d) {
-  if (!std::isfinite(x)) return "n/a";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(d) << x;
-  return s.str();
-}
 json jnum(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
 /// Derived metrics of one study.
@@ -416,8 +401,8 @@ void outageEndFigure(const View& v, const ModelSetSpec& s, const std::string& pa
   for (std::size_t o = 0; o < v.O; ++o) {
     const std::size_t k = v.endEpoch(o);
     plot::Axes ax;
-    ax.title = "outage " + fmt(v.r.meta.outages[o].start - v.r.meta.t0) + " to " +
-               fmt(v.r.meta.outages[o].end - v.r.meta.t0) + " s";
+    ax.title = "outage " + formatReadable(v.r.meta.outages[o].start - v.r.meta.t0) + " to " +
+               formatReadable(v.r.meta.outages[o].end - v.r.meta.t0) + " s";
     ax.xlabel = "model (legend order)";
     ax.ylabel = "horizontal position error [m]";
     double hi = 0.0;
@@ -453,7 +438,7 @@ void outageEndFigure(const View& v, const ModelSetSpec& s, const std::string& pa
 
 std::string bandText(const View& v, int dof) {
   const auto b = aneesBand(v.r.acc.runs, dof);
-  return "[" + fixed(b.first, 2) + ", " + fixed(b.second, 2) + "]";
+  return "[" + formatFixed(b.first, 2) + ", " + formatFixed(b.second, 2) + "]";
 }
 
 std::string report(const View& v, const std::vector<std::string>& figs_per_set_flat) {
@@ -464,14 +449,14 @@ std::string report(const View& v, const std::vector<std::string>& figs_per_set_f
         "(error-state EKF), in the manner of the emulation study of Khaghani et al. (2019), judged by "
         "accuracy and by consistency (Cucci, Voirol, Khaghani & Guerrier 2023).\n\n";
   md << "## What was compared\n\n";
-  md << "- trajectory: " << meta.trajectory << ", starting at file time " << fmt(meta.t0) << " s\n";
+  md << "- trajectory: " << meta.trajectory << ", starting at file time " << formatReadable(meta.t0) << " s\n";
   md << "- true IMU errors on all six axes: " << meta.truth_description << "\n";
   md << "- " << v.r.acc.runs << " Monte Carlo runs, study seed " << meta.seed
      << "; every candidate model sees the same error realisation, GNSS/baro noise and initial error in a "
         "run (paired comparison); each run is a complete EKF run on its own estimates\n";
   for (std::size_t o = 0; o < v.O; ++o)
-    md << "- GNSS outage " << o + 1 << ": from " << fmt(meta.outages[o].start - meta.t0) << " s to "
-       << fmt(meta.outages[o].end - meta.t0) << " s (" << fmt(meta.outages[o].end - meta.outages[o].start)
+    md << "- GNSS outage " << o + 1 << ": from " << formatReadable(meta.outages[o].start - meta.t0) << " s to "
+       << formatReadable(meta.outages[o].end - meta.t0) << " s (" << formatReadable(meta.outages[o].end - meta.outages[o].start)
        << " s without GNSS)\n";
   {
     std::istringstream s(meta.settings);
@@ -505,7 +490,7 @@ std::string report(const View& v, const std::vector<std::string>& figs_per_set_f
       const std::size_t k = v.endEpoch(o);
       const double dur = meta.outages[o].end - meta.outages[o].start;
       const SetVerdict sv = judge(v, s, o);
-      md << "### Outage " << o + 1 << " (" << fmt(dur) << " s), values at its end (t = " << fmt(v.rel(k))
+      md << "### Outage " << o + 1 << " (" << formatReadable(dur) << " s), values at its end (t = " << formatReadable(v.rel(k))
          << " s)\n\n";
       md << "| model | states | RMS horiz. pos. error [m] | predicted horiz. sigma [m] | mean max horiz. drift [m] "
             "| RMS yaw error [deg] | ANEES pos (band " << bandText(v, 3) << ") | ANEES all over the outage (mean) "
@@ -517,38 +502,38 @@ std::string report(const View& v, const std::vector<std::string>& figs_per_set_f
         const double an = v.anees(m, k, 0);
         const auto band = aneesBand(v.r.acc.runs, 3);
         const std::string flag = an > band.second ? " (over-optimistic)" : an < band.first ? " (pessimistic)" : "";
-        md << "| " << s.models[i] << " | " << meta.states[m] << " | " << fixed(v.rmsH(m, k), 2) << " | "
-           << fixed(v.sigH(m, k), 2) << " | " << fixed(A.drift_h[o] / v.R, 2) << " | "
-           << fmt(v.rms(m, k, 8) / units::kDeg) << " | " << fmt(an) << flag << " | "
-           << fmt(v.outageMeanAnees(m, o, 3)) << " | " << fixed(v.cov(m, k, 0, true), 2) << " | "
-           << fixed(A.steps > 0 ? 1e6 * A.wall_s / A.steps : 0.0, 2) << " | "
-           << (sv.adequate[i] ? "yes" : "no") << " (error x" << fixed(sv.err_ratio[i], 2) << ", ANEES x"
-           << fixed(sv.anees_ratio[i], 2) << ") |\n";
+        md << "| " << s.models[i] << " | " << meta.states[m] << " | " << formatFixed(v.rmsH(m, k), 2) << " | "
+           << formatFixed(v.sigH(m, k), 2) << " | " << formatFixed(A.drift_h[o] / v.R, 2) << " | "
+           << formatReadable(v.rms(m, k, 8) / units::kDeg) << " | " << formatReadable(an) << flag << " | "
+           << formatReadable(v.outageMeanAnees(m, o, 3)) << " | " << formatFixed(v.cov(m, k, 0, true), 2) << " | "
+           << formatFixed(A.steps > 0 ? 1e6 * A.wall_s / A.steps : 0.0, 2) << " | "
+           << (sv.adequate[i] ? "yes" : "no") << " (error x" << formatFixed(sv.err_ratio[i], 2) << ", ANEES x"
+           << formatFixed(sv.anees_ratio[i], 2) << ") |\n";
       }
       md << "\n";
       md << "![errors](" << figs_per_set_flat[fi++] << ")\n\n";
       md << "![NEES](" << figs_per_set_flat[fi++] << ")\n\n";
-      md << "**Recommendation for a " << fmt(dur) << " s outage:** ";
+      md << "**Recommendation for a " << formatReadable(dur) << " s outage:** ";
       if (sv.recommended.empty())
-        md << "no model stays within " << fmt(100 * meta.margin) << " % of " << s.reference << ".\n\n";
+        md << "no model stays within " << formatReadable(100 * meta.margin) << " % of " << s.reference << ".\n\n";
       else
         md << "**" << sv.recommended << "** is the simplest model (fewest filter states) whose horizontal "
            << "position error at the outage end and whose ANEES over the outage stay within "
-           << fmt(100 * meta.margin) << " % of the reference " << s.reference << ".\n\n";
+           << formatReadable(100 * meta.margin) << " % of the reference " << s.reference << ".\n\n";
       md << "**White noise alone (" << s.white_noise << ")** ";
       if (sv.wn_never_departs)
-        md << "stays within " << fmt(100 * meta.margin) << " % of " << s.reference
-           << " in horizontal error and predicted sigma for the whole " << fmt(dur) << " s outage.\n\n";
+        md << "stays within " << formatReadable(100 * meta.margin) << " % of " << s.reference
+           << " in horizontal error and predicted sigma for the whole " << formatReadable(dur) << " s outage.\n\n";
       else
-        md << "is enough for outages shorter than about **" << fmt(sv.wn_enough_below_s) << " s**: after that "
+        md << "is enough for outages shorter than about **" << formatReadable(sv.wn_enough_below_s) << " s**: after that "
            << "its horizontal position error "
            << (std::isnan(sv.wn_err_departs_s) ? std::string("never departs")
                                                 : "departs from " + s.reference + "'s by more than " +
-                                                      fmt(100 * meta.margin) + " % for good at " + fmt(sv.wn_err_departs_s) +
+                                                      formatReadable(100 * meta.margin) + " % for good at " + formatReadable(sv.wn_err_departs_s) +
                                                       " s")
            << " and its predicted sigma "
            << (std::isnan(sv.wn_sigma_departs_s) ? std::string("never departs")
-                                                  : "departs for good at " + fmt(sv.wn_sigma_departs_s) + " s")
+                                                  : "departs for good at " + formatReadable(sv.wn_sigma_departs_s) + " s")
            << " into the outage.\n\n";
       if (v.anees(v.index(s.reference), k, 0) > aneesBand(v.r.acc.runs, 3).second)
         md << "Caution: even the reference " << s.reference
@@ -567,17 +552,17 @@ std::string report(const View& v, const std::vector<std::string>& figs_per_set_f
     for (std::size_t o = 0; o < v.O; ++o) {
       const std::size_t k = v.endEpoch(o), wn = v.index(s.white_noise), ref = v.index(s.reference);
       const SetVerdict sv = judge(v, s, o);
-      md << "| " << s.title << " | " << fmt(meta.outages[o].end - meta.outages[o].start) << " | "
-         << fixed(v.rmsH(wn, k) / v.rmsH(ref, k), 2) << " | " << fmt(v.anees(wn, k, 0)) << " | "
-         << fmt(v.anees(ref, k, 0)) << " | " << (sv.recommended.empty() ? "none" : sv.recommended) << " | "
-         << (sv.wn_never_departs ? ">= " : "") << fmt(sv.wn_enough_below_s) << " |\n";
+      md << "| " << s.title << " | " << formatReadable(meta.outages[o].end - meta.outages[o].start) << " | "
+         << formatFixed(v.rmsH(wn, k) / v.rmsH(ref, k), 2) << " | " << formatReadable(v.anees(wn, k, 0)) << " | "
+         << formatReadable(v.anees(ref, k, 0)) << " | " << (sv.recommended.empty() ? "none" : sv.recommended) << " | "
+         << (sv.wn_never_departs ? ">= " : "") << formatReadable(sv.wn_enough_below_s) << " |\n";
     }
   md << "\n";
   md << "## Cost\n\n| model | states | wall time per run [s] | us per filter step |\n|---|---:|---:|---:|\n";
   for (std::size_t m = 0; m < v.M; ++m) {
     const auto& A = v.a(m);
-    md << "| " << meta.labels[m] << " | " << meta.states[m] << " | " << fixed(A.wall_s / v.R, 3) << " | "
-       << fixed(A.steps > 0 ? 1e6 * A.wall_s / A.steps : 0.0, 2) << " |\n";
+    md << "| " << meta.labels[m] << " | " << meta.states[m] << " | " << formatFixed(A.wall_s / v.R, 3) << " | "
+       << formatFixed(A.steps > 0 ? 1e6 * A.wall_s / A.steps : 0.0, 2) << " |\n";
   }
   md << "\nFiles: `study.json` (all metrics per model and outage, configuration, seeds, versions), "
         "`timeseries.csv` (per model and epoch: RMS error, predicted sigma, ANEES, coverage), the figures above.\n";

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/plot/figure.hpp"
 
@@ -18,12 +19,6 @@ std::string squaredUnit(units::Quantity q) {
 }
 
 std::vector<double> toStd(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
-
-std::string g6(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
 
 }  // namespace
 
@@ -88,7 +83,7 @@ void writeWvOutputs(const gmwm::RecordingWv& w, const std::string& input_json, O
 
 std::string wvSummary(const gmwm::RecordingWv& w) {
   std::ostringstream os;
-  os << "wavelet variance of " << w.source << ": " << w.samples << " samples at " << g6(w.rate_hz)
+  os << "wavelet variance of " << w.source << ": " << w.samples << " samples at " << formatNumber(w.rate_hz)
      << " Hz, " << (w.channels.empty() ? 0 : w.channels[0].wv.scales()) << " scales"
      << (w.options.robust ? " (robust)" : "") << "\n";
   char line[256];
@@ -97,8 +92,8 @@ std::string wvSummary(const gmwm::RecordingWv& w) {
   os << line;
   for (const auto& c : w.channels) {
     const int J = c.wv.scales() - 1;
-    const std::string lo = g6(c.wv.wv[0]) + " (" + g6(c.wv.tau[0] / w.rate_hz) + " s)";
-    const std::string hi = g6(c.wv.wv[J]) + " (" + g6(c.wv.tau[J] / w.rate_hz) + " s)";
+    const std::string lo = formatNumber(c.wv.wv[0]) + " (" + formatNumber(c.wv.tau[0] / w.rate_hz) + " s)";
+    const std::string hi = formatNumber(c.wv.wv[J]) + " (" + formatNumber(c.wv.tau[J] / w.rate_hz) + " s)";
     std::snprintf(line, sizeof line, "  %-8s %-11s %-22s %-22s\n", c.name.c_str(),
                   squaredUnit(c.quantity).c_str(), lo.c_str(), hi.c_str());
     os << line;

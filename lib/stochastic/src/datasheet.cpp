@@ -23,10 +23,10 @@ double modelAvar(const Model& m, double m_samples) {
   return 2.0 * wv;
 }
 
-std::string line(const char* label, double v, const char* unit) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "%-18s %.4g %s\n", label, v, unit);
-  return buf;
+std::string line(const char* label, double v, const std::string& unit) {
+  std::string l = label;
+  l.resize(std::max<std::size_t>(l.size(), 18), ' ');
+  return l + " " + formatNumber(v, 4) + " " + unit + "\n";
 }
 
 /// " (incl. 1 GM with T < 4 samples, 97 % of N^2)" when short GMs carry white noise.
@@ -125,13 +125,12 @@ DatasheetFigures datasheetFigures(const Model& m, double max_averaging_s) {
 std::string formatDatasheet(const DatasheetFigures& f, units::Quantity q) {
   using namespace units;
   std::string s;
-  char buf[64];
   if (q == Quantity::AngularRate) {
     // N [rad/sqrt(s)]: angle std after t is N sqrt(t) -> deg/sqrt(h) = N (180/pi) 60.
     if (f.noise_density) s += line("ARW", *f.noise_density / kDeg * kSqrtHour, ("deg/sqrt(h)" + whiteNote(f)).c_str());
     if (f.bias_instability) {
-      std::snprintf(buf, sizeof buf, "deg/h (ADEV min at %.3g s)", *f.bias_instability_tau_s);
-      s += line("bias instability", *f.bias_instability / kDeg * kHour, buf);
+      s += line("bias instability", *f.bias_instability / kDeg * kHour,
+                "deg/h (ADEV min at " + formatNumber(*f.bias_instability_tau_s, 3) + " s)");
     }
     if (!f.bias_instability_warning.empty()) s += "  warning: bias instability: " + f.bias_instability_warning + "\n";
     // K [rad/s/sqrt(s)] -> deg/h/sqrt(h) = K (180/pi) 3600 * 60.
@@ -142,8 +141,8 @@ std::string formatDatasheet(const DatasheetFigures& f, units::Quantity q) {
     // N [m/s^2*sqrt(s) = m/s/sqrt(s)] -> m/s/sqrt(h) = N 60.
     if (f.noise_density) s += line("VRW", *f.noise_density * kSqrtHour, ("m/s/sqrt(h)" + whiteNote(f)).c_str());
     if (f.bias_instability) {
-      std::snprintf(buf, sizeof buf, "mg (ADEV min at %.3g s)", *f.bias_instability_tau_s);
-      s += line("bias instability", *f.bias_instability / kG0 * 1e3, buf);
+      s += line("bias instability", *f.bias_instability / kG0 * 1e3,
+                "mg (ADEV min at " + formatNumber(*f.bias_instability_tau_s, 3) + " s)");
     }
     if (!f.bias_instability_warning.empty()) s += "  warning: bias instability: " + f.bias_instability_warning + "\n";
     // K [m/s^2/sqrt(s)] -> mg/sqrt(h) = K 60 / g0 * 1e3.

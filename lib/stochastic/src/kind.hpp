@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "navimpact/core/format.hpp"
 #include "navimpact/stochastic/block_likelihood.hpp"
 #include "navimpact/stochastic/datasheet.hpp"
 #include "navimpact/stochastic/process_kind.hpp"
@@ -91,12 +92,5 @@ void checkTau(double tau);
 
 /// The definition of a kind.
 const KindDef& kindDef(ProcessKind k);
-
-/// "%.4g", for state labels.
-inline std::string g4(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
 
 }  // namespace navimpact::stochastic::detail

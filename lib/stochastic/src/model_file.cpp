@@ -10,6 +10,7 @@
 #include <set>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 
@@ -136,12 +137,6 @@ std::vector<std::string> modelNames(const YAML::Node& root, const std::string& f
   return mapKeys(models, file, "models.");
 }
 
-std::string fmt17(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 }  // namespace
 
 const Model& ImuModel::forChannel(const std::string& channel) const {
@@ -210,7 +205,7 @@ std::string toYaml(const ImuModel& m, const std::string& comment) {
   }
   s += "# IMU error model: per-sample parameters at rate_hz (WN sigma, QN Q, RW gamma,\n"
        "# DR omega per sample; GM sigma stationary, T in s; SIN amp, freq in Hz).\n";
-  s += "rate_hz: " + fmt17(m.rate_hz) + "  # Hz\n";
+  s += "rate_hz: " + formatNumber(m.rate_hz, 17) + "  # Hz\n";
   auto q = [](const Model& a) { return "\"" + formatTerms(a.terms, 17) + "\""; };
   const bool gyro_same = m.axis[0].terms == m.axis[1].terms && m.axis[0].terms == m.axis[2].terms;
   const bool acc_same = m.axis[3].terms == m.axis[4].terms && m.axis[3].terms == m.axis[5].terms;

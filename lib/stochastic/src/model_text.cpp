@@ -230,19 +230,6 @@ Process parseTerm(Parser& P, double rate_hz) {
   return p;
 }
 
-/// %g with @p digits significant digits; digits >= 17 means "exact": the
-/// shortest of 15, 16, 17 digits that reads back as the same double.
-std::string fmt(double v, int digits) {
-  char buf[64];
-  if (digits >= 17) {
-    for (int d = 15; d <= 17; ++d) {
-      std::snprintf(buf, sizeof buf, "%.*g", d, v);
-      if (std::strtod(buf, nullptr) == v) return buf;
-    }
-  }
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
 
 }  // namespace
 
@@ -277,7 +264,9 @@ std::string formatTerms(const std::vector<Process>& terms, int digits) {
     s += info.name;
     s += "(";
     for (std::size_t k = 0; k < info.params.size(); ++k)
-      s += std::string(k ? ", " : "") + info.params[k].key + "=" + fmt(p.*info.params[k].field, digits);
+      s += std::string(k ? ", " : "") + info.params[k].key + "=" +
+           // digits >= 17: exact (formatExact: the lowest precision 15..17 that reads back)
+           (digits >= 17 ? formatExact(p.*info.params[k].field) : formatNumber(p.*info.params[k].field, digits));
     s += ")";
   }
   return s;

@@ -195,7 +195,7 @@ class GaussMarkov final : public KindDef {
     b.Qc(0, 0) = 2.0 * p.sigma * p.sigma / p.T;
     b.H(0) = 1.0;
     b.P0(0, 0) = p.sigma * p.sigma;
-    b.names = {"(T=" + g4(p.T) + "s)"};
+    b.names = {"(T=" + formatNumber(p.T, 4) + "s)"};
   }
 
   std::function<double(double)> density(const Process& p, double rate_hz) const override {

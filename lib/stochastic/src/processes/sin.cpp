@@ -91,7 +91,7 @@ class Sinusoid final : public KindDef {
     b.F(1, 0) = -w;
     b.H(0) = 1.0;
     b.P0(0, 0) = b.P0(1, 1) = 0.5 * p.amp * p.amp;
-    const std::string f = "(f=" + g4(p.freq_hz) + "Hz)";
+    const std::string f = "(f=" + formatNumber(p.freq_hz, 4) + "Hz)";
     b.names = {f + ".a", f + ".b"};
   }
 

@@ -308,9 +308,6 @@ struct Diagnosis {
 Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
                    const DiagnoseOptions& opt = {});
 
-/// Short number formatting for reports ("3.1e-05", "45.2").
-std::string fmtNum(double v, int digits = 3);
-
 /// Unit name of a channel's SI unit ("rad/s" or "m/s^2").
 std::string channelUnit(const std::string& channel);
 
