@@ -17,6 +17,7 @@
 
 #include "navimpact/core/build_info.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 #include "study_internal.hpp"
 
@@ -25,13 +26,6 @@ namespace navimpact::analysis {
 using nlohmann::json;
 
 namespace {
-
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
 
 // FNV-1a 64: a fingerprint of the inputs, to refuse shards of other inputs.
 struct Fnv {
@@ -91,7 +85,7 @@ std::string inputsHash(const SweepConfig& cfg) {
 
 std::string columnName(const SweepConfig& cfg, const SweepColumn& c) {
   return "GNSS " + cfg.gnss[c.gnss].name + ", " + (cfg.baro[c.baro] ? "baro on" : "baro off") + ", IMU " +
-         num(cfg.imu_rates_hz[c.rate]) + " Hz";
+         formatNumber(cfg.imu_rates_hz[c.rate]) + " Hz";
 }
 
 }  // namespace
@@ -176,7 +170,7 @@ std::shared_ptr<const SweepPlan> prepareSweep(const SweepConfig& cfg, const std:
           for (std::size_t j = 0; j < idx.size(); ++j)
             if (std::abs(sm.epochs[idx[j]] - o.end) <= half) found = j;
           if (found == idx.size())
-            throw Error("sweep: no record epoch at the end of the " + num(o.end - start) + " s outage in " + col.name);
+            throw Error("sweep: no record epoch at the end of the " + formatNumber(o.end - start) + " s outage in " + col.name);
           col.duration_epoch.push_back(found);
         }
         plan->studies.push_back(sp);

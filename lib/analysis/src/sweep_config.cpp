@@ -6,6 +6,7 @@
 
 #include "navimpact/analysis/sweep.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/text_io.hpp"
 
 namespace navimpact::analysis {
@@ -42,14 +43,9 @@ struct Reader {
     const double v = get<double>(n, key);
     if (!std::isfinite(v) || v < lo || (open_lo && v == lo) || v > hi)
       throw keyError(file, key,
-                     "must be a number in " + std::string(open_lo ? "(" : "[") + fmtG(lo) + ", " + fmtG(hi) + "] " +
-                         unit + ", got " + fmtG(v));
+                     "must be a number in " + std::string(open_lo ? "(" : "[") + formatNumber(lo) + ", " + formatNumber(hi) + "] " +
+                         unit + ", got " + formatNumber(v));
     return v;
-  }
-  static std::string fmtG(double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%.6g", v);
-    return b;
   }
 };
 

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::filter {
 
@@ -16,13 +17,6 @@ using Eigen::Vector3d;
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRad2Deg = 180.0 / kPi;
-
-std::string num(double x, int prec = 4) {
-  std::ostringstream s;
-  s.precision(prec);
-  s << x;
-  return s.str();
-}
 
 Quaterniond quatZ(double yaw) { return Quaterniond(Eigen::AngleAxisd(yaw, Vector3d::UnitZ())); }
 
@@ -34,7 +28,7 @@ double yawOf(const Quaterniond& q) { return ins::rollPitchYaw(q.toRotationMatrix
 
 Eigen::Vector2d levelRollPitch(const Vector3d& f_B) {
   if (!f_B.allFinite() || f_B.norm() < 1.0)
-    throw Error("levelling: mean specific force of " + num(f_B.norm()) +
+    throw Error("levelling: mean specific force of " + formatNumber(f_B.norm(), 4) +
                 " m/s^2 is not gravity (accelerometer units or axes wrong?)");
   // Groves 2013 eq. 5.101
   return {std::atan2(-f_B.y(), -f_B.z()), std::atan2(f_B.x(), std::hypot(f_B.y(), f_B.z()))};
@@ -45,14 +39,14 @@ Eigen::Vector2d levelRollPitch(const Vector3d& f_B) {
 StaticDetector::StaticDetector(const StaticDetectorOptions& opt, double rate) : opt_(opt) {
   if (!(rate > 0.0) || !std::isfinite(rate)) throw Error("static detector: IMU rate must be > 0 Hz");
   if (!(opt.window_s > 0.0) || !std::isfinite(opt.window_s))
-    throw Error("static detector: window must be > 0 s, got " + num(opt.window_s));
+    throw Error("static detector: window must be > 0 s, got " + formatNumber(opt.window_s, 4));
   w_ = static_cast<int>(std::lround(opt.window_s * rate));
-  if (w_ < 2) throw Error("static detector: window of " + num(opt.window_s) + " s holds fewer than 2 IMU samples");
+  if (w_ < 2) throw Error("static detector: window of " + formatNumber(opt.window_s, 4) + " s holds fewer than 2 IMU samples");
   if (!(opt.gyro_sigma_rad_s.array() > 0.0).all() || !opt.gyro_sigma_rad_s.allFinite() ||
       !(opt.acc_sigma_mps2.array() > 0.0).all() || !opt.acc_sigma_mps2.allFinite())
     throw Error("static detector: at-rest sigmas must be > 0");
   if (!(opt.false_alarm > 0.0 && opt.false_alarm < 0.5))
-    throw Error("static detector: false-alarm probability must be in (0, 0.5), got " + num(opt.false_alarm));
+    throw Error("static detector: false-alarm probability must be in (0, 0.5), got " + formatNumber(opt.false_alarm, 4));
   if (!(opt.max_mean_rate_rad_s > 0.0)) throw Error("static detector: max_mean_rate_rad_s must be > 0");
   thr_ = boost::math::quantile(boost::math::chi_squared(6.0 * (w_ - 1)), 1.0 - opt.false_alarm);
   for (int a = 0; a < 3; ++a) {
@@ -166,7 +160,7 @@ void CoarseAligner::levelStatic(const Sums& sums) {
   const Quaterniond qi = q_rest_end_.conjugate();
   q_BtoB0_ = (qi * q_BtoB0_).normalized();
   for (FixRec& r : fixes_) r.q_BtoB0 = r.fix.t <= t_rest_end_ ? Quaterniond::Identity() : (qi * r.q_BtoB0).normalized();
-  rep_.notes.push_back("levelled from the accelerometers over " + num(span, 4) +
+  rep_.notes.push_back("levelled from the accelerometers over " + formatNumber(span, 4) +
                        " s at rest at the start; the mean gyro output there is removed as bias (with Earth rate)");
 }
 
@@ -175,7 +169,7 @@ void CoarseAligner::endRest(const Sums& sums, const std::string& why) {
     levelStatic(sums);
   } else {
     static_start_ = false;
-    rep_.notes.push_back("not at rest for " + num(opt_.min_static_s, 4) + " s at the start (" + why + ")");
+    rep_.notes.push_back("not at rest for " + formatNumber(opt_.min_static_s, 4) + " s at the start (" + why + ")");
   }
 }
 
@@ -188,8 +182,8 @@ void CoarseAligner::levelQuasiStatic() {
   rep_.levelling = "quasi_static";
   rep_.level_span_s = qs_T_;
   rep_.notes.push_back("not at rest at the start and no GNSS velocity to correct for the acceleration: levelled over the first " +
-                       num(qs_T_, 4) + " s as if at rest (tilt sigma " + num(sigma_tilt_ * kRad2Deg, 3) +
-                       " deg from an assumed acceleration of " + num(opt_.accel_sigma_mps2, 3) + " m/s^2)");
+                       formatNumber(qs_T_, 4) + " s as if at rest (tilt sigma " + formatNumber(sigma_tilt_ * kRad2Deg, 3) +
+                       " deg from an assumed acceleration of " + formatNumber(opt_.accel_sigma_mps2, 3) + " m/s^2)");
 }
 
 bool CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
@@ -236,7 +230,7 @@ bool CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
   t_levelled_ = t_last_;
   rep_.levelling = "gnss_velocity";
   rep_.level_span_s = T;
-  rep_.notes.push_back("moving at the start: levelled by matching the specific force over " + num(T, 4) +
+  rep_.notes.push_back("moving at the start: levelled by matching the specific force over " + formatNumber(T, 4) +
                        " s to the GNSS velocity change minus gravity");
   if (!heading_) {
     yaw0_ = yawFor(r, p);
@@ -342,7 +336,7 @@ void CoarseAligner::finish(const FixRec& r) {
     for (int i = 0; i < 3; ++i)
       sv(i) = std::hypot(std::hypot(a.fix.sigma_pos_N(i), r.fix.sigma_pos_N(i)) / dt,
                          0.5 * opt_.accel_sigma_mps2 * dt);
-    vnote = "mean velocity over the last " + num(dt, 4) + " s between GNSS fixes";
+    vnote = "mean velocity over the last " + formatNumber(dt, 4) + " s between GNSS fixes";
   }
   const Vector3d p = imuPosition(r) + v * (t_last_ - r.fix.t);
   const earth::Geodetic g = earth::nedToGeodetic(*origin_, p);
@@ -375,11 +369,11 @@ void CoarseAligner::finish(const FixRec& r) {
   rep_.static_at_end = vnote.rfind("at rest", 0) == 0;
   if (rep_.levelling == "static")
     rep_.gyro_bias_B = gyro_bias_ - (q_B0toN().conjugate() * earth::w_IE_N(g.lat));
-  rep_.notes.push_back("aligned at t = " + num(t_last_, 8) + " s: roll " + num(rep_.rpy[0] * kRad2Deg, 4) +
-                       ", pitch " + num(rep_.rpy[1] * kRad2Deg, 4) + ", yaw " + num(rep_.rpy[2] * kRad2Deg, 4) +
-                       " deg (1-sigma " + num(s_tilt * kRad2Deg, 3) + " / " + num(s_yaw * kRad2Deg, 3) +
+  rep_.notes.push_back("aligned at t = " + formatNumber(t_last_, 8) + " s: roll " + formatNumber(rep_.rpy[0] * kRad2Deg, 4) +
+                       ", pitch " + formatNumber(rep_.rpy[1] * kRad2Deg, 4) + ", yaw " + formatNumber(rep_.rpy[2] * kRad2Deg, 4) +
+                       " deg (1-sigma " + formatNumber(s_tilt * kRad2Deg, 3) + " / " + formatNumber(s_yaw * kRad2Deg, 3) +
                        " deg), heading from " + rep_.heading + ", position from the GNSS fix at " +
-                       num(r.fix.t, 8) + " s, velocity " + vnote);
+                       formatNumber(r.fix.t, 8) + " s, velocity " + vnote);
 }
 
 void CoarseAligner::addImu(const ins::ImuSample& s) {
@@ -423,7 +417,7 @@ void CoarseAligner::addImu(const ins::ImuSample& s) {
   }
   if (want_quasi_static_ && !levelled_ && qs_T_ >= opt_.level_window_s - 0.5 / rate_) levelQuasiStatic();
   if (s.t - t0_ > opt_.max_align_s)
-    throw Error("alignment not complete after " + num(opt_.max_align_s, 6) + " s of IMU data: " + missing());
+    throw Error("alignment not complete after " + formatNumber(opt_.max_align_s, 6) + " s of IMU data: " + missing());
 }
 
 void CoarseAligner::addFix(const AlignmentFix& f) {
@@ -490,10 +484,10 @@ std::string CoarseAligner::missing() const {
   std::vector<std::string> m;
   if (!levelled_)
     m.push_back(static_start_ ? "levelling (still at rest; it ends when the vehicle moves or after " +
-                                    num(opt_.max_level_s, 4) + " s)"
+                                    formatNumber(opt_.max_level_s, 4) + " s)"
                               : "levelling (moving at the start, waiting for GNSS fixes)");
   if (!heading_)
-    m.push_back("heading (no GNSS course with a 1-sigma below " + num(opt_.max_course_sigma_rad * kRad2Deg, 3) +
+    m.push_back("heading (no GNSS course with a 1-sigma below " + formatNumber(opt_.max_course_sigma_rad * kRad2Deg, 3) +
                 " deg yet: the vehicle has not moved far enough between fixes; give the initial heading)");
   if (!origin_) m.push_back("position (no GNSS fix since the start of the IMU data)");
   if (m.empty()) m.push_back("a GNSS fix with a velocity (moving, or a second fix)");

@@ -703,7 +703,7 @@ UpdateResult ErrorStateEkf::updateGnssVelocity(const Vector3d& z_N, const Vector
 
 UpdateResult ErrorStateEkf::updateZeroVelocity(double sigma) {
   if (!(sigma > 0.0) || !std::isfinite(sigma))
-    throw Error("zero-velocity update sigma must be > 0 at t = " + tstr(state().t) + " s");
+    throw Error("zero-velocity update sigma must be > 0 at t = " + formatNumber(state().t, 9) + " s");
   flushPropagation();
   const VectorXd dz = state().v_N;
   return update(dz, H_zeroVelocity(), MatrixXd::Identity(3, 3) * (sigma * sigma));
@@ -720,7 +720,7 @@ UpdateResult ErrorStateEkf::updateNonHolonomic(double sigma_lat, double sigma_ve
                                                const Vector3d& point_B) {
   if (!(sigma_lat > 0.0) || !std::isfinite(sigma_lat) || !(sigma_vert > 0.0) ||
       !std::isfinite(sigma_vert))
-    throw Error("non-holonomic constraint sigmas must be > 0 at t = " + tstr(state().t) + " s");
+    throw Error("non-holonomic constraint sigmas must be > 0 at t = " + formatNumber(state().t, 9) + " s");
   flushPropagation();
   const VectorXd dz = residualNonHolonomic(point_B);
   MatrixXd R = MatrixXd::Zero(2, 2);

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
 
 namespace navimpact::report {
@@ -18,22 +19,6 @@ using nlohmann::json;
 
 namespace {
 
-std::string fmt(double x, int prec = 3) {
-  if (!std::isfinite(x)) return "n/a";
-  std::ostringstream s;
-  const double a = std::abs(x);
-  if (a != 0.0 && (a < 1e-3 || a >= 1e5))
-    s << std::scientific << std::setprecision(prec - 1) << x;
-  else
-    s << std::setprecision(prec) << x;
-  return s.str();
-}
-std::string fixed(double x, int d) {
-  if (!std::isfinite(x)) return "n/a";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(d) << x;
-  return s.str();
-}
 json jnum(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 json jtime(double x) { return x >= 0.0 ? json(x) : json(nullptr); }
 
@@ -54,12 +39,12 @@ const char* kThresholdRule =
 
 std::string thresholdText(const WnThreshold& t) {
   if (!t.defined) return "n/a";
-  if (t.departs_s < 0) return "> " + fmt(t.scanned_to_s) + " s";
-  return fmt(t.departs_s) + " s";
+  if (t.departs_s < 0) return "> " + formatReadable(t.scanned_to_s) + " s";
+  return formatReadable(t.departs_s) + " s";
 }
 std::string intervalText(const WnThreshold& t) {
   if (!t.defined) return "n/a";
-  auto b = [&](double v) { return v < 0 ? "> " + fmt(t.scanned_to_s) : fmt(v); };
+  auto b = [&](double v) { return v < 0 ? "> " + formatReadable(t.scanned_to_s) : formatReadable(v); };
   return "[" + b(t.lo_s) + ", " + b(t.hi_s) + "] s";
 }
 
@@ -103,7 +88,7 @@ plot::Color cellColor(const CandidateVerdict& v, double margin) {
 }
 
 std::string cellText(const CandidateVerdict& v) {
-  std::string s = fmt(v.ratio, 3);
+  std::string s = formatReadable(v.ratio, 3);
   if (v.worse || !v.consistent) {
     s += " \u2717";  // ✗
     if (v.worse) s += "e";
@@ -135,7 +120,7 @@ void drawMap(const SweepResults& r, std::size_t c, const std::string& path) {
                thresholdText(sr.threshold) + ", 95 % " + intervalText(sr.threshold) +
                (sr.cells.empty() || sr.cells.back().reference_consistent ? "" : " (reference inconsistent)");
     ax.xlabel = "GNSS outage duration";
-    for (std::size_t j = 0; j < D; ++j) ax.xticks.push_back({j + 0.5, fmt(meta.durations_s[j]) + " s"});
+    for (std::size_t j = 0; j < D; ++j) ax.xticks.push_back({j + 0.5, formatReadable(meta.durations_s[j]) + " s"});
     for (std::size_t i = 0; i < S; ++i) ax.yticks.push_back({double(S - 1 - i) + 0.5, sr.set.models[i]});
     for (std::size_t j = 0; j < D; ++j)
       for (std::size_t i = 0; i < S; ++i) {
@@ -166,10 +151,10 @@ std::string reportMd(const SweepResults& r, const std::vector<std::string>& maps
   std::ostringstream md;
   md << "# Model-sufficiency map: which IMU model is enough for this application?\n\n";
   md << "Config `" << meta.config_file << "`, " << r.runs << " paired runs per cell (seed " << meta.seed
-     << "), GNSS outage from " << fmt(meta.outage_start_s) << " s, durations";
-  for (double d : meta.durations_s) md << " " << fmt(d);
+     << "), GNSS outage from " << formatReadable(meta.outage_start_s) << " s, durations";
+  for (double d : meta.durations_s) md << " " << formatReadable(d);
   md << " s; " << meta.columns.size() << " column(s) of GNSS quality x barometer x IMU rate; margin "
-     << fmt(100 * meta.margin) << " %, alpha " << fmt(meta.alpha) << ".\n\n";
+     << formatReadable(100 * meta.margin) << " %, alpha " << formatReadable(meta.alpha) << ".\n\n";
 
   md << "## The paper's threshold, per sensor\n\n"
      << "Khaghani et al. (2019): \"at least 10 seconds is needed to observe a meaningful difference\" between "
@@ -184,13 +169,13 @@ std::string reportMd(const SweepResults& r, const std::vector<std::string>& maps
     for (const auto& sr : r.columns[c].sets) {
       const auto& t = sr.threshold;
       if (!t.defined) continue;
-      auto when = [&](double v) { return v < 0 ? "> " + fmt(t.scanned_to_s) + " s" : fmt(v) + " s"; };
+      auto when = [&](double v) { return v < 0 ? "> " + formatReadable(t.scanned_to_s) + " s" : formatReadable(v) + " s"; };
       md << "| " << sr.set.title << " | " << meta.columns[c].name << " | " << t.white_noise << " vs "
          << t.reference << " | **" << thresholdText(t) << "** | " << intervalText(t) << " | "
-         << (t.first_departure_s < 0 ? "never" : fmt(t.first_departure_s) + " s") << " | " << when(t.significant_s)
+         << (t.first_departure_s < 0 ? "never" : formatReadable(t.first_departure_s) + " s") << " | " << when(t.significant_s)
          << " |\n";
     }
-  md << "\nDeparts: RMS horizontal error more than " << fmt(100 * meta.margin)
+  md << "\nDeparts: RMS horizontal error more than " << formatReadable(100 * meta.margin)
      << " % above the reference's, or consistency lost; the threshold is this estimated effect. \"Significantly "
         "insufficient\" is where the map's test has the evidence (it moves earlier as runs are added); between "
         "the two a cell can read sufficient: not yet shown to be worse.\n\n";
@@ -204,7 +189,7 @@ std::string reportMd(const SweepResults& r, const std::vector<std::string>& maps
     for (std::size_t s = 0; s < r.columns[c].sets.size(); ++s) md << "---|";
     md << "\n";
     for (std::size_t j = 0; j < meta.durations_s.size(); ++j) {
-      md << "| " << fmt(meta.durations_s[j]) << " |";
+      md << "| " << formatReadable(meta.durations_s[j]) << " |";
       for (const auto& sr : r.columns[c].sets) {
         const auto& cell = sr.cells[j];
         md << " " << (cell.recommended.empty() ? "none" : cell.recommended)
@@ -229,10 +214,10 @@ std::string reportMd(const SweepResults& r, const std::vector<std::string>& maps
             "p NEES vs ref | verdict |\n|---:|---|---:|---:|---:|---:|---:|---:|---|---:|---|\n";
       for (const auto& cell : sr.cells)
         for (const auto& v : cell.models)
-          md << "| " << fmt(cell.duration_s) << " | " << v.label << (cell.recommended == v.label ? " **(rec.)**" : "")
-             << " | " << v.states << " | " << fmt(v.rms_h_m) << " | " << fixed(v.ratio, 3) << " | " << fmt(v.p_worse, 2)
-             << " | " << v.runs_worse << "/" << r.runs << " | " << fmt(v.anees) << " | [" << fixed(v.band_lo, 2)
-             << ", " << fixed(v.band_hi, 2) << "] | " << fmt(v.p_nees_vs_ref, 2) << " | "
+          md << "| " << formatReadable(cell.duration_s) << " | " << v.label << (cell.recommended == v.label ? " **(rec.)**" : "")
+             << " | " << v.states << " | " << formatReadable(v.rms_h_m) << " | " << formatFixed(v.ratio, 3) << " | " << formatReadable(v.p_worse, 2)
+             << " | " << v.runs_worse << "/" << r.runs << " | " << formatReadable(v.anees) << " | [" << formatFixed(v.band_lo, 2)
+             << ", " << formatFixed(v.band_hi, 2) << "] | " << formatReadable(v.p_nees_vs_ref, 2) << " | "
              << (v.sufficient ? "sufficient" : std::string("insufficient") + (v.worse ? ", worse" : "") +
                                                    (!v.consistent ? ", NEES outside band" : ""))
              << (v.consistent_as_reference ? " (as consistent as the reference)" : "")
