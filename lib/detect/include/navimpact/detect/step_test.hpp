@@ -41,7 +41,7 @@
 namespace navimpact::detect {
 
 struct StepTestOptions {
-  std::size_t target_blocks = 512;   ///< block means used (blocks of max(1, n / target) samples)
+  std::size_t target_blocks = 128;   ///< block means used (blocks of max(1, n / target) samples)
   /// Maximise the likelihood over the variance of every random term under
   /// each hypothesis (a generalised likelihood ratio); false: the model as given.
   bool profile_variances = true;
