@@ -55,28 +55,13 @@ navimpact::gmwm::RecordingFitOptions fitOptions(const std::string& spec, const O
   return f;
 }
 
-std::vector<na::OutageWindow> checkOutages(const Opts& o) {
-  std::vector<na::OutageWindow> w;
+std::vector<navimpact::Outage> checkOutages(const Opts& o) {
+  std::vector<navimpact::Outage> w;
   if (!o.outages.empty() && o.trajectory.empty())
     throw navimpact::Error("--outage needs --trajectory (the navigation part runs along it)");
   if (!o.trajectory.empty() && o.outages.empty())
     throw navimpact::Error("--trajectory needs at least one --outage START:DURATION");
-  for (const auto& spec : o.outages) {
-    const auto c = spec.find(':');
-    double a = NAN, b = NAN;
-    try {
-      if (c == std::string::npos) throw std::invalid_argument("no colon");
-      std::size_t p1 = 0, p2 = 0;
-      a = std::stod(spec.substr(0, c), &p1);
-      b = std::stod(spec.substr(c + 1), &p2);
-      if (p1 != c || p2 != spec.size() - c - 1) throw std::invalid_argument("trailing text");
-    } catch (const std::exception&) {
-      throw navimpact::Error("--outage '" + spec + "': expected START:DURATION in seconds");
-    }
-    if (!(a >= 0) || !(b > 0))
-      throw navimpact::Error("--outage '" + spec + "': START must be >= 0 and DURATION > 0");
-    w.push_back({a, a + b});
-  }
+  for (const auto& spec : o.outages) w.push_back(navimpact::parseOutage(spec, "--outage"));
   if (!o.trajectory.empty() && !std::filesystem::exists(o.trajectory))
     throw navimpact::Error("--trajectory " + o.trajectory + ": no such file");
   if (o.nav_runs < 2) throw navimpact::Error("--nav-runs must be >= 2");

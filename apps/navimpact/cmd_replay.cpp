@@ -49,7 +49,7 @@ navimpact::cli::Registrar reg({
         if (!o->gnss_label.empty()) cfg.gnss_label = o->gnss_label;
         if (!o->outages.empty()) {
           cfg.outages.clear();
-          for (const auto& s : o->outages) cfg.outages.push_back(navimpact::analysis::parseOutage(s));
+          for (const auto& s : o->outages) cfg.outages.push_back(navimpact::parseOutage(s));
         }
         if (o->propagate_every > 0) cfg.propagate_every = o->propagate_every;
         const auto r = navimpact::analysis::runReplay(cfg);

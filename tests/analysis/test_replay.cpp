@@ -40,7 +40,7 @@ TEST(Replay, PerfectImuStaysWithinItsPredictedSigmaThroughAnOutage) {
   an::ReplayConfig c;
   c.rawlog = path;
   c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
-  c.outages.push_back({30.0, 20.0});
+  c.outages.push_back(navimpact::Outage::fromStartDuration(30.0, 20.0));
   const auto r = an::runReplay(c);
   ASSERT_EQ(r.run.epochs.size(), 601u);  // GT at 10 Hz over 60 s
   EXPECT_NEAR(r.run.epochs.front().t - r.t_zero, 0.0, 1e-9);
@@ -65,7 +65,7 @@ TEST(Replay, BadInputIsAClearError) {
   an::ReplayConfig c;
   c.rawlog = ok;
   c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
-  c.outages.push_back({50.0, 20.0});
+  c.outages.push_back(navimpact::Outage::fromStartDuration(50.0, 20.0));
   EXPECT_NE(errorOf(c).find("outage 50:20 ends at 70 s, after the data"), std::string::npos) << errorOf(c);
   c.outages.clear();
   c.model_spec.clear();
@@ -77,7 +77,7 @@ TEST(Replay, BadInputIsAClearError) {
   c.rawlog = noImu;
   c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
   EXPECT_NE(errorOf(c).find("no IMU data"), std::string::npos) << errorOf(c);
-  EXPECT_THROW(an::parseOutage("200"), navimpact::Error);
-  EXPECT_THROW(an::parseOutage("-1:5"), navimpact::Error);
-  EXPECT_DOUBLE_EQ(an::parseOutage("200:60").duration_s, 60.0);
+  EXPECT_THROW(navimpact::parseOutage("200"), navimpact::Error);
+  EXPECT_THROW(navimpact::parseOutage("-1:5"), navimpact::Error);
+  EXPECT_DOUBLE_EQ(navimpact::parseOutage("200:60").duration_s(), 60.0);
 }

@@ -70,7 +70,7 @@ std::size_t modelIndex(const an::StudyResults& r, const std::string& label) {
 std::size_t outageEndEpoch(const an::StudyResults& r) {
   std::size_t k = 0;
   for (std::size_t i = 0; i < r.meta.epochs.size(); ++i)
-    if (r.meta.epochs[i] <= r.meta.outages[0].end + 1e-9) k = i;
+    if (r.meta.epochs[i] <= r.meta.outages[0].end_s + 1e-9) k = i;
   return k;
 }
 
@@ -105,7 +105,7 @@ TEST(StudyConfig, BadInputIsRejectedBeforeAnyRun) {
       an::prepareStudy(cfg, "test");
       FAIL() << "outage outside the trajectory accepted";
     } catch (const navimpact::Error& e) {
-      EXPECT_NE(std::string(e.what()).find("ends after the trajectory"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("s, after the end of the trajectory"), std::string::npos) << e.what();
     }
   }
   // A model name that the file does not have.
@@ -233,7 +233,7 @@ TEST(StudyFindings, ModelsAgreeEarlyInTheOutage) {
   const auto& r = sharedStudy();
   std::size_t k1 = 0;
   for (std::size_t i = 0; i < r.meta.epochs.size(); ++i)
-    if (r.meta.epochs[i] <= r.meta.outages[0].start + 1.0 + 1e-9) k1 = i;
+    if (r.meta.epochs[i] <= r.meta.outages[0].start_s + 1.0 + 1e-9) k1 = i;
   const std::size_t ke = outageEndEpoch(r);
   const double early = rmsH(r, "Gyro 1", k1) / rmsH(r, "Ref both", k1);
   const double late = rmsH(r, "Gyro 1", ke) / rmsH(r, "Ref both", ke);

@@ -109,7 +109,7 @@ TEST(SweepConfig, EveryBadKeyIsNamed) {
   expectError(load(baseYaml("sweep: {outage: {start_s: 6, durations_s: [5]}}\n", "1")), "monte_carlo.runs");
   // Outage past the trajectory: refused before any run, naming the column.
   const auto cfg = an::loadSweepConfig(writeConfig(baseYaml("sweep: {outage: {start_s: 90, durations_s: [5, 20]}}\n")));
-  expectError([&] { an::prepareSweep(cfg, "test"); }, "ends after the trajectory");
+  expectError([&] { an::prepareSweep(cfg, "test"); }, "s, after the end of the trajectory");
 }
 
 TEST(SweepRuns, AShortOutageIsTheStartOfTheLongestOneBitForBit) {
@@ -123,7 +123,7 @@ TEST(SweepRuns, AShortOutageIsTheStartOfTheLongestOneBitForBit) {
   const auto& sm = an::studyMeta(*plan);
   std::size_t k_end = sm.epochs.size();
   for (std::size_t k = 0; k < sm.epochs.size(); ++k)
-    if (std::abs(sm.epochs[k] - sm.outages[0].end) < 1e-9) k_end = k;
+    if (std::abs(sm.epochs[k] - sm.outages[0].end_s) < 1e-9) k_end = k;
   ASSERT_LT(k_end, sm.epochs.size());
   std::vector<an::RunRecord> recs;
   an::runStudy(plan, an::Shard{}, 2, {}, [&](const an::RunRecord& r) { recs.push_back(r); });

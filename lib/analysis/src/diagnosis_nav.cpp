@@ -34,7 +34,7 @@ struct NavGainPlan {
   TruthSeries truth;
   ins::NavState truth0;
   double rate = 0, t0 = 0, t1 = 0;
-  std::vector<OutageWindow> outages;   ///< absolute filter times
+  std::vector<Outage> outages;         ///< absolute filter times
   std::vector<std::size_t> end_epoch;  ///< truth index of each outage end
   NavRunOptions nav;
   std::size_t samples = 0;             ///< recording samples
@@ -56,15 +56,9 @@ std::shared_ptr<const NavGainPlan> prepareNavGain(const NavGainOptions& opt, dou
   const std::size_t n = static_cast<std::size_t>(std::floor((tr.tEnd() - tr.tBegin()) * rate + 1e-9));
   plan->t1 = plan->t0 + double(n) / rate;
   const double duration = plan->t1 - plan->t0;
-  for (const auto& o : opt.outages) {
-    if (!(o.start >= 0.0 && o.end > o.start))
-      throw Error("--outage " + formatNumber(o.start, 6) + ":" + formatNumber(o.end - o.start, 6) + " is invalid");
-    if (o.end > duration + 1e-9)
-      throw Error("--outage " + formatNumber(o.start, 6) + ":" + formatNumber(o.end - o.start, 6) + " ends at " +
-                  formatNumber(o.end, 6) + " s, after the end of the trajectory " + opt.trajectory.file + " (" +
-                  formatNumber(duration, 6) + " s)");
-    plan->outages.push_back({plan->t0 + o.start, plan->t0 + o.end});
-  }
+  checkOutages(opt.outages, duration,
+               "the end of the trajectory " + opt.trajectory.file + " (" + formatNumber(duration) + " s)", "--outage");
+  for (const auto& o : opt.outages) plan->outages.push_back(o.shifted(plan->t0));
   if (n > samples)
     throw Error("static recording too short for the navigation gain: " + formatNumber(samples / rate, 6) +
                 " s available, " + formatNumber(duration, 6) + " s needed for the trajectory " +
@@ -80,7 +74,7 @@ std::shared_ptr<const NavGainPlan> prepareNavGain(const NavGainOptions& opt, dou
   for (std::size_t k = 0; k <= n; k += step_out) ks.push_back(k);
   std::vector<std::size_t> ends;
   for (const auto& o : opt.outages) {
-    const auto ka = std::size_t(std::llround(o.start * rate)), ke = std::min(n, std::size_t(std::llround(o.end * rate)));
+    const auto ka = std::size_t(std::llround(o.start_s * rate)), ke = std::min(n, std::size_t(std::llround(o.end_s * rate)));
     for (std::size_t k = ka; k < ke; k += step_in) ks.push_back(k);
     ks.push_back(ke);
     ends.push_back(ke);
@@ -285,8 +279,8 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
   // Per outage, paired over runs.
   for (std::size_t q = 0; q < O; ++q) {
     NavOutageGain og;
-    og.start_s = p.outages[q].start - p.t0;
-    og.duration_s = p.outages[q].end - p.outages[q].start;
+    og.start_s = p.outages[q].start_s - p.t0;
+    og.duration_s = p.outages[q].end_s - p.outages[q].start_s;
     for (const auto& o : outs) {
       og.h_before.push_back(o.h[0][q]);
       og.h_after.push_back(o.h[1][q]);

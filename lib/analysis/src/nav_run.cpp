@@ -24,12 +24,6 @@ double blockNees(const Eigen::Matrix<double, N, 1>& e, const Eigen::Matrix<doubl
   return e.dot(llt.solve(e));
 }
 
-bool inOutage(double t, const std::vector<OutageWindow>& w) {
-  for (const auto& o : w)
-    if (t > o.start && t <= o.end) return true;
-  return false;
-}
-
 }  // namespace
 
 std::array<double, 4> navNees(const filter::Vector9d& err, const filter::Matrix9d& P9) {
@@ -53,8 +47,8 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
     throw Error("navigation run: truth series has " + std::to_string(truth.t.size()) + " times but " +
                 std::to_string(truth.x.size()) + " states");
   for (const auto& o : opt.outages)
-    if (!(o.end > o.start))
-      throw Error("navigation run: outage (" + formatNumber(o.start, 10) + ", " + formatNumber(o.end, 10) + "] is empty");
+    if (!(o.end_s > o.start_s))
+      throw Error("navigation run: outage (" + formatNumber(o.start_s, 10) + ", " + formatNumber(o.end_s, 10) + "] is empty");
 
   const auto t_start = std::chrono::steady_clock::now();
   filter::ErrorStateEkf ekf(in.x0, opt.P0_nav, model, opt.ekf);
@@ -147,7 +141,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
   for (auto& o : res.outages) {
     for (std::size_t k = 0; k < res.epochs.size(); ++k) {
       const NavEpoch& e = res.epochs[k];
-      if (e.t <= o.window.start || e.t > o.window.end + 1e-9) continue;
+      if (e.t <= o.window.start_s || e.t > o.window.end_s + 1e-9) continue;
       o.end_epoch = static_cast<int>(k);
       if (!hasTruth) continue;
       o.max_drift_h = std::max(o.max_drift_h, e.err.head<2>().norm());

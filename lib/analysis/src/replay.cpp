@@ -42,17 +42,6 @@ std::string resolveModel(const fs::path& dir, const std::string& spec) {
 
 }  // namespace
 
-ReplayOutage parseOutage(const std::string& text) {
-  const auto c = text.find(':');
-  ReplayOutage o;
-  if (c == std::string::npos || !parseDouble(trim(std::string_view(text).substr(0, c)), o.start_s) ||
-      !parseDouble(trim(std::string_view(text).substr(c + 1)), o.duration_s))
-    throw Error("outage '" + text + "': expected START:DURATION in seconds, e.g. 200:60");
-  if (!(o.start_s >= 0.0) || !(o.duration_s > 0.0))
-    throw Error("outage '" + text + "': START must be >= 0 s and DURATION > 0 s");
-  return o;
-}
-
 ReplayConfig loadReplayConfig(const std::string& path) {
   InputScope scope(path);
   YAML::Node root;
@@ -100,7 +89,7 @@ ReplayConfig loadReplayConfig(const std::string& path) {
       const std::string k = "outages[" + std::to_string(i) + "]";
       subKeys(o[i], k, {"start_s", "duration_s"});
       if (!o[i]["start_s"] || !o[i]["duration_s"]) throw keyError(path, k, "needs start_s and duration_s [s]");
-      ReplayOutage w{num(o[i]["start_s"], k + ".start_s"), pos(o[i]["duration_s"], k + ".duration_s")};
+      const Outage w = Outage::fromStartDuration(num(o[i]["start_s"], k + ".start_s"), pos(o[i]["duration_s"], k + ".duration_s"));
       if (!(w.start_s >= 0.0)) throw keyError(path, k + ".start_s", "must be >= 0");
       c.outages.push_back(w);
     }
@@ -295,13 +284,9 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
 
   // Outages in rawlog time.
   NavRunOptions opt;
-  for (const auto& o : cfg.outages) {
-    const double a = r.t_zero + o.start_s, b = a + o.duration_s;
-    if (b > t_last + 1e-6)
-      throw Error("outage " + formatNumber(o.start_s, 10) + ":" + formatNumber(o.duration_s, 10) + " ends at " + formatNumber(o.start_s + o.duration_s, 10) +
-                  " s, after the data (IMU data span 0.." + formatNumber(t_last - r.t_zero, 10) + " s)");
-    opt.outages.push_back({a, b});
-  }
+  checkOutages(cfg.outages, t_last - r.t_zero,
+               "the data (IMU data span 0.." + formatNumber(t_last - r.t_zero, 10) + " s)");
+  for (const auto& o : cfg.outages) opt.outages.push_back(o.shifted(r.t_zero));
 
   // Measurement noise: overridden by the configuration, else recorded with the
   // sample, else (baro) the scenario's.

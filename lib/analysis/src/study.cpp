@@ -81,7 +81,7 @@ json metaToJson(const StudyMeta& m) {
                     {"white_noise", s.white_noise}});
   j["sets"] = sets;
   json o = json::array();
-  for (const auto& w : m.outages) o.push_back({w.start, w.end});
+  for (const auto& w : m.outages) o.push_back({w.start_s, w.end_s});
   j["outages"] = o;
   j["epochs"] = m.epochs;
   j["margin"] = m.margin;
@@ -223,14 +223,9 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
   meta.trajectory = cfg.trajectory.file + " (" + formatNumber(duration) + " s used)";
 
   // Outages inside the trajectory.
-  for (const auto& o : cfg.outages) {
-    if (!(o.start >= 0.0 && o.end > o.start))
-      throw Error("outage (" + formatNumber(o.start) + ", " + formatNumber(o.end) + "] s is invalid");
-    if (o.end > duration + 1e-9)
-      throw Error("outage (" + formatNumber(o.start) + ", " + formatNumber(o.end) + "] s ends after the trajectory (" +
-                  formatNumber(duration) + " s of " + cfg.trajectory.file + ")");
-    meta.outages.push_back({plan->t0 + o.start, plan->t0 + o.end});
-  }
+  checkOutages(cfg.outages, duration,
+               "the end of the trajectory (" + formatNumber(duration) + " s of " + cfg.trajectory.file + ")");
+  for (const auto& o : cfg.outages) meta.outages.push_back(o.shifted(plan->t0));
 
   // True errors.
   if (cfg.truth.kind == "model") {
@@ -265,7 +260,7 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
   const auto step_in = std::max<std::size_t>(1, std::size_t(std::llround(rate / cfg.outage_record_rate_hz)));
   for (std::size_t k = 0; k <= n; k += step_out) ks.push_back(k);
   for (const auto& o : cfg.outages) {
-    const auto ks0 = std::size_t(std::llround(o.start * rate)), ke = std::size_t(std::llround(o.end * rate));
+    const auto ks0 = std::size_t(std::llround(o.start_s * rate)), ke = std::size_t(std::llround(o.end_s * rate));
     for (std::size_t k = ks0; k < ke; k += step_in) ks.push_back(k);
     ks.push_back(std::min(ke, n));
   }

@@ -284,9 +284,9 @@ StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::stri
       const double s = get<double>(o[i]["start_s"], c, w + ".start_s");
       const double d = positive(get<double>(o[i]["duration_s"], c, w + ".duration_s"), c, w + ".duration_s");
       if (!(s >= 0.0)) throw keyError(path, w + ".start_s", "must be >= 0 (seconds from the trajectory start)");
-      if (!cfg.outages.empty() && s < cfg.outages.back().end)
+      if (!cfg.outages.empty() && s < cfg.outages.back().end_s)
         throw keyError(path, w + ".start_s", "outages must be in time order and not overlap");
-      cfg.outages.push_back({s, s + d});
+      cfg.outages.push_back(Outage::fromStartDuration(s, d));
     }
   }
   if (const YAML::Node m = root["monte_carlo"]) {

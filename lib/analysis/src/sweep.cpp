@@ -158,19 +158,19 @@ std::shared_ptr<const SweepPlan> prepareSweep(const SweepConfig& cfg, const std:
         col.settings = sm.settings;
         col.notices = sm.notices;
         col.states = sm.states;
-        const double start = sm.outages.front().start, half = 0.5 / sc.imu_rate_hz;
+        const double start = sm.outages.front().start_s, half = 0.5 / sc.imu_rate_hz;
         std::vector<std::size_t> idx;
         for (std::size_t k = 0; k < sm.epochs.size(); ++k)
-          if (sm.epochs[k] > start + half && sm.epochs[k] <= sm.outages.back().end + half) {
+          if (sm.epochs[k] > start + half && sm.epochs[k] <= sm.outages.back().end_s + half) {
             idx.push_back(k);
             col.tau_s.push_back(sm.epochs[k] - start);
           }
         for (const auto& o : sm.outages) {
           std::size_t found = idx.size();
           for (std::size_t j = 0; j < idx.size(); ++j)
-            if (std::abs(sm.epochs[idx[j]] - o.end) <= half) found = j;
+            if (std::abs(sm.epochs[idx[j]] - o.end_s) <= half) found = j;
           if (found == idx.size())
-            throw Error("sweep: no record epoch at the end of the " + formatNumber(o.end - start) + " s outage in " + col.name);
+            throw Error("sweep: no record epoch at the end of the " + formatNumber(o.end_s - start) + " s outage in " + col.name);
           col.duration_epoch.push_back(found);
         }
         plan->studies.push_back(sp);

@@ -84,7 +84,7 @@ void writeReplayFigures(const ReplayResult& r, OutputSet& out) {
       if (i >= 6) ax.xlabel = "time [s]";
       ax.xlim = std::make_pair(x0, x1);
       for (const auto& o : r.cfg.outages)
-        ax.spans.push_back({"GNSS outage", o.start_s, o.start_s + o.duration_s, {128, 128, 128}, 0.18});
+        ax.spans.push_back({"GNSS outage", o.start_s, o.end_s, {128, 128, 128}, 0.18});
       std::vector<double> lo(n), hi(n);
       for (std::size_t k = 0; k < n; ++k) {
         lo[k] = -sig[i][k];
@@ -106,10 +106,10 @@ void writeReplayFigures(const ReplayResult& r, OutputSet& out) {
                 out.stage("errors_full.png").string());
   for (std::size_t i = 0; i < r.cfg.outages.size(); ++i) {
     const auto& o = r.cfg.outages[i];
-    const double a = std::max(0.0, o.start_s - 0.1 * o.duration_s);
-    const double b = std::min(tEnd, o.start_s + 1.1 * o.duration_s);
+    const double a = std::max(0.0, o.start_s - 0.1 * o.duration_s());
+    const double b = std::min(tEnd, o.start_s + 1.1 * o.duration_s());
     const std::string name = "errors_outage_" + std::to_string(i + 1) + ".png";
-    plot::savePng(figure(a, b, "GNSS outage " + std::to_string(i + 1) + ": " + formatNumber(o.duration_s, 10) + " s from " +
+    plot::savePng(figure(a, b, "GNSS outage " + std::to_string(i + 1) + ": " + formatNumber(o.duration_s(), 10) + " s from " +
                                    formatNumber(o.start_s, 10) + " s — errors and ±1σ"),
                   out.stage(name).string());
   }
@@ -134,7 +134,7 @@ std::string solutionCsv(const ReplayResult& r) {
     const Eigen::Vector3d ee = truth ? Eigen::Vector3d(eulerError(x, r.truth[k]) / kDeg) : Eigen::Vector3d::Zero();
     bool gnss = true;
     for (const auto& w : r.cfg.outages)
-      if (e.t - r.t_zero > w.start_s + 1e-9 && e.t - r.t_zero <= w.start_s + w.duration_s + 1e-9) gnss = false;
+      if (e.t - r.t_zero > w.start_s + 1e-9 && e.t - r.t_zero <= w.end_s + 1e-9) gnss = false;
     o << e.t - r.t_zero << ',' << std::setprecision(12) << x.lat / kDeg << ',' << x.lon / kDeg << ','
       << std::setprecision(10) << x.h << ',' << x.v_N[0] << ',' << x.v_N[1] << ',' << x.v_N[2] << ',' << rpy[0]
       << ',' << rpy[1] << ',' << rpy[2];
@@ -186,7 +186,7 @@ std::string summaryJson(const ReplayResult& r) {
     const auto& o = r.run.outages[i];
     json jo;
     jo["start_s"] = r.cfg.outages[i].start_s;
-    jo["duration_s"] = r.cfg.outages[i].duration_s;
+    jo["duration_s"] = r.cfg.outages[i].duration_s();
     if (o.end_epoch < 0) {
       jo["note"] = "no recorded epoch inside the outage";
       outs.push_back(jo);
@@ -210,7 +210,7 @@ std::string summaryJson(const ReplayResult& r) {
     std::array<double, 4> neesB{};
     int n = 0;
     for (std::size_t k = 0; k <= ke; ++k) {
-      if (ep[k].t <= o.window.start) continue;
+      if (ep[k].t <= o.window.start_s) continue;
       maxPh = std::max(maxPh, block(k, 0).head<2>().norm());
       maxPv = std::max(maxPv, std::abs(block(k, 0)[2]));
       maxVh = std::max(maxVh, block(k, 1).head<2>().norm());
@@ -288,12 +288,12 @@ std::string replaySummary(const ReplayResult& r) {
     const auto& o = r.cfg.outages[i];
     if (!r.run.has_truth)
       std::snprintf(b, sizeof b, "outage %zu (%g s from %g s): predicted horizontal 1-sigma at end %.2f m, vertical %.2f m\n",
-                    i + 1, o.duration_s, o.start_s, e.sigma.head<2>().norm(), e.sigma[2]);
+                    i + 1, o.duration_s(), o.start_s, e.sigma.head<2>().norm(), e.sigma[2]);
     else
       std::snprintf(b, sizeof b,
                     "outage %zu (%g s from %g s): horizontal error at end %.2f m (1-sigma %.2f m), max %.2f m; "
                     "vertical %.2f m (1-sigma %.2f m)\n",
-                    i + 1, o.duration_s, o.start_s, e.err.head<2>().norm(), e.sigma.head<2>().norm(),
+                    i + 1, o.duration_s(), o.start_s, e.err.head<2>().norm(), e.sigma.head<2>().norm(),
                     w.max_drift_h, std::abs(e.err[2]), e.sigma[2]);
     s += b;
   }

@@ -56,7 +56,7 @@ struct View {
   double t(std::size_t k) const { return r.meta.epochs[k]; }
   double rel(std::size_t k) const { return r.meta.epochs[k] - r.meta.t0; }
   bool inOutage(std::size_t k, std::size_t o) const {
-    return t(k) > r.meta.outages[o].start + 1e-9 && t(k) <= r.meta.outages[o].end + 1e-9;
+    return t(k) > r.meta.outages[o].start_s + 1e-9 && t(k) <= r.meta.outages[o].end_s + 1e-9;
   }
   bool inAnyOutage(std::size_t k) const {
     for (std::size_t o = 0; o < O; ++o)
@@ -67,7 +67,7 @@ struct View {
   std::size_t endEpoch(std::size_t o) const {
     std::size_t best = 0;
     for (std::size_t k = 0; k < E; ++k)
-      if (t(k) <= r.meta.outages[o].end + 1e-9) best = k;
+      if (t(k) <= r.meta.outages[o].end_s + 1e-9) best = k;
     return best;
   }
   double outageMeanAnees(std::size_t m, std::size_t o, int b) const {
@@ -140,7 +140,7 @@ SetVerdict judge(const View& v, const ModelSetSpec& s, std::size_t o) {
   // horizontal error or predicted sigma stays outside the margin for good
   // (a persistent departure; isolated crossings early in the outage, where
   // both errors are at the GNSS noise level, do not count).
-  const double start = v.r.meta.outages[o].start;
+  const double start = v.r.meta.outages[o].start_s;
   double last_ok = 0.0;
   bool any_ok_after = true;
   for (std::size_t k = 0; k < v.E; ++k) {
@@ -184,7 +184,7 @@ json buildJson(const View& v, bool with_cost) {
   study["notices"] = meta.notices;
   json outs = json::array();
   for (const auto& o : meta.outages)
-    outs.push_back({{"start_s", o.start - meta.t0}, {"end_s", o.end - meta.t0}, {"duration_s", o.end - o.start}});
+    outs.push_back({{"start_s", o.start_s - meta.t0}, {"end_s", o.end_s - meta.t0}, {"duration_s", o.end_s - o.start_s}});
   study["outages"] = outs;
   j["study"] = study;
   json band;
@@ -225,8 +225,8 @@ json buildJson(const View& v, bool with_cost) {
       e["coverage68"] = c68;
       e["coverage95"] = c95;
       json x;
-      x["start_s"] = meta.outages[o].start - meta.t0;
-      x["end_s"] = meta.outages[o].end - meta.t0;
+      x["start_s"] = meta.outages[o].start_s - meta.t0;
+      x["end_s"] = meta.outages[o].end_s - meta.t0;
       x["end"] = e;
       const auto& A = v.a(m);
       x["max_drift_h_m"] = {{"mean", A.drift_h[o] / v.R}, {"rms", std::sqrt(A.drift_h2[o] / v.R)}};
@@ -260,7 +260,7 @@ json buildJson(const View& v, bool with_cost) {
     for (std::size_t o = 0; o < v.O; ++o) {
       const SetVerdict sv = judge(v, s, o);
       json x;
-      x["outage_end_s"] = meta.outages[o].end - meta.t0;
+      x["outage_end_s"] = meta.outages[o].end_s - meta.t0;
       x["recommended"] = sv.recommended;
       json ad = json::object();
       for (std::size_t i = 0; i < s.models.size(); ++i)
@@ -303,8 +303,8 @@ double scaleOf(int c) { return c >= 6 ? 1.0 / units::kDeg : 1.0; }
 
 void errorsFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std::string& path) {
   const auto& w = v.r.meta.outages[o];
-  const double x0 = w.start - v.r.meta.t0 - v.r.meta.plot_before_s,
-               x1 = w.end - v.r.meta.t0 + v.r.meta.plot_after_s;
+  const double x0 = w.start_s - v.r.meta.t0 - v.r.meta.plot_before_s,
+               x1 = w.end_s - v.r.meta.t0 + v.r.meta.plot_after_s;
   plot::Figure fig;
   fig.width = 1800;
   fig.height = 1300;
@@ -320,7 +320,7 @@ void errorsFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std
     ax.title = std::string(rowName[c / 3]) + " " + axisName[c % 3];
     ax.xlabel = "time [s]";
     ax.ylabel = std::string(rowName[c / 3]) + " error [" + unit[c / 3] + "]";
-    ax.spans.push_back({"GNSS outage", w.start - v.r.meta.t0, w.end - v.r.meta.t0, {128, 128, 128}, 0.15});
+    ax.spans.push_back({"GNSS outage", w.start_s - v.r.meta.t0, w.end_s - v.r.meta.t0, {128, 128, 128}, 0.15});
     ax.xlim = std::make_pair(x0, x1);
     ax.legend = c == 0 ? plot::LegendPos::TopLeft : plot::LegendPos::None;
     for (std::size_t i = 0; i < s.models.size(); ++i) {
@@ -347,8 +347,8 @@ void errorsFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std
 
 void neesFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std::string& path) {
   const auto& w = v.r.meta.outages[o];
-  const double x0 = w.start - v.r.meta.t0 - v.r.meta.plot_before_s,
-               x1 = w.end - v.r.meta.t0 + v.r.meta.plot_after_s;
+  const double x0 = w.start_s - v.r.meta.t0 - v.r.meta.plot_before_s,
+               x1 = w.end_s - v.r.meta.t0 + v.r.meta.plot_after_s;
   plot::Figure fig;
   fig.width = 1600;
   fig.height = 1100;
@@ -363,7 +363,7 @@ void neesFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std::
     ax.xlabel = "time [s]";
     ax.ylabel = "ANEES";
     ax.logy = true;
-    ax.spans.push_back({"GNSS outage", w.start - v.r.meta.t0, w.end - v.r.meta.t0, {128, 128, 128}, 0.15});
+    ax.spans.push_back({"GNSS outage", w.start_s - v.r.meta.t0, w.end_s - v.r.meta.t0, {128, 128, 128}, 0.15});
     ax.xlim = std::make_pair(x0, x1);
     const auto band = aneesBand(v.r.acc.runs, kDof[b]);
     ax.hlines.push_back({"95 % band", band.first, {0, 0, 0}, plot::LineStyle::Dashed});
@@ -401,8 +401,8 @@ void outageEndFigure(const View& v, const ModelSetSpec& s, const std::string& pa
   for (std::size_t o = 0; o < v.O; ++o) {
     const std::size_t k = v.endEpoch(o);
     plot::Axes ax;
-    ax.title = "outage " + formatReadable(v.r.meta.outages[o].start - v.r.meta.t0) + " to " +
-               formatReadable(v.r.meta.outages[o].end - v.r.meta.t0) + " s";
+    ax.title = "outage " + formatReadable(v.r.meta.outages[o].start_s - v.r.meta.t0) + " to " +
+               formatReadable(v.r.meta.outages[o].end_s - v.r.meta.t0) + " s";
     ax.xlabel = "model (legend order)";
     ax.ylabel = "horizontal position error [m]";
     double hi = 0.0;
@@ -455,8 +455,8 @@ std::string report(const View& v, const std::vector<std::string>& figs_per_set_f
      << "; every candidate model sees the same error realisation, GNSS/baro noise and initial error in a "
         "run (paired comparison); each run is a complete EKF run on its own estimates\n";
   for (std::size_t o = 0; o < v.O; ++o)
-    md << "- GNSS outage " << o + 1 << ": from " << formatReadable(meta.outages[o].start - meta.t0) << " s to "
-       << formatReadable(meta.outages[o].end - meta.t0) << " s (" << formatReadable(meta.outages[o].end - meta.outages[o].start)
+    md << "- GNSS outage " << o + 1 << ": from " << formatReadable(meta.outages[o].start_s - meta.t0) << " s to "
+       << formatReadable(meta.outages[o].end_s - meta.t0) << " s (" << formatReadable(meta.outages[o].end_s - meta.outages[o].start_s)
        << " s without GNSS)\n";
   {
     std::istringstream s(meta.settings);
@@ -488,7 +488,7 @@ std::string report(const View& v, const std::vector<std::string>& figs_per_set_f
     md << "## " << s.title << "\n\n";
     for (std::size_t o = 0; o < v.O; ++o) {
       const std::size_t k = v.endEpoch(o);
-      const double dur = meta.outages[o].end - meta.outages[o].start;
+      const double dur = meta.outages[o].end_s - meta.outages[o].start_s;
       const SetVerdict sv = judge(v, s, o);
       md << "### Outage " << o + 1 << " (" << formatReadable(dur) << " s), values at its end (t = " << formatReadable(v.rel(k))
          << " s)\n\n";
@@ -552,7 +552,7 @@ std::string report(const View& v, const std::vector<std::string>& figs_per_set_f
     for (std::size_t o = 0; o < v.O; ++o) {
       const std::size_t k = v.endEpoch(o), wn = v.index(s.white_noise), ref = v.index(s.reference);
       const SetVerdict sv = judge(v, s, o);
-      md << "| " << s.title << " | " << formatReadable(meta.outages[o].end - meta.outages[o].start) << " | "
+      md << "| " << s.title << " | " << formatReadable(meta.outages[o].end_s - meta.outages[o].start_s) << " | "
          << formatFixed(v.rmsH(wn, k) / v.rmsH(ref, k), 2) << " | " << formatReadable(v.anees(wn, k, 0)) << " | "
          << formatReadable(v.anees(ref, k, 0)) << " | " << (sv.recommended.empty() ? "none" : sv.recommended) << " | "
          << (sv.wn_never_departs ? ">= " : "") << formatReadable(sv.wn_enough_below_s) << " |\n";

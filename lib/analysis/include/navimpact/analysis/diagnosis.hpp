@@ -199,8 +199,8 @@ struct DiagnoseOptions {
 struct NavGainOptions {
   emulation::TrajectorySpec trajectory;     ///< reference trajectory (smoothed = truth)
   emulation::SmoothingOptions smoothing;
-  /// GNSS outages relative to the first trajectory time, (start, end] [s].
-  std::vector<OutageWindow> outages;
+  /// GNSS outages relative to the first trajectory time, (start, end] [s] (navimpact::parseOutage).
+  std::vector<Outage> outages;
   int runs = 10;                  ///< paired realisations (>= 2): recording window + GNSS/baro noise
   std::uint64_t seed = 20261121;  ///< run r: deriveSeed(seed, r), streams 1 GNSS, 2 baro, 3 initial error
   emulation::GnssOptions gnss;    ///< defaults: Table 2 (seed ignored)

@@ -43,6 +43,7 @@
 #include <Eigen/Core>
 
 #include "navimpact/core/recording.hpp"
+#include "navimpact/core/outage.hpp"
 #include "navimpact/emulation/sensors.hpp"
 #include "navimpact/filter/ekf.hpp"
 #include "navimpact/ins/nav_state.hpp"
@@ -50,11 +51,6 @@
 
 namespace navimpact::analysis {
 
-/// A GNSS outage: fixes with start < t <= end are not used [s, filter time].
-struct OutageWindow {
-  double start = 0.0;  ///< last instant with GNSS [s]
-  double end = 0.0;    ///< end of the outage [s], > start
-};
 
 /// True states at the epochs where errors are recorded (time-ordered).
 struct TruthSeries {
@@ -80,7 +76,7 @@ struct NavRunInput {
 struct NavRunOptions {
   filter::EkfConfig ekf;                        ///< filter options (propagate_every, ...)
   filter::Matrix9d P0_nav = filter::Matrix9d::Identity();  ///< initial nav covariance [m, m/s, rad]^2
-  std::vector<OutageWindow> outages;            ///< GNSS outage windows
+  std::vector<Outage> outages;                  ///< GNSS outages, absolute filter time [s]
   Eigen::Vector3d lever_arm_B = Eigen::Vector3d::Zero();   ///< GNSS antenna in body FRD [m]
   bool baro_in_outage = true;                   ///< keep baro updates during GNSS outages
   bool use_gnss_velocity = true;                ///< apply GNSS velocity besides position
@@ -100,7 +96,7 @@ struct NavEpoch {
 
 /// What one outage did to this run.
 struct OutageSummary {
-  OutageWindow window;
+  Outage window;                    ///< the outage, absolute filter time [s]
   int end_epoch = -1;               ///< index into NavRunResult::epochs of the last epoch <= end (-1: none)
   double max_drift_h = 0.0;         ///< max horizontal position error over the epochs in (start, end] [m]
   double max_drift_3d = 0.0;        ///< max 3-D position error over the same epochs [m]

@@ -46,22 +46,13 @@
 
 namespace navimpact::analysis {
 
-/// An outage in replay time [s].
-struct ReplayOutage {
-  double start_s = 0.0;     ///< last instant with GNSS, from time zero [s], >= 0
-  double duration_s = 0.0;  ///< [s], > 0
-};
-
-/// Parse "START:DURATION" (seconds). @throws navimpact::Error naming the text.
-ReplayOutage parseOutage(const std::string& text);
-
 /// Replay options (see the file comment for the YAML form).
 struct ReplayConfig {
   std::string config_file;
   std::string rawlog;
   std::string imu_label, gnss_label;            ///< of a rawlog navimpact did not write; "" = the only one
   std::string model_spec;                       ///< "" = the rawlog scenario's model
-  std::vector<ReplayOutage> outages;
+  std::vector<Outage> outages;                  ///< GNSS outages from time zero [s] (navimpact::parseOutage)
   int propagate_every = 10;                     ///< covariance propagation every k IMU samples
   bool use_gnss_velocity = true;
   double gate_probability = 0.0;

@@ -94,7 +94,7 @@ struct StudyConfig {
   bool baro_in_outage = true;
   bool use_baro = true;                    ///< false: the filter gets no barometer at all (sweep axis)
   /// Outages relative to the first trajectory time [s] (start, end]; default (200, 260].
-  std::vector<OutageWindow> outages;
+  std::vector<Outage> outages;
   std::size_t runs = 100;                  ///< Monte Carlo runs, >= 1
   std::uint64_t seed = 1;                  ///< study seed
   unsigned threads = 0;                    ///< 0 = all hardware threads
@@ -197,7 +197,7 @@ struct StudyMeta {
   std::vector<std::string> labels, sources;   ///< candidates and their model text
   std::vector<int> states;                    ///< EKF state count per candidate
   std::vector<ModelSetSpec> sets;
-  std::vector<OutageWindow> outages;          ///< absolute filter time [s]
+  std::vector<Outage> outages;                ///< absolute filter time [s]
   std::vector<double> epochs;                 ///< record epochs, absolute [s]
   double margin = 0.25, plot_before_s = 30.0, plot_after_s = 10.0;
   std::string settings;                       ///< GNSS/baro/filter settings, one line each

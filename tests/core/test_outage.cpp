@@ -1,0 +1,104 @@
+// The one GNSS outage: the interval (start, end] it removes, its text form
+// START:DURATION read back, and the one validation (order, overlap, span),
+// on outages drawn at random over the whole documented range (seeded, logged).
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <iostream>
+#include <random>
+#include <string>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/outage.hpp"
+
+using navimpact::Outage;
+
+namespace {
+
+std::string errorOf(const std::vector<Outage>& w, double span, const std::string& after = "the data") {
+  try {
+    navimpact::checkOutages(w, span, after);
+  } catch (const navimpact::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Outage, CoversTheHalfOpenInterval) {
+  const Outage o = Outage::fromStartDuration(200.0, 60.0);
+  EXPECT_DOUBLE_EQ(o.end_s, 260.0);
+  EXPECT_DOUBLE_EQ(o.duration_s(), 60.0);
+  EXPECT_FALSE(o.covers(200.0));  // the fix at the start is the last one used
+  EXPECT_TRUE(o.covers(200.000001));
+  EXPECT_TRUE(o.covers(260.0));   // the fix at the end is not used
+  EXPECT_FALSE(o.covers(260.000001));
+  const Outage a = o.shifted(1000.0);
+  EXPECT_DOUBLE_EQ(a.start_s, 1200.0);
+  EXPECT_DOUBLE_EQ(a.end_s, 1260.0);
+  EXPECT_TRUE(navimpact::inOutage(230.0, {Outage{0.0, 10.0}, o}));
+  EXPECT_FALSE(navimpact::inOutage(100.0, {Outage{0.0, 10.0}, o}));
+}
+
+TEST(Outage, ParsesStartColonDuration) {
+  const Outage o = navimpact::parseOutage(" 200 : 60 ");
+  EXPECT_DOUBLE_EQ(o.start_s, 200.0);
+  EXPECT_DOUBLE_EQ(o.end_s, 260.0);
+  EXPECT_EQ(navimpact::outageText(o), "200:60");
+  for (const char* bad : {"200", "200-60", "abc", ":60", "200:", "200:60:1", "200:6O", ""})
+    EXPECT_THROW(navimpact::parseOutage(bad), navimpact::Error) << bad;
+  for (const char* bad : {"-1:5", "5:0", "5:-1", "nan:5", "5:inf"}) {
+    try {
+      navimpact::parseOutage(bad, "--outage");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const navimpact::Error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("--outage '" + std::string(bad) + "'", 0), 0u) << e.what();
+    }
+  }
+}
+
+TEST(Outage, TextReadsBackOverTheRange) {
+  const std::uint64_t seed = 20261124;
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> s(0.0, 1e5), d(1e-3, 1e4);
+  std::cout << "seed " << seed << ": 2000 outages, start U(0, 1e5) s, duration U(1e-3, 1e4) s\n";
+  for (int i = 0; i < 2000; ++i) {
+    // Round to what the text carries (6 significant digits), then read back exactly.
+    const Outage o = navimpact::parseOutage(navimpact::outageText(Outage::fromStartDuration(s(g), d(g))));
+    const Outage r = navimpact::parseOutage(navimpact::outageText(o));
+    EXPECT_EQ(navimpact::outageText(r), navimpact::outageText(o));
+    EXPECT_GT(r.end_s, r.start_s);
+  }
+}
+
+TEST(Outage, OneValidation) {
+  const std::vector<Outage> ok = {Outage::fromStartDuration(100, 30), Outage::fromStartDuration(130, 40)};
+  EXPECT_EQ(errorOf(ok, 170.0), "");
+  EXPECT_EQ(errorOf(ok, 170.0 - 0.5e-6), "");  // a microsecond of slack at the end
+  EXPECT_EQ(errorOf(ok, 169.0), "outage 130:40 ends at 170 s, after the data");
+  EXPECT_NE(errorOf({Outage::fromStartDuration(100, 30), Outage::fromStartDuration(120, 5)}, 200.0)
+                .find("outage 120:5 starts before the previous outage ends at 130 s"),
+            std::string::npos);
+  EXPECT_NE(errorOf({Outage::fromStartDuration(100, 30), Outage::fromStartDuration(50, 5)}, 200.0)
+                .find("starts before the previous outage"),
+            std::string::npos);
+  EXPECT_NE(errorOf({Outage{-1.0, 5.0}}, 200.0).find("START must be >= 0 s"), std::string::npos);
+  EXPECT_NE(errorOf({Outage{5.0, 5.0}}, 200.0).find("DURATION > 0 s"), std::string::npos);
+  // Random lists: valid ones pass, the same list with one outage moved past the span fails naming it.
+  const std::uint64_t seed = 11;
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> gap(0.0, 50.0), len(0.01, 100.0);
+  std::cout << "seed " << seed << ": 200 lists of 1-5 outages, gaps U(0, 50) s, durations U(0.01, 100) s\n";
+  for (int i = 0; i < 200; ++i) {
+    std::vector<Outage> w;
+    double t = gap(g);
+    for (int k = 0; k < 1 + int(g() % 5); ++k) {
+      w.push_back(Outage::fromStartDuration(t, len(g)));
+      t = w.back().end_s + gap(g);
+    }
+    EXPECT_EQ(errorOf(w, w.back().end_s), "");
+    const double span = w.back().end_s - 1e-3;
+    EXPECT_NE(errorOf(w, span).find(navimpact::outageText(w.back()) + " ends at"), std::string::npos);
+  }
+}
