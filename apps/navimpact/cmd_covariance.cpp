@@ -18,6 +18,7 @@ struct Opts {
   bool print_states = false;
   std::string trajectory;
   bool overwrite = false;
+  bool allow_large = false;
 };
 
 navimpact::cli::Registrar reg({
@@ -35,11 +36,14 @@ navimpact::cli::Registrar reg({
                      "roll_rad, pitch_rad, yaw_rad) instead of the static state");
       app.add_flag("--print-states", o->print_states,
                    "print the filter state layout of every model before running");
+      app.add_flag("--allow-large", o->allow_large,
+                   "run even when the estimated work or result memory is above the documented budget");
       navimpact::cli::addOverwriteFlag(app, o->overwrite);
       return [o]() -> int {
         namespace an = navimpact::analysis;
         navimpact::OutputSet out(o->out, navimpact::cli::overwriteMode(o->overwrite));
-        const an::CovarianceStudyConfig cfg = an::loadCovarianceStudyConfig(o->config);
+        an::CovarianceStudyConfig cfg = an::loadCovarianceStudyConfig(o->config);
+        cfg.allow_large = o->allow_large;
         if (o->print_states) {
           for (const auto& set : cfg.model_sets)
             for (const auto& m : set.models) {

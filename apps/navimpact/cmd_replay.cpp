@@ -15,6 +15,7 @@ struct Opts {
   std::string rawlog, config, model, out, imu_label, gnss_label;
   std::vector<std::string> outages;
   int propagate_every = 0;
+  double max_imu_gap_s = -1.0;
   bool overwrite = false;
 };
 
@@ -37,6 +38,9 @@ navimpact::cli::Registrar reg({
                      "IMU label of a rawlog navimpact did not write (default: the only one present)");
       app.add_option("--gnss-label", o->gnss_label,
                      "GNSS label of a rawlog navimpact did not write (default: the only one present)");
+      app.add_option("--max-imu-gap", o->max_imu_gap_s,
+                     "accept IMU gaps up to S seconds and propagate across them (default 0: a gap is an error)")
+          ->check(CLI::Range(0.0, navimpact::analysis::kMaxImuGapS));
       app.add_option("--out", o->out, "output folder")->required();
       navimpact::cli::addOverwriteFlag(app, o->overwrite);
       return [o]() -> int {
@@ -52,6 +56,7 @@ navimpact::cli::Registrar reg({
           for (const auto& s : o->outages) cfg.outages.push_back(navimpact::parseOutage(s));
         }
         if (o->propagate_every > 0) cfg.propagate_every = o->propagate_every;
+        if (o->max_imu_gap_s >= 0.0) cfg.max_imu_gap_s = o->max_imu_gap_s;
         const auto r = navimpact::analysis::runReplay(cfg);
         navimpact::report::writeReplayOutputs(r, out);
         out.commit();

@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <iomanip>
+#include <random>
+#include <sstream>
 
 #include "navimpact/analysis/covariance_study.hpp"
 #include "navimpact/core/error.hpp"
@@ -78,4 +81,64 @@ TEST(CovarianceStudy, ConfigErrorsNameTheKey) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("static_state.h_ft"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+std::string covarianceError(const std::string& name, const std::string& extra, bool run = false, bool allow = false) {
+  const std::string path = (test::tempDir() / name).string();
+  std::ofstream(path) << "model_file: " << test::sourcePath("config/models/navchip_table1.yaml") << "\n"
+                      << extra << "\nstatic_state: {lat_deg: 46}\nmodel_sets: [{name: a, models: [acc_ref]}]\n";
+  try {
+    auto c = analysis::loadCovarianceStudyConfig(path);
+    c.allow_large = allow;
+    if (run) analysis::checkBudget(c, std::lround(c.duration_s * c.imu_rate_hz));
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+// Every rate and duration has a documented range, checked at load with the key
+// named: values drawn at random (seed logged) beyond each end are refused, and
+// the ends themselves accepted.
+TEST(CovarianceStudy, RatesAndDurationOutsideTheirRangesAreRefusedAtLoad) {
+  const std::uint64_t seed = 4242;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<> u(0.0, 1.0);
+  for (int k = 0; k < 6; ++k) {
+    const double high = 1.0e4 * std::pow(10.0, 0.01 + 300.0 * u(rng));  // 1e4 .. 1e304
+    const double low = std::pow(10.0, -300.0 * u(rng)) * 0.999;         // below 1 Hz
+    SCOPED_TRACE("seed 4242 case " + std::to_string(k) + ": high " + std::to_string(high) + " low " +
+                 std::to_string(low));
+    std::ostringstream h, l;
+    h << std::setprecision(17) << "imu_rate_hz: " << high;
+    l << std::setprecision(17) << "imu_rate_hz: " << low << "\noutput_rate_hz: " << low / 2;
+    const auto mh = covarianceError("rate_hi.yaml", h.str());
+    EXPECT_NE(mh.find(": key 'imu_rate_hz': must be in [1, 10000] Hz"), std::string::npos) << mh;
+    const auto ml = covarianceError("rate_lo.yaml", l.str());
+    EXPECT_NE(ml.find(": key 'imu_rate_hz': must be in [1, 10000] Hz"), std::string::npos) << ml;
+    std::ostringstream d;
+    d << std::setprecision(17) << "duration_s: " << 604800.0 * (1.0 + 1e-6 + u(rng) * 1e6);
+    const auto md = covarianceError("dur.yaml", d.str());
+    EXPECT_NE(md.find(": key 'duration_s': must be in (0, 604800] s"), std::string::npos) << md;
+  }
+  EXPECT_EQ(covarianceError("edge.yaml", "imu_rate_hz: 10000\nduration_s: 1"), "");
+  EXPECT_EQ(covarianceError("edge1.yaml", "imu_rate_hz: 1\noutput_rate_hz: 1\nduration_s: 604800\n"
+                                          "baro: {rate_hz: 0.5}"), "");
+  const auto mb = covarianceError("baro.yaml", "baro: {sigma_m: 1e308}");
+  EXPECT_NE(mb.find(": key 'baro.sigma_m': must be in (0, 10000] m, got 1e+308"), std::string::npos) << mb;
+}
+
+// Work and memory are estimated before a run and refused above the budget with
+// the key named, unless allowed; a 48 h static run at 200 Hz is within it.
+TEST(CovarianceStudy, WorkAboveTheBudgetIsRefusedBeforeTheRun) {
+  EXPECT_EQ(covarianceError("soak.yaml", "duration_s: 172800\nimu_rate_hz: 200", true), "");
+  const auto m = covarianceError("big.yaml", "duration_s: 604800\nimu_rate_hz: 10000", true);
+  EXPECT_NE(m.find(": key 'duration_s': the run needs about "), std::string::npos) << m;
+  EXPECT_NE(m.find("--allow-large"), std::string::npos) << m;
+  EXPECT_EQ(covarianceError("big_ok.yaml", "duration_s: 604800\nimu_rate_hz: 10000", true, true), "");
+  const auto r = covarianceError("rows.yaml", "duration_s: 604800\nimu_rate_hz: 10000\noutput_rate_hz: 10000\n"
+                                              "filter: {propagate_every: 1000000}", true);
+  EXPECT_NE(r.find(": key 'output_rate_hz': the results need about 4.84e+05 MB, above the budget of 2e+03 MB"), std::string::npos) << r;
 }

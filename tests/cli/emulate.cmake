@@ -51,3 +51,18 @@ set_tests_properties(cli_emulate_gzip9_replays PROPERTIES FIXTURES_REQUIRED emu_
 add_test(NAME cli_emulate_bad_gzip_level
   COMMAND ${NI} emulate --config ${_edir}/uav30.yaml --out ${_edir}/bad_level.rawlog --gzip-level 12)
 set_tests_properties(cli_emulate_bad_gzip_level PROPERTIES WILL_FAIL TRUE)
+
+# Values beyond their documented physical range are refused at load, naming the key.
+foreach(_case "baro_sigma|imu: {errors: none}\nbaro: {sigma_m: 1e308}|key 'baro.sigma_m': must be in .0, 10000. m, got 1e.308"
+              "lever_arm|imu: {errors: none}\ngnss: {lever_arm_B_m: [0, 1e308, 0]}|key 'gnss.lever_arm_B_m.1.': must be in .-100, 100. m"
+              "imu_rate|imu: {rate_hz: 1e7, errors: none}|key 'imu.rate_hz': must be in .1, 10000. Hz, got 1e.07")
+  string(REPLACE "|" ";" _p "${_case}")
+  list(GET _p 0 _n)
+  list(GET _p 1 _body)
+  list(GET _p 2 _re)
+  file(WRITE ${_edir}/range_${_n}.yaml
+       "trajectory: {file: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz, end_s: 30}\n${_body}\n")
+  navimpact_cli_fail(cli_emulate_range_${_n}
+    ARGS emulate --config ${_edir}/range_${_n}.yaml --out ${_edir}/range_${_n}.rawlog
+    REGEX "${_re}" NOOUT ${_edir}/range_${_n}.rawlog)
+endforeach()

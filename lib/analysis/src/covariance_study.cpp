@@ -17,6 +17,7 @@
 #include "navimpact/emulation/trajectory.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/core/limits.hpp"
 
 namespace navimpact::analysis {
 
@@ -110,12 +111,10 @@ CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
   c.model_file = mp.lexically_normal().string();
   echo["model_file"] = mf;
 
-  c.duration_s = r.num(root, "duration_s", "", 60.0, "s");
-  positive(path, "duration_s", c.duration_s);
-  c.imu_rate_hz = r.num(root, "imu_rate_hz", "", 200.0, "Hz");
-  positive(path, "imu_rate_hz", c.imu_rate_hz);
-  c.output_rate_hz = r.num(root, "output_rate_hz", "", 10.0, "Hz");
-  positive(path, "output_rate_hz", c.output_rate_hz);
+  c.duration_s = limits::check(path, "duration_s", r.num(root, "duration_s", "", 60.0, "s"), limits::kDurationS);
+  c.imu_rate_hz = limits::check(path, "imu_rate_hz", r.num(root, "imu_rate_hz", "", 200.0, "Hz"), limits::kImuRateHz);
+  c.output_rate_hz =
+      limits::check(path, "output_rate_hz", r.num(root, "output_rate_hz", "", 10.0, "Hz"), limits::kAidingRateHz);
   if (c.output_rate_hz > c.imu_rate_hz)
     throw keyError(path, "output_rate_hz", "must not exceed imu_rate_hz");
   echo["duration_s"] = c.duration_s;
@@ -177,7 +176,8 @@ CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
     c.baro_rate_hz = r.num(b, "rate_hz", "baro", 10.0, "Hz");
     c.baro_sigma_m = r.num(b, "sigma_m", "baro", 1e-3, "m");
     nonNegative(path, "baro.rate_hz", c.baro_rate_hz);
-    positive(path, "baro.sigma_m", c.baro_sigma_m);
+    if (c.baro_rate_hz > 0.0) limits::check(path, "baro.rate_hz", c.baro_rate_hz, limits::kAidingRateHz);
+    limits::check(path, "baro.sigma_m", c.baro_sigma_m, limits::kPositionSigmaM);
     if (c.baro_rate_hz > c.imu_rate_hz) throw keyError(path, "baro.rate_hz", "must not exceed imu_rate_hz");
   }
   echo["baro"] = {{"rate_hz", c.baro_rate_hz}, {"sigma_m", c.baro_sigma_m}};
@@ -250,6 +250,8 @@ Eigen::Vector3d eulerSigmas(const Matrix3d& P_psi, const ins::NavState& x) {
   return (Mi * P_psi * Mi.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 
+void checkBudget(const CovarianceStudyConfig& cfg, long n);
+
 namespace {
 /// Nominal state and rates at sample k (k = 0 .. n) of the horizon.
 using NominalFn = std::function<void(long k, ins::NavState& x, Vector3d& w_B, Vector3d& f_B)>;
@@ -259,6 +261,7 @@ CovarianceStudyResult runAlong(const CovarianceStudyConfig& cfg, long n, const N
   CovarianceStudyResult res;
   int total = 0, done = 0;
   for (const auto& s : cfg.model_sets) total += static_cast<int>(s.models.size());
+  checkBudget(cfg, n);
   const double dt = 1.0 / cfg.imu_rate_hz;
   const long every_out = std::max(1L, std::lround(cfg.imu_rate_hz / cfg.output_rate_hz));
   const long every_baro =
@@ -309,6 +312,40 @@ CovarianceStudyResult runAlong(const CovarianceStudyConfig& cfg, long n, const N
   return res;
 }
 }  // namespace
+
+CovarianceBudget estimateCovarianceBudget(const CovarianceStudyConfig& cfg, long n) {
+  CovarianceBudget b;
+  const double k = cfg.filter.propagate_every;
+  const double rows = std::floor(double(n) * cfg.output_rate_hz / cfg.imu_rate_hz) + 1.0;
+  for (const ModelSet& set : cfg.model_sets)
+    for (const std::string& name : set.models) {
+      const double N =
+          filter::StateLayout::build(stochastic::loadImuModel(cfg.model_file + ":" + name), cfg.filter.imu).size();
+      // per IMU step: the nominal-rate Jacobian and noise (N^2); per propagation: Phi P Phi^T (2 N^3)
+      b.work += double(n) * (N * N + 2.0 * N * N * N / k);
+      b.memory_bytes += rows * (sizeof(double) + 9 * sizeof(double));
+    }
+  return b;
+}
+
+void checkBudget(const CovarianceStudyConfig& cfg, long n) {
+  const CovarianceBudget b = estimateCovarianceBudget(cfg, n);
+  auto g = [](double v) {
+    char s[32];
+    std::snprintf(s, sizeof s, "%.3g", v);
+    return std::string(s);
+  };
+  if (cfg.allow_large) return;
+  if (b.work > limits::kDefaultWorkBudget)
+    throw keyError(cfg.source, "duration_s",
+                   "the run needs about " + g(b.work) + " floating-point operations (" + g(double(n)) +
+                       " IMU steps; imu_rate_hz, filter.propagate_every and the models' state counts), above the budget of " +
+                       g(limits::kDefaultWorkBudget) + ": shorten it or pass --allow-large");
+  if (b.memory_bytes > limits::kDefaultMemoryBudgetBytes)
+    throw keyError(cfg.source, "output_rate_hz",
+                   "the results need about " + g(b.memory_bytes / 1e6) + " MB, above the budget of " +
+                       g(limits::kDefaultMemoryBudgetBytes / 1e6) + " MB: lower it or duration_s, or pass --allow-large");
+}
 
 CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,
                                          const std::function<void(int, int)>& progress) {

@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <algorithm>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +22,7 @@
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/stochastic/model_file.hpp"
+#include "navimpact/core/limits.hpp"
 
 namespace navimpact::analysis {
 
@@ -95,7 +98,11 @@ ReplayConfig loadReplayConfig(const std::string& path) {
     }
   }
   if (const auto f = root["filter"]) {
-    subKeys(f, "filter", {"propagate_every", "use_gnss_velocity", "gate_probability"});
+    subKeys(f, "filter", {"propagate_every", "use_gnss_velocity", "gate_probability", "max_imu_gap_s"});
+    if (f["max_imu_gap_s"]) {
+      c.max_imu_gap_s = limits::check(path, "filter.max_imu_gap_s", num(f["max_imu_gap_s"], "filter.max_imu_gap_s"),
+                                      limits::Range{0.0, kMaxImuGapS, false, "s"});
+    }
     if (f["propagate_every"]) {
       c.propagate_every = f["propagate_every"].as<int>();
       if (c.propagate_every < 1) throw keyError(path, "filter.propagate_every", "must be >= 1");
@@ -113,16 +120,23 @@ ReplayConfig loadReplayConfig(const std::string& path) {
   }
   if (const auto n = root["noise"]) {
     subKeys(n, "noise", {"sigma_pos_h_m", "sigma_pos_v_m", "sigma_vel_h_mps", "sigma_vel_v_mps", "sigma_baro_m"});
-    if (n["sigma_pos_h_m"]) c.sigma_pos_h_m = pos(n["sigma_pos_h_m"], "noise.sigma_pos_h_m");
-    if (n["sigma_pos_v_m"]) c.sigma_pos_v_m = pos(n["sigma_pos_v_m"], "noise.sigma_pos_v_m");
-    if (n["sigma_vel_h_mps"]) c.sigma_vel_h_mps = pos(n["sigma_vel_h_mps"], "noise.sigma_vel_h_mps");
-    if (n["sigma_vel_v_mps"]) c.sigma_vel_v_mps = pos(n["sigma_vel_v_mps"], "noise.sigma_vel_v_mps");
-    if (n["sigma_baro_m"]) c.sigma_baro_m = pos(n["sigma_baro_m"], "noise.sigma_baro_m");
+    auto ranged = [&](const char* k, const limits::Range& range) {
+      return limits::check(path, std::string("noise.") + k, num(n[k], std::string("noise.") + k), range);
+    };
+    if (n["sigma_pos_h_m"]) c.sigma_pos_h_m = ranged("sigma_pos_h_m", limits::kPositionSigmaM);
+    if (n["sigma_pos_v_m"]) c.sigma_pos_v_m = ranged("sigma_pos_v_m", limits::kPositionSigmaM);
+    if (n["sigma_vel_h_mps"]) c.sigma_vel_h_mps = ranged("sigma_vel_h_mps", limits::kVelocitySigmaMps);
+    if (n["sigma_vel_v_mps"]) c.sigma_vel_v_mps = ranged("sigma_vel_v_mps", limits::kVelocitySigmaMps);
+    if (n["sigma_baro_m"]) c.sigma_baro_m = ranged("sigma_baro_m", limits::kPositionSigmaM);
   }
   if (const auto l = root["gnss_lever_arm_B_m"]) {
     if (!l.IsSequence() || l.size() != 3) throw keyError(path, "gnss_lever_arm_B_m", "expected [x, y, z] in metres");
-    c.lever_arm_B = Eigen::Vector3d(num(l[0], "gnss_lever_arm_B_m"), num(l[1], "gnss_lever_arm_B_m"),
-                                    num(l[2], "gnss_lever_arm_B_m"));
+    Eigen::Vector3d v;
+    for (int k = 0; k < 3; ++k) {
+      const std::string key = "gnss_lever_arm_B_m[" + std::to_string(k) + "]";
+      v[k] = limits::check(path, key, num(l[k], key), limits::kLeverArmM);
+    }
+    c.lever_arm_B = v;
   }
   if (const auto a = root["initial_attitude_deg"]) {
     if (!a.IsSequence() || a.size() != 3)
@@ -270,16 +284,60 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
     throw Error(cfg.rawlog + ": the scenario records no IMU error model: give one with --model FILE[:NAME]");
   }
 
-  // IMU samples and time zero.
-  const double dt = d.imu[1].t - d.imu[0].t;
+  // IMU samples and time zero. The nominal step is the median interval; an
+  // interval longer than kGapSteps nominal steps is a gap: an error unless the
+  // configuration allows gaps up to max_imu_gap_s, then the filter propagates
+  // across it in nominal-length sub-steps with the rates of the sample after
+  // the gap held constant, and the outputs say so.
+  std::vector<double> steps(d.imu.size() - 1);
+  for (std::size_t k = 1; k < d.imu.size(); ++k) steps[k - 1] = d.imu[k].t - d.imu[k - 1].t;
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  const double med = steps[steps.size() / 2];
+  const double dt0 = d.imu[1].t - d.imu[0].t;
+  const double dt = std::abs(dt0 - med) <= 0.01 * med ? dt0 : med;
   r.imu_rate_hz = 1.0 / dt;
   r.t_zero = d.imu.front().t - dt;
-  std::vector<ins::ImuSample> imu(d.imu.size());
+  std::vector<ins::ImuSample> imu;
+  imu.reserve(d.imu.size());
   double prev = r.t_zero;
+  auto g10 = [](double v) {  // 10 significant digits
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.10g", v);
+    return std::string(buf);
+  };
+  std::size_t gaps = 0;
+  double longest = 0.0, longestAt = 0.0;
   for (std::size_t k = 0; k < d.imu.size(); ++k) {
-    imu[k] = ins::ImuSample::fromRates(d.imu[k].t, d.imu[k].t - prev, d.imu[k].w_IB_B, d.imu[k].f_B);
+    const double h = d.imu[k].t - prev;
+    if (k > 0 && h > kImuGapSteps * med) {
+      if (!(h <= cfg.max_imu_gap_s))
+        throw Error(cfg.rawlog + ": IMU gap of " + g10(h) + " s ending at t = " + g10(d.imu[k].t - r.t_zero) +
+                    " s (nominal step " + g10(med) + " s; the filter would coast across it unnoticed): allow gaps "
+                    "up to a length with filter.max_imu_gap_s or --max-imu-gap S (accepted 0-" +
+                    g10(kMaxImuGapS) + " s)");
+      const auto m = static_cast<std::size_t>(std::llround(h / med));
+      if (imu.size() + m > 2 * d.imu.size() + 16)
+        throw Error(cfg.rawlog + ": IMU gaps hold more missing samples than the data has samples");
+      for (std::size_t j = 1; j <= m; ++j) {
+        const double t = j == m ? d.imu[k].t : prev + h * static_cast<double>(j) / static_cast<double>(m);
+        imu.push_back(ins::ImuSample::fromRates(t, t - imu.back().t, d.imu[k].w_IB_B, d.imu[k].f_B));
+      }
+      ++gaps;
+      if (h > longest) {
+        longest = h;
+        longestAt = d.imu[k].t - r.t_zero;
+      }
+    } else {
+      imu.push_back(ins::ImuSample::fromRates(d.imu[k].t, h, d.imu[k].w_IB_B, d.imu[k].f_B));
+    }
     prev = d.imu[k].t;
   }
+  if (gaps > 0)
+    r.notices.push_back(std::to_string(gaps) + " IMU gap(s) longer than " + g10(kImuGapSteps) +
+                        " nominal steps accepted (longest " + g10(longest) + " s, ending at t = " + g10(longestAt) +
+                        " s; filter.max_imu_gap_s = " + g10(cfg.max_imu_gap_s) +
+                        " s): the filter propagated across each with the rates of the sample after it held constant");
+  r.imu_gaps = gaps;
   const double t_last = d.imu.back().t;
 
   // Outages in rawlog time.
@@ -292,6 +350,8 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   // sample, else (baro) the scenario's.
   double sBaro = NAN;
   if (scen && scen["baro"] && scen["baro"]["sigma_m"]) sBaro = scen["baro"]["sigma_m"].as<double>();
+  if (std::isfinite(sBaro) && !cfg.sigma_baro_m)
+    limits::check(cfg.rawlog, "scenario baro.sigma_m", sBaro, limits::kPositionSigmaM);
   for (auto& b : d.baro) {
     if (cfg.sigma_baro_m) b.sigma_m = *cfg.sigma_baro_m;
     else if (!b.sigma_m) b.sigma_m = sBaro;
@@ -314,7 +374,11 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   Eigen::Vector3d lever = Eigen::Vector3d::Zero();
   if (scen && scen["gnss"] && scen["gnss"]["lever_arm_B_m"]) {
     const auto l = scen["gnss"]["lever_arm_B_m"].as<std::vector<double>>();
-    if (l.size() == 3) lever = Eigen::Vector3d(l[0], l[1], l[2]);
+    if (l.size() == 3 && !cfg.lever_arm_B) {
+      for (int k = 0; k < 3; ++k)
+        limits::check(cfg.rawlog, "scenario gnss.lever_arm_B_m[" + std::to_string(k) + "]", l[k], limits::kLeverArmM);
+      lever = Eigen::Vector3d(l[0], l[1], l[2]);
+    }
   }
   if (cfg.lever_arm_B) lever = *cfg.lever_arm_B;
   opt.lever_arm_B = lever;

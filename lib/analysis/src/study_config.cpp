@@ -8,6 +8,7 @@
 
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/core/units.hpp"
 
@@ -153,7 +154,7 @@ StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::stri
     checkKeys(s, c, "imu", {"rate_hz"});
     opt(s, "rate_hz", c, "imu", cfg.imu_rate_hz);
   }
-  positive(cfg.imu_rate_hz, c, "imu.rate_hz");
+  limits::check(path, "imu.rate_hz", cfg.imu_rate_hz, limits::kImuRateHz);
 
   // truth
   const YAML::Node tn = root["truth"];
@@ -258,21 +259,24 @@ StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::stri
     if (g["lever_arm_B_m"]) {
       const auto v = get<std::vector<double>>(g["lever_arm_B_m"], c, "gnss.lever_arm_B_m");
       if (v.size() != 3) throw keyError(path, "gnss.lever_arm_B_m", "expected 3 numbers [m]");
+      for (int k = 0; k < 3; ++k)
+        limits::check(path, "gnss.lever_arm_B_m[" + std::to_string(k) + "]", v[k], limits::kLeverArmM);
       cfg.gnss.lever_arm_B = Eigen::Vector3d(v[0], v[1], v[2]);
     }
   }
-  for (auto [v, k] : {std::pair{cfg.gnss.rate_hz, "gnss.rate_hz"}, {cfg.gnss.sigma_pos_h_m, "gnss.sigma_pos_h_m"},
-                      {cfg.gnss.sigma_pos_v_m, "gnss.sigma_pos_v_m"}, {cfg.gnss.sigma_vel_h_mps, "gnss.sigma_vel_h_mps"},
-                      {cfg.gnss.sigma_vel_v_mps, "gnss.sigma_vel_v_mps"}})
-    positive(v, c, k);
+  limits::check(path, "gnss.rate_hz", cfg.gnss.rate_hz, limits::kAidingRateHz);
+  limits::check(path, "gnss.sigma_pos_h_m", cfg.gnss.sigma_pos_h_m, limits::kPositionSigmaM);
+  limits::check(path, "gnss.sigma_pos_v_m", cfg.gnss.sigma_pos_v_m, limits::kPositionSigmaM);
+  limits::check(path, "gnss.sigma_vel_h_mps", cfg.gnss.sigma_vel_h_mps, limits::kVelocitySigmaMps);
+  limits::check(path, "gnss.sigma_vel_v_mps", cfg.gnss.sigma_vel_v_mps, limits::kVelocitySigmaMps);
   if (const YAML::Node b = root["baro"]) {
     checkKeys(b, c, "baro", {"rate_hz", "sigma_m", "during_outages"});
     opt(b, "rate_hz", c, "baro", cfg.baro.rate_hz);
     opt(b, "sigma_m", c, "baro", cfg.baro.sigma_m);
     opt(b, "during_outages", c, "baro", cfg.baro_in_outage);
   }
-  positive(cfg.baro.rate_hz, c, "baro.rate_hz");
-  positive(cfg.baro.sigma_m, c, "baro.sigma_m");
+  limits::check(path, "baro.rate_hz", cfg.baro.rate_hz, limits::kAidingRateHz);
+  limits::check(path, "baro.sigma_m", cfg.baro.sigma_m, limits::kPositionSigmaM);
 
   if (const YAML::Node o = root["outages"]) {
     if (!o.IsSequence() || o.size() == 0) throw keyError(path, "outages", "expected a non-empty list");
@@ -282,7 +286,8 @@ StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::stri
       checkKeys(o[i], c, w, {"start_s", "duration_s"});
       if (!o[i]["start_s"] || !o[i]["duration_s"]) throw keyError(path, w, "needs start_s and duration_s");
       const double s = get<double>(o[i]["start_s"], c, w + ".start_s");
-      const double d = positive(get<double>(o[i]["duration_s"], c, w + ".duration_s"), c, w + ".duration_s");
+      const double d = limits::check(path, w + ".duration_s", get<double>(o[i]["duration_s"], c, w + ".duration_s"),
+                                     limits::kDurationS);
       if (!(s >= 0.0)) throw keyError(path, w + ".start_s", "must be >= 0 (seconds from the trajectory start)");
       if (!cfg.outages.empty() && s < cfg.outages.back().end_s)
         throw keyError(path, w + ".start_s", "outages must be in time order and not overlap");
@@ -293,7 +298,9 @@ StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::stri
     checkKeys(m, c, "monte_carlo", {"runs", "seed", "threads"});
     if (m["runs"]) {
       const long long r = get<long long>(m["runs"], c, "monte_carlo.runs");
-      if (r < 1) throw keyError(path, "monte_carlo.runs", "must be >= 1, got " + std::to_string(r));
+      if (r < 1 || r > limits::kMaxMonteCarloRuns)
+        throw keyError(path, "monte_carlo.runs",
+                       "must be in [1, " + std::to_string(limits::kMaxMonteCarloRuns) + "], got " + std::to_string(r));
       cfg.runs = static_cast<std::size_t>(r);
     }
     opt(m, "seed", c, "monte_carlo", cfg.seed);
@@ -331,8 +338,8 @@ StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::stri
     opt(r, "rate_hz", c, "record", cfg.record_rate_hz);
     opt(r, "outage_rate_hz", c, "record", cfg.outage_record_rate_hz);
   }
-  positive(cfg.record_rate_hz, c, "record.rate_hz");
-  positive(cfg.outage_record_rate_hz, c, "record.outage_rate_hz");
+  limits::check(path, "record.rate_hz", cfg.record_rate_hz, limits::kAidingRateHz);
+  limits::check(path, "record.outage_rate_hz", cfg.outage_record_rate_hz, limits::kAidingRateHz);
   if (const YAML::Node r = root["report"]) {
     checkKeys(r, c, "report", {"margin", "plot_before_s", "plot_after_s"});
     opt(r, "margin", c, "report", cfg.margin);

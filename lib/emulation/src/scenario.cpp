@@ -12,6 +12,7 @@
 #include "navimpact/core/format.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/stochastic/model_file.hpp"
+#include "navimpact/core/limits.hpp"
 
 namespace navimpact::emulation {
 
@@ -148,7 +149,7 @@ EmulationConfig loadEmulationConfig(const std::string& path) {
 
   if (const auto i = root["imu"]) {
     checkKeys(i, c, "imu", {"rate_hz", "errors", "model", "seed", "static"});
-    cfg.imu_rate_hz = positive(get<double>(i, "rate_hz", c, "imu", cfg.imu_rate_hz), c, "imu.rate_hz");
+    cfg.imu_rate_hz = limits::check(c.file, "imu.rate_hz", get<double>(i, "rate_hz", c, "imu", cfg.imu_rate_hz), limits::kImuRateHz);
     cfg.imu_errors = get<std::string>(i, "errors", c, "imu", cfg.imu_errors);
     if (cfg.imu_errors != "model" && cfg.imu_errors != "static" && cfg.imu_errors != "none")
       throw keyError(path, "imu.errors", "'" + cfg.imu_errors + "' is not model, static or none");
@@ -175,28 +176,31 @@ EmulationConfig loadEmulationConfig(const std::string& path) {
     checkKeys(g, c, "gnss", {"rate_hz", "sigma_pos_h_m", "sigma_pos_v_m", "sigma_vel_h_mps", "sigma_vel_v_mps",
                              "lever_arm_B_m", "seed"});
     auto& o = cfg.gnss;
-    o.rate_hz = positive(get<double>(g, "rate_hz", c, "gnss", o.rate_hz), c, "gnss.rate_hz");
-    o.sigma_pos_h_m = positive(get<double>(g, "sigma_pos_h_m", c, "gnss", o.sigma_pos_h_m), c, "gnss.sigma_pos_h_m");
-    o.sigma_pos_v_m = positive(get<double>(g, "sigma_pos_v_m", c, "gnss", o.sigma_pos_v_m), c, "gnss.sigma_pos_v_m");
-    o.sigma_vel_h_mps = positive(get<double>(g, "sigma_vel_h_mps", c, "gnss", o.sigma_vel_h_mps), c, "gnss.sigma_vel_h_mps");
-    o.sigma_vel_v_mps = positive(get<double>(g, "sigma_vel_v_mps", c, "gnss", o.sigma_vel_v_mps), c, "gnss.sigma_vel_v_mps");
+    o.rate_hz = limits::check(c.file, "gnss.rate_hz", get<double>(g, "rate_hz", c, "gnss", o.rate_hz), limits::kAidingRateHz);
+    o.sigma_pos_h_m = limits::check(c.file, "gnss.sigma_pos_h_m", get<double>(g, "sigma_pos_h_m", c, "gnss", o.sigma_pos_h_m), limits::kPositionSigmaM);
+    o.sigma_pos_v_m = limits::check(c.file, "gnss.sigma_pos_v_m", get<double>(g, "sigma_pos_v_m", c, "gnss", o.sigma_pos_v_m), limits::kPositionSigmaM);
+    o.sigma_vel_h_mps = limits::check(c.file, "gnss.sigma_vel_h_mps", get<double>(g, "sigma_vel_h_mps", c, "gnss", o.sigma_vel_h_mps), limits::kVelocitySigmaMps);
+    o.sigma_vel_v_mps = limits::check(c.file, "gnss.sigma_vel_v_mps", get<double>(g, "sigma_vel_v_mps", c, "gnss", o.sigma_vel_v_mps), limits::kVelocitySigmaMps);
     if (g["lever_arm_B_m"]) {
       const auto l = get<std::vector<double>>(g, "lever_arm_B_m", c, "gnss", {});
       if (l.size() != 3) throw keyError(path, "gnss.lever_arm_B_m", "expected [x, y, z] in metres (body FRD)");
+      for (int k = 0; k < 3; ++k)
+        limits::check(c.file, "gnss.lever_arm_B_m[" + std::to_string(k) + "]", l[k], limits::kLeverArmM);
       o.lever_arm_B = Eigen::Vector3d(l[0], l[1], l[2]);
     }
     o.seed = get<std::uint64_t>(g, "seed", c, "gnss", o.seed);
   }
   if (const auto b = root["baro"]) {
     checkKeys(b, c, "baro", {"rate_hz", "sigma_m", "seed"});
-    cfg.baro.rate_hz = positive(get<double>(b, "rate_hz", c, "baro", cfg.baro.rate_hz), c, "baro.rate_hz");
-    cfg.baro.sigma_m = positive(get<double>(b, "sigma_m", c, "baro", cfg.baro.sigma_m), c, "baro.sigma_m");
+    cfg.baro.rate_hz = limits::check(c.file, "baro.rate_hz", get<double>(b, "rate_hz", c, "baro", cfg.baro.rate_hz), limits::kAidingRateHz);
+    cfg.baro.sigma_m = limits::check(c.file, "baro.sigma_m", get<double>(b, "sigma_m", c, "baro", cfg.baro.sigma_m), limits::kPositionSigmaM);
     cfg.baro.seed = get<std::uint64_t>(b, "seed", c, "baro", cfg.baro.seed);
   }
   if (const auto gt = root["ground_truth"]) {
     checkKeys(gt, c, "ground_truth", {"rate_hz"});
-    cfg.truth_rate_hz = positive(get<double>(gt, "rate_hz", c, "ground_truth", cfg.truth_rate_hz), c,
-                                 "ground_truth.rate_hz");
+    cfg.truth_rate_hz = limits::check(c.file, "ground_truth.rate_hz",
+                                      get<double>(gt, "rate_hz", c, "ground_truth", cfg.truth_rate_hz),
+                                      limits::kAidingRateHz);
   }
   if (const auto o = root["output"]) {
     checkKeys(o, c, "output", {"start_utc"});

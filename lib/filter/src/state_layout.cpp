@@ -7,6 +7,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
+#include "navimpact/core/limits.hpp"
 
 namespace navimpact::filter {
 
@@ -67,6 +68,7 @@ StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuError
     }
     if (model.axis[c].empty()) continue;
     stochastic::validate(model.axis[c]);
+    const std::size_t axisStart = L.names_.size();
     const stochastic::Model m = whiteShortGms(model.axis[c], opt.white_gm_below_s, ch, L.notes_);
     std::map<stochastic::ProcessKind, int> count;
     for (const stochastic::Process& p : m.terms) {
@@ -85,6 +87,11 @@ StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuError
         throw Error("internal: state-space block of " + base + " has " + std::to_string(ss.n) +
                     " states, expected a different number");
       L.blocks_.push_back(b);
+      const std::size_t axisStates = L.names_.size() - axisStart;
+      if (axisStates > static_cast<std::size_t>(limits::kMaxImuStatesPerAxis))
+        throw Error((model.source.empty() ? std::string("IMU model") : "model " + model.source) + ": " + ch +
+                    " needs more than " + std::to_string(limits::kMaxImuStatesPerAxis) + " error states (" +
+                    std::to_string(m.terms.size()) + " terms), more than the filter accepts per axis");
     }
   }
   const int m = L.imuSize();

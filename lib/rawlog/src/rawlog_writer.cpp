@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <stdexcept>
 #include <vector>
 
@@ -240,6 +241,7 @@ Recording readRawlog(const std::string& path, const RawlogReadOptions& opt) {
   std::size_t entry = 0, skipped = 0;
   double lastT = -1e300;
   std::string lastLabel;
+  std::map<std::string, std::pair<double, std::size_t>> lastOfLabel;  // label -> time, entry of its last record
   earth::Geodetic origin;
   auto where = [&](const std::string& label, double t) {
     std::string s = path + ": entry " + std::to_string(entry);
@@ -295,6 +297,15 @@ Recording readRawlog(const std::string& path, const RawlogReadOptions& opt) {
                   std::to_string(lastT) + " s)");
     lastT = t;
     lastLabel = label;
+    if (label == "IMU" || label == "BARO" || label == "GT" || label == "GNSS") {
+      // Each sensor's own timestamps increase strictly: a second record at the
+      // same time is a duplicate (a GNSS fix applied twice), never accepted.
+      auto [it, first] = lastOfLabel.try_emplace(label, t, entry);
+      if (!first && !(t > it->second.first))
+        throw Error(where(label, t) + ": same time as " + printable(label, 40) + " entry " +
+                    std::to_string(it->second.second) + " (a duplicated record; each sensor's timestamps must increase)");
+      it->second = {t, entry};
+    }
     if (label == "GT" && std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(o)) {
       const auto& rp = *std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(o);
       if (!haveOrigin) throw Error(where(label, t) + ": the reference needs the scenario comment's origin, none found before it");

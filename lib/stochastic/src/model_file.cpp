@@ -13,6 +13,7 @@
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 #include "navimpact/stochastic/model_text.hpp"
+#include "navimpact/core/limits.hpp"
 
 namespace navimpact::stochastic {
 
@@ -56,8 +57,7 @@ double readRate(const YAML::Node& n, const std::string& file, const std::string&
   } catch (const YAML::Exception&) {
     throw keyError(file, key, "expected a number in Hz, found '" + n.Scalar() + "'");
   }
-  if (!(v > 0.0) || !std::isfinite(v)) throw keyError(file, key, "must be a finite number > 0 Hz");
-  return v;
+  return limits::check(file, key, v, limits::kImuRateHz);
 }
 
 /// Build the six axes of one model node (single-model root or models.NAME).

@@ -55,7 +55,22 @@ struct CovarianceStudyConfig {
   filter::EkfConfig filter;          ///< discretization, propagate_every
   std::vector<ModelSet> model_sets;
   std::string echo;                  ///< the configuration as JSON text (for summary.json)
+  bool allow_large = false;          ///< run even above the work and memory budgets (--allow-large)
 };
+
+/// Work and memory a covariance run needs (checked before it starts).
+struct CovarianceBudget {
+  double work = 0.0;          ///< floating-point operations, about: steps x (N^2 + 2 N^3 / propagate_every) per model
+  double memory_bytes = 0.0;  ///< results held: output rows x 10 doubles per model [bytes]
+};
+
+/// Estimate of the work and memory of a run of @p n IMU steps.
+CovarianceBudget estimateCovarianceBudget(const CovarianceStudyConfig& cfg, long n);
+
+/// @throws navimpact::Error naming the configuration and key when the run of
+///         @p n IMU steps is above limits::kDefaultWorkBudget or
+///         limits::kDefaultMemoryBudgetBytes and allow_large is not set.
+void checkBudget(const CovarianceStudyConfig& cfg, long n);
 
 /**
  * Read and validate a study configuration.

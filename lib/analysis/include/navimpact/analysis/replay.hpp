@@ -16,11 +16,19 @@
  * rawlog: ../../datasets/uav_flight_260s_ref.rawlog
  * model: ../models/navchip_table1.yaml:ref   # filter's IMU model; default: the rawlog's scenario model
  * outages: [{start_s: 200, duration_s: 60}]  # [s] from time zero
- * filter: {propagate_every: 10, use_gnss_velocity: true, gate_probability: 0}
+ * filter: {propagate_every: 10, use_gnss_velocity: true, gate_probability: 0, max_imu_gap_s: 0}
  * initial_sigma: {pos_h_m: 1, pos_v_m: 1, vel_mps: 0.1, roll_pitch_deg: 0.1, yaw_deg: 0.5}
  * noise: {sigma_pos_h_m: 2, sigma_pos_v_m: 4, sigma_vel_h_mps: 0.05, sigma_vel_v_mps: 0.1, sigma_baro_m: 0.5}
  * gnss_lever_arm_B_m: [0, 0, 0]              # default: the scenario's
  * @endcode
+ * IMU gaps: an IMU interval longer than kImuGapSteps times the median interval
+ * is an error naming the rawlog and the time, unless `filter.max_imu_gap_s`
+ * (or --max-imu-gap) allows gaps up to that length [s] (0 to kMaxImuGapS);
+ * then the filter propagates across each gap in nominal-length sub-steps with
+ * the rates of the sample after the gap held constant, and a notice in
+ * summary.json says how many gaps and the longest. Duplicated records (two of
+ * one sensor at the same time) are refused by the rawlog reader.
+ *
  * Without `noise`, the covariances recorded with each GNSS fix and the
  * scenario's barometer sigma are used.
  *
@@ -46,6 +54,11 @@
 
 namespace navimpact::analysis {
 
+/// An IMU interval longer than this many nominal (median) steps is a gap.
+constexpr double kImuGapSteps = 1.5;
+/// Largest accepted filter.max_imu_gap_s [s].
+constexpr double kMaxImuGapS = 60.0;
+
 /// Replay options (see the file comment for the YAML form).
 struct ReplayConfig {
   std::string config_file;
@@ -62,6 +75,7 @@ struct ReplayConfig {
   std::optional<Eigen::Vector3d> lever_arm_B;
   std::optional<Eigen::Vector3d> initial_attitude_deg;  ///< roll, pitch, yaw [deg]; used without GT
   double record_interval_s = 0.1;               ///< record interval without GT [s], > 0
+  double max_imu_gap_s = 0.0;                   ///< longest IMU gap propagated across [s]; 0 = gaps are errors
 };
 
 /// Read a replay configuration. @throws navimpact::Error naming file and key.
@@ -78,6 +92,7 @@ struct ReplayResult {
   std::vector<ins::NavState> truth;         ///< truth at the epochs (empty without GT)
   std::vector<ins::NavState> estimate;      ///< estimate at the epochs
   double read_s = 0.0;                      ///< CPU time of reading the rawlog [s]
+  std::size_t imu_gaps = 0;                 ///< IMU gaps propagated across (allowed by max_imu_gap_s)
   std::vector<std::string> notices;
 };
 

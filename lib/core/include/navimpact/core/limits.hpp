@@ -1,0 +1,60 @@
+/**
+ * @file limits.hpp
+ * @brief Documented physical ranges of configuration values, and the work and
+ *        memory budgets of a run: limits as validation, checked when a value is
+ *        loaded (with the file and key named), not left to luck at run time.
+ *
+ * The ranges are wide (beyond any real sensor or mission) but finite, so that
+ * no single value can make a run spin, overflow or exhaust memory:
+ *  - IMU rate 1 Hz - 10 kHz; aiding and output rates (GNSS, barometer, ground
+ *    truth, records) 0.001 Hz - 10 kHz;
+ *  - position and altitude sigmas (0, 10 km]; velocity sigmas (0, 1 km/s];
+ *  - lever-arm components [-100, 100] m;
+ *  - durations (0, 7 days];
+ *  - IMU error states per axis at most 32 (a model has a handful);
+ *  - Monte Carlo runs of a study at most 10^6.
+ * README ("Ranges and budgets") lists them with the budgets.
+ */
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace navimpact::limits {
+
+/// A closed or left-open range of a physical value, in SI (or the key's unit).
+struct Range {
+  double lo, hi;
+  bool lo_open;      ///< lo itself excluded (e.g. a sigma must be > 0)
+  const char* unit;  ///< unit of the key, for the message
+};
+
+inline constexpr Range kImuRateHz{1.0, 1.0e4, false, "Hz"};
+inline constexpr Range kAidingRateHz{1.0e-3, 1.0e4, false, "Hz"};
+inline constexpr Range kPositionSigmaM{0.0, 1.0e4, true, "m"};
+inline constexpr Range kVelocitySigmaMps{0.0, 1.0e3, true, "m/s"};
+inline constexpr Range kLeverArmM{-100.0, 100.0, false, "m"};
+inline constexpr Range kDurationS{0.0, 7.0 * 86400.0, true, "s"};
+
+/// Most Monte Carlo runs of one study (monte_carlo.runs).
+inline constexpr long long kMaxMonteCarloRuns = 1000000;
+
+/// Most IMU error states of one sensor axis in the filter.
+inline constexpr int kMaxImuStatesPerAxis = 32;
+
+/// Default work budget of one covariance command, in estimated floating-point
+/// operations summed over its models (analysis::estimateCovarianceBudget):
+/// about an hour of one core (2.4e9 estimated operations per second measured
+/// on a 2-core build machine: a 48 h static run at 200 Hz with a 24-state model
+/// is 9.8e11, about 7 minutes).
+inline constexpr double kDefaultWorkBudget = 1.0e13;
+/// Default memory budget of the results a run holds [bytes].
+inline constexpr double kDefaultMemoryBudgetBytes = 2.0e9;
+
+/// Text of a range, e.g. "(0, 1e+04] m".
+std::string describe(const Range& r);
+
+/// @p v if it lies in @p r; else throws keyError(file, key, "must be in RANGE, got V").
+double check(const std::string& file, const std::string& key, double v, const Range& r);
+
+}  // namespace navimpact::limits

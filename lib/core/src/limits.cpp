@@ -1,0 +1,28 @@
+#include "navimpact/core/limits.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "navimpact/core/error.hpp"
+
+namespace navimpact::limits {
+
+namespace {
+std::string g(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+}  // namespace
+
+std::string describe(const Range& r) {
+  return std::string(r.lo_open ? "(" : "[") + g(r.lo) + ", " + g(r.hi) + "] " + r.unit;
+}
+
+double check(const std::string& file, const std::string& key, double v, const Range& r) {
+  const bool ok = std::isfinite(v) && (r.lo_open ? v > r.lo : v >= r.lo) && v <= r.hi;
+  if (!ok) throw keyError(file, key, "must be in " + describe(r) + ", got " + g(v));
+  return v;
+}
+
+}  // namespace navimpact::limits
