@@ -142,7 +142,7 @@ int run(const Opts& o) {
   }
   const std::string comment = "extended by navimpact diagnose from " + o.in.input + " (model " + o.model +
                               ", seed " + std::to_string(o.seed) + ")";
-  const std::size_t figs = navimpact::report::writeDiagnosisOutputs(d, in.dump(), comment, out);
+  const std::size_t figs = navimpact::report::writeDiagnosisOutputs(d, in.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), comment, out);
   out.commit();
 
   for (const auto& n : d.notices) std::cerr << "navimpact: notice: " << n << "\n";

@@ -58,7 +58,7 @@ int run(Opts o) {
                                 {"axes", o.in.axes},
                                 {"label", o.in.label}};
   input.update(navimpact::cli::inputSelectionJson(o.in));
-  navimpact::report::writeFitOutputs(f, input.dump(), NAVIMPACT_VERSION, outs);
+  navimpact::report::writeFitOutputs(f, input.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), NAVIMPACT_VERSION, outs);
   outs.commit();
 
   std::cout << navimpact::report::fitSummary(f) << "wrote";

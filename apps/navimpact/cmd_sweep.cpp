@@ -56,7 +56,7 @@ std::string timingJson(double wall_s, const an::SweepResults& r) {
   t["wall_s"] = wall_s;
   t["filter_steps"] = r.filter_steps;
   t["us_per_filter_step"] = r.us_per_filter_step;
-  return t.dump(1) + "\n";
+  return t.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 void printSummary(const an::SweepResults& r, const std::string& dir) {

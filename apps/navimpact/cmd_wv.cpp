@@ -42,7 +42,7 @@ int run(const Opts& o) {
                                         {"samples", s.size()},
                                         {"units", navimpact::cli::inputUnitsNote(o.in, fmt)}};
   for (const auto& [k, v] : navimpact::cli::inputSelectionJson(o.in).items()) input[k] = v;
-  navimpact::report::writeWvOutputs(w, input.dump(), outs);
+  navimpact::report::writeWvOutputs(w, input.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), outs);
   outs.commit();
 
   std::cout << navimpact::report::wvSummary(w) << "wrote";

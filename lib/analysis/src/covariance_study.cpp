@@ -71,9 +71,6 @@ struct Reader {
   }
 };
 
-void positive(const std::string& file, const std::string& key, double v) {
-  if (!(v > 0.0)) throw keyError(file, key, "must be > 0, got " + std::to_string(v));
-}
 void nonNegative(const std::string& file, const std::string& key, double v) {
   if (!(v >= 0.0)) throw keyError(file, key, "must be >= 0, got " + std::to_string(v));
 }
@@ -86,7 +83,7 @@ std::string modelText(const stochastic::ImuModel& m) {
 
 }  // namespace
 
-CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
+static CovarianceStudyConfig loadCovarianceStudyConfigImpl(const std::string& path) {
   InputScope scope(path);
   CovarianceStudyConfig c;
   c.source = path;
@@ -96,7 +93,7 @@ CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
   } catch (const YAML::BadFile&) {
     throw fileError(path, 0, "cannot open configuration file");
   } catch (const YAML::Exception& e) {
-    throw fileError(path, e.mark.line + 1, std::string("YAML syntax error: ") + e.msg);
+    throw fileError(path, e.mark.line + 1, std::string("YAML syntax error: ") + printable(e.msg, 120));
   }
   const Reader r{path};
   r.keys(root, "", {"model_file", "duration_s", "imu_rate_hz", "output_rate_hz", "summary_times_s",
@@ -234,8 +231,19 @@ CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
     echo["model_sets"].push_back({{"name", ms.name}, {"title", ms.title}, {"models", ms.models}});
     c.model_sets.push_back(ms);
   }
-  c.echo = echo.dump();
+  c.echo = echo.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   return c;
+}
+
+// A value of the wrong type (yaml-cpp's conversion errors, a list or map used
+// as a key) is an error naming the file and line, never an internal error.
+CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
+  try {
+    return loadCovarianceStudyConfigImpl(path);
+  } catch (const YAML::Exception& e) {
+    throw Error(path + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) : "") +
+                ": " + printable(e.msg, 120) + " (a value or key of the wrong type)");
+  }
 }
 
 Eigen::Vector3d eulerSigmas(const Matrix3d& P_psi, const ins::NavState& x) {

@@ -45,7 +45,7 @@ std::string resolveModel(const fs::path& dir, const std::string& spec) {
 
 }  // namespace
 
-ReplayConfig loadReplayConfig(const std::string& path) {
+static ReplayConfig loadReplayConfigImpl(const std::string& path) {
   InputScope scope(path);
   YAML::Node root;
   try {
@@ -53,7 +53,7 @@ ReplayConfig loadReplayConfig(const std::string& path) {
   } catch (const YAML::BadFile&) {
     throw Error(path + ": cannot open the replay configuration");
   } catch (const YAML::Exception& e) {
-    throw fileError(path, e.mark.line + 1, std::string("YAML syntax: ") + e.msg);
+    throw fileError(path, e.mark.line + 1, std::string("YAML syntax: ") + printable(e.msg, 120));
   }
   ReplayConfig c;
   c.config_file = path;
@@ -146,6 +146,17 @@ ReplayConfig loadReplayConfig(const std::string& path) {
   }
   if (root["record_interval_s"]) c.record_interval_s = pos(root["record_interval_s"], "record_interval_s");
   return c;
+}
+
+// A value of the wrong type (yaml-cpp's conversion errors, a list or map used
+// as a key) is an error naming the file and line, never an internal error.
+ReplayConfig loadReplayConfig(const std::string& path) {
+  try {
+    return loadReplayConfigImpl(path);
+  } catch (const YAML::Exception& e) {
+    throw Error(path + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) : "") +
+                ": " + printable(e.msg, 120) + " (a value or key of the wrong type)");
+  }
 }
 
 namespace {

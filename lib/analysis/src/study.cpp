@@ -508,7 +508,7 @@ void writeShard(const StudyResults& r, OutputSet& out) {
   j["shard"] = {{"k", r.shard.k}, {"n", r.shard.n}};
   j["run_indices"] = r.run_indices;
   j["byte_order"] = "native little-endian IEEE-754 doubles";
-  out.writeText("shard.json", j.dump(1) + "\n");
+  out.writeText("shard.json", j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   const std::size_t E = r.meta.epochs.size(), O = r.meta.outages.size();
   std::ofstream f(out.stage("runs.bin"), std::ios::binary);
   f.write(kMagic, 8);

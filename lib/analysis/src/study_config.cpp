@@ -83,7 +83,7 @@ std::string resolveModelSpec(const Ctx& c, const std::string& spec) {
 
 StudyConfig loadStudyConfig(const std::string& path) { return loadStudyConfig(path, {}); }
 
-StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::string>& extra_keys) {
+static StudyConfig loadStudyConfigImpl(const std::string& path, const std::vector<std::string>& extra_keys) {
   InputScope scope(path);
   StudyConfig cfg;
   cfg.config_file = path;
@@ -93,7 +93,7 @@ StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::stri
   try {
     root = YAML::Load(cfg.config_text);
   } catch (const YAML::Exception& e) {
-    throw fileError(path, e.mark.line + 1, std::string("YAML: ") + e.msg);
+    throw fileError(path, e.mark.line + 1, std::string("YAML: ") + printable(e.msg, 120));
   }
   std::set<std::string> top{"trajectory", "smoothing", "imu",         "truth",  "candidates", "sets",  "gnss",
                             "baro",       "outages",   "monte_carlo", "filter", "record",     "report"};
@@ -348,6 +348,17 @@ StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::stri
   }
   positive(cfg.margin, c, "report.margin");
   return cfg;
+}
+
+// A value of the wrong type (yaml-cpp's conversion errors, a list or map used
+// as a key) is an error naming the file and line, never an internal error.
+StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::string>& extra_keys) {
+  try {
+    return loadStudyConfigImpl(path, extra_keys);
+  } catch (const YAML::Exception& e) {
+    throw Error(path + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) : "") +
+                ": " + printable(e.msg, 120) + " (a value or key of the wrong type)");
+  }
 }
 
 Shard parseShard(const std::string& text) {

@@ -1,7 +1,12 @@
 #include "navimpact/core/alloc_limit.hpp"
 
-#include <cstdlib>
+#include <cstddef>
 #include <new>
+
+// Deliberately without <cstdlib>: glibc declares its allocation functions
+// noexcept, and the aligned_alloc replacement below must be able to throw.
+extern "C" void* malloc(std::size_t n);
+extern "C" int posix_memalign(void** p, std::size_t align, std::size_t n);
 
 namespace navimpact {
 namespace {
@@ -16,7 +21,7 @@ thread_local std::size_t t_refused = 0;
 void* allocate(std::size_t n) {
   if (t_limit != 0 && n > t_limit) refuse(n);
   for (;;) {
-    if (void* p = std::malloc(n ? n : 1)) return p;
+    if (void* p = malloc(n ? n : 1)) return p;
     std::new_handler h = std::get_new_handler();
     if (!h) throw std::bad_alloc();
     h();
@@ -59,4 +64,16 @@ void* operator new(std::size_t n, std::align_val_t a) {
 }
 void* operator new[](std::size_t n, std::align_val_t a) {
   return navimpact::allocateAligned(n, static_cast<std::size_t>(a));
+}
+
+// MRPT allocates its matrices and images through mrpt::aligned_malloc, which
+// calls aligned_alloc and uses the result unchecked (a rawlog matrix of
+// 0xffffffff x 4 floats crashed in memset). Under an AllocationLimit, a larger
+// request throws std::bad_alloc like operator new, so the reader can name the
+// malformed entry; otherwise this forwards to posix_memalign (C11 semantics).
+extern "C" void* aligned_alloc(std::size_t align, std::size_t n) {
+  if (navimpact::t_limit != 0 && n > navimpact::t_limit) navimpact::refuse(n);
+  if (align < sizeof(void*)) align = sizeof(void*);
+  void* p = nullptr;
+  return posix_memalign(&p, align, n ? n : 1) == 0 ? p : nullptr;
 }

@@ -82,7 +82,7 @@ std::string quote(const std::string& s) {
 
 }  // namespace
 
-EmulationConfig loadEmulationConfig(const std::string& path) {
+static EmulationConfig loadEmulationConfigImpl(const std::string& path) {
   InputScope scope(path);
   YAML::Node root;
   try {
@@ -90,7 +90,7 @@ EmulationConfig loadEmulationConfig(const std::string& path) {
   } catch (const YAML::BadFile&) {
     throw Error(path + ": cannot open the emulation configuration");
   } catch (const YAML::Exception& e) {
-    throw fileError(path, e.mark.line + 1, std::string("YAML syntax: ") + e.msg);
+    throw fileError(path, e.mark.line + 1, std::string("YAML syntax: ") + printable(e.msg, 120));
   }
   Ctx c{path, fs::path(path).parent_path()};
   EmulationConfig cfg;
@@ -208,6 +208,17 @@ EmulationConfig loadEmulationConfig(const std::string& path) {
   }
   parseUtc(cfg.start_utc, c);
   return cfg;
+}
+
+// A value of the wrong type (yaml-cpp's conversion errors, a list or map used
+// as a key) is an error naming the file and line, never an internal error.
+EmulationConfig loadEmulationConfig(const std::string& path) {
+  try {
+    return loadEmulationConfigImpl(path);
+  } catch (const YAML::Exception& e) {
+    throw Error(path + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) : "") +
+                ": " + printable(e.msg, 120) + " (a value or key of the wrong type)");
+  }
 }
 
 Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {

@@ -69,7 +69,7 @@ void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStud
       }
       j["runs"].push_back(jr);
     }
-    out.writeText("summary.json", j.dump(2) + "\n");
+    out.writeText("summary.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   // one figure per model set: rows position / velocity / attitude, columns N, E, D (roll, pitch, yaw)
   for (const ModelSet& set : cfg.model_sets) {

@@ -178,7 +178,7 @@ std::string diagnosisJson(const Diagnosis& d, const std::string& input_json) {
     nav["wall_s"] = g.wall_s;
     j["navigation"] = nav;
   }
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 namespace {

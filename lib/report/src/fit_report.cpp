@@ -176,7 +176,7 @@ std::string fitJson(const gm::RecordingFit& f, const std::string& input_json) {
                 {"terms_wv", terms_wv}};
     j["channels"].push_back(cj);
   }
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 /// One WV panel in the style of the paper's Figures 1-4.

@@ -59,7 +59,7 @@ std::string powerJson(const PowerResult& r) {
   j["runs"] = runs;
   j["cpu_s"] = r.cpu_s;
   j["wall_s"] = r.wall_s;
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace navimpact::report

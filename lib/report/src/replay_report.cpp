@@ -249,7 +249,7 @@ std::string summaryJson(const ReplayResult& r) {
                 "solution.csv holds the estimate and the predicted sigmas, its error and NEES columns are empty";
     j["epochs"] = ep.size();
     j["notices"] = r.notices;
-    return j.dump(2) + "\n";
+    return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   }
   // Overall RMS over all epochs.
   double sPh = 0, sPv = 0, sV = 0;
@@ -267,7 +267,7 @@ std::string summaryJson(const ReplayResult& r) {
                       {"roll_pitch_yaw_deg", {std::sqrt(sA[0] / n), std::sqrt(sA[1] / n), std::sqrt(sA[2] / n)}},
                       {"epochs", ep.size()}};
   j["notices"] = r.notices;
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 std::string replaySummary(const ReplayResult& r) {

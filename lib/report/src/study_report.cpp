@@ -596,13 +596,13 @@ std::string timeseriesCsv(const View& v) {
 
 std::string studyMetricsJson(const StudyResults& r) {
   const View v(r);
-  return buildJson(v, false).dump(1);
+  return buildJson(v, false).dump(1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 void writeStudyOutputs(const StudyResults& r, OutputSet& out) {
   if (r.acc.runs == 0) throw Error("study: no runs to report");
   const View v(r);
-  out.writeText("study.json", buildJson(v, true).dump(1) + "\n");
+  out.writeText("study.json", buildJson(v, true).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   out.writeText("timeseries.csv", timeseriesCsv(v));
   std::vector<std::string> figs;
   for (const auto& s : r.meta.sets) {

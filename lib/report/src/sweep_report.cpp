@@ -317,7 +317,7 @@ std::string sweepJson(const SweepResults& r) {
     cols.push_back(col);
   }
   j["columns"] = cols;
-  return j.dump(1) + "\n";
+  return j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 void writeSweepOutputs(const SweepResults& r, OutputSet& out) {

@@ -54,7 +54,7 @@ void writeWvOutputs(const gmwm::RecordingWv& w, const std::string& input_json, O
       csv << c.name << ',' << i + 1 << ',' << c.wv.tau[i] / w.rate_hz << ',' << c.wv.wv[i] << ','
           << c.wv.ci_low[i] << ',' << c.wv.ci_high[i] << '\n';
   }
-  out.writeText("wv.json", j.dump(2) + "\n");
+  out.writeText("wv.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   out.writeText("wv.csv", csv.str());
   // One log-log figure per sensor: the axes present, each with its CI band.
   for (int sensor = 0; sensor < 2; ++sensor) {

@@ -110,7 +110,7 @@ YAML::Node loadYaml(const std::string& file) {
   try {
     return YAML::LoadFile(file);
   } catch (const YAML::ParserException& e) {
-    throw fileError(file, static_cast<std::size_t>(e.mark.line + 1), "YAML syntax error: " + e.msg);
+    throw fileError(file, static_cast<std::size_t>(e.mark.line + 1), "YAML syntax error: " + printable(e.msg, 120));
   } catch (const YAML::Exception& e) {
     throw Error(file + ": cannot read model file: " + e.what());
   }
@@ -154,7 +154,7 @@ std::vector<std::string> listModels(const std::string& file) {
   return modelNames(loadYaml(file), file);
 }
 
-ImuModel loadImuModel(const std::string& spec) {
+static ImuModel loadImuModelImpl(const std::string& spec) {
   InputScope scope(spec);
   std::string file, name;
   splitSpec(spec, file, name);
@@ -189,6 +189,17 @@ ImuModel loadImuModel(const std::string& spec) {
     m.source = file + ":" + name;
   }
   return m;
+}
+
+// A value of the wrong type (yaml-cpp's conversion errors, a list or map used
+// as a key) is an error naming the file and line, never an internal error.
+ImuModel loadImuModel(const std::string& spec) {
+  try {
+    return loadImuModelImpl(spec);
+  } catch (const YAML::Exception& e) {
+    throw Error(spec + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) : "") +
+                ": " + printable(e.msg, 120) + " (a value or key of the wrong type)");
+  }
 }
 
 std::string toYaml(const ImuModel& m, const std::string& comment) {

@@ -1,0 +1,82 @@
+#include "fuzz_targets.hpp"
+
+#include <new>
+#include <stdexcept>
+
+#include "navimpact/analysis/covariance_study.hpp"
+#include "navimpact/analysis/replay.hpp"
+#include "navimpact/analysis/study.hpp"
+#include "navimpact/core/alloc_limit.hpp"
+#include "navimpact/core/csv_reader.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/emulation/scenario.hpp"
+#include "navimpact/emulation/trajectory.hpp"
+#include "navimpact/rawlog/imu_reader.hpp"
+#include "navimpact/rawlog/writer.hpp"
+#include "navimpact/stochastic/model_file.hpp"
+
+namespace navimpact::fuzz {
+
+const std::vector<Target>& targets() {
+  static const std::vector<Target> t = {
+      {"imu_csv", ".csv",
+       [](const std::string& p) {
+         CsvImuOptions o;
+         o.rate_hz = 100.0;
+         o.gyro_unit = "deg/s";
+         o.acc_unit = "g";
+         (void)readImuCsv(p, o);
+       }},
+      {"trajectory_csv", ".csv",
+       [](const std::string& p) {
+         emulation::TrajectorySpec s;
+         s.file = p;
+         (void)emulation::readTrajectoryCsv(s);
+       }},
+      {"model_file", ".yaml",
+       [](const std::string& p) {
+         for (const auto& name : stochastic::listModels(p)) (void)stochastic::loadImuModel(p + ":" + name);
+         if (stochastic::listModels(p).empty()) (void)stochastic::loadImuModel(p);
+       }},
+      {"covariance_config", ".yaml", [](const std::string& p) { (void)analysis::loadCovarianceStudyConfig(p); }},
+      {"replay_config", ".yaml", [](const std::string& p) { (void)analysis::loadReplayConfig(p); }},
+      {"emulation_config", ".yaml", [](const std::string& p) { (void)emulation::loadEmulationConfig(p); }},
+      {"study_config", ".yaml", [](const std::string& p) { (void)analysis::loadStudyConfig(p); }},
+      {"imu_rawlog", ".rawlog",
+       [](const std::string& p) {
+         try {
+           (void)rawlog::readImuRawlog(p, "IMU");  // navimpact's label
+         } catch (const Error& e) {
+           if (std::string(e.what()).find("no CObservationIMU with label 'IMU'") == std::string::npos) throw;
+           (void)rawlog::readImuRawlog(p, "XSENS");  // the label of the MRPT sample seed
+         }
+       }},
+      {"rawlog", ".rawlog", [](const std::string& p) { (void)rawlog::readRawlog(p); }},
+  };
+  return t;
+}
+
+std::string runOne(const Target& t, const std::string& path) {
+  constexpr std::size_t kCap = std::size_t(1) << 30;  // no single allocation above 1 GiB
+  AllocationLimit::takeRefused();
+  try {
+    AllocationLimit limit(kCap);
+    t.read(path);
+    return "";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    if (m.empty()) throw std::runtime_error("empty error message");
+    if (m.find('\n') != std::string::npos) throw std::runtime_error("error message of more than one line: " + m);
+    return m;
+  } catch (const std::bad_alloc&) {
+    const std::size_t n = AllocationLimit::takeRefused();
+    throw std::runtime_error(n ? "asked for one allocation of " + std::to_string(n) + " bytes"
+                               : "std::bad_alloc (out of memory)");
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string("exception other than navimpact::Error: ") + e.what());
+  } catch (...) {
+    throw std::runtime_error("non-standard exception");
+  }
+}
+
+}  // namespace navimpact::fuzz
