@@ -14,6 +14,7 @@ namespace {
 struct Opts {
   std::string rawlog, config, model, out, imu_label, gnss_label;
   std::vector<std::string> outages;
+  std::string outages_every;
   int propagate_every = 0;
   double max_imu_gap_s = -1.0;
   bool overwrite = false;
@@ -32,6 +33,9 @@ navimpact::cli::Registrar reg({
       app.add_option("--outage", o->outages,
                      "GNSS outage START:DURATION [s] from the start of the IMU data; repeatable; "
                      "replaces the configuration's outages");
+      app.add_option("--outages-every", o->outages_every,
+                     "GNSS outages all along the run, PERIOD:DURATION [s]: each after PERIOD - DURATION s of "
+                     "GNSS from the filter start; added to the other outages");
       app.add_option("--propagate-every", o->propagate_every,
                      "propagate the covariance every k IMU samples (default 10)");
       app.add_option("--imu-label", o->imu_label,
@@ -55,13 +59,14 @@ navimpact::cli::Registrar reg({
           cfg.outages.clear();
           for (const auto& s : o->outages) cfg.outages.push_back(navimpact::parseOutage(s));
         }
+        if (!o->outages_every.empty()) cfg.outages_every = navimpact::analysis::parseOutagePattern(o->outages_every);
         if (o->propagate_every > 0) cfg.propagate_every = o->propagate_every;
         if (o->max_imu_gap_s >= 0.0) cfg.max_imu_gap_s = o->max_imu_gap_s;
         const auto r = navimpact::analysis::runReplay(cfg);
         navimpact::report::writeReplayOutputs(r, out);
         out.commit();
         std::fputs(navimpact::report::replaySummary(r).c_str(), stdout);
-        std::printf("wrote %s/{solution.csv, summary.json, errors_*.png}\n", o->out.c_str());
+        std::printf("wrote %s/{solution.csv, summary.json, trajectory.png, errors_*.png}\n", o->out.c_str());
         return 0;
       };
     }});

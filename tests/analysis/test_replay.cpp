@@ -1,6 +1,8 @@
 // Replay of emulated rawlogs: time base, outage bookkeeping, bad input.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <random>
 
 #include "navimpact/analysis/replay.hpp"
@@ -145,4 +147,133 @@ TEST(Replay, DuplicatedGnssRecordIsAnError) {
   EXPECT_NE(m.find("(label GNSS"), std::string::npos) << m;
   EXPECT_NE(m.find("same time as GNSS entry"), std::string::npos) << m;
   EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+}
+
+// Outages all along a run, scored against GT: the pattern lays them from the
+// filter start, every outage is scored at its end epoch, summary.json carries
+// reference_errors and the flat per-outage keys, and the NEES counts the
+// reference's sigma (a larger reference sigma can only lower it).
+TEST(Replay, OutagesEveryAreScoredAgainstTheReference) {
+  const auto dir = navimpact::test::tempDir();
+  const auto path = (dir / "model.rawlog").string();
+  navimpact::rawlog::writeRawlog(path, emulate60("model"));
+  an::ReplayConfig c;
+  c.rawlog = path;
+  c.outages_every = an::parseOutagePattern("15:5");
+  const auto r = an::runReplay(c);
+  // starts 10, 25, 40 (ends 15, 30, 45); 55..60 ends at 60 = the data end
+  ASSERT_EQ(r.cfg.outages.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(r.cfg.outages[k].start_s, 10.0 + 15.0 * k, 1e-9);
+    EXPECT_NEAR(r.cfg.outages[k].duration_s, 5.0, 1e-9);
+  }
+  ASSERT_TRUE(r.score.has_value());
+  const auto& sc = *r.score;
+  ASSERT_EQ(sc.outages.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const auto& e = r.run.epochs.at(static_cast<std::size_t>(r.run.outages[k].end_epoch));
+    EXPECT_NEAR(sc.outages[k].end_s, 15.0 + 15.0 * k, 1e-9);
+    EXPECT_NEAR(sc.outages[k].horizontal_error_m, e.err.head<2>().norm(), 1e-12);
+    EXPECT_NEAR(sc.outages[k].nees, e.nees[0], 1e-9 * (1.0 + e.nees[0]));  // no reference sigma: the filter's NEES
+    EXPECT_GE(sc.outages[k].max_drift_h_m, sc.outages[k].horizontal_error_m);
+  }
+  // GNSS-aided epochs: 601 epochs minus those inside the four outages (50 each)
+  EXPECT_EQ(sc.aided_epochs, 601u - 4u * 50u);
+  EXPECT_GT(sc.horizontal_rms_m, 0.0);
+  const std::string js = navimpact::report::summaryJson(r);
+  for (const char* key : {"\"reference_errors\"", "\"horizontal_rms_m\"", "\"vertical_rms_m\"", "\"horizontal_error_m\"",
+                          "\"vertical_error_m\"", "\"horizontal_sigma_m\"", "\"nees\"", "\"outage_distribution\""})
+    EXPECT_NE(js.find(key), std::string::npos) << key;
+  c.reference_sigma_h_m = 5.0;
+  c.reference_sigma_v_m = 5.0;
+  const auto r2 = an::runReplay(c);
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_LT(r2.score->outages[k].nees, sc.outages[k].nees);
+  c.outages_every = an::OutagePattern{100.0, 5.0};  // none fits in 60 s
+  EXPECT_TRUE(an::runReplay(c).cfg.outages.empty());
+}
+
+// A rawlog without GT and without a GNSS fix at its first IMU sample: an
+// aligning phase (reported) instead of a refusal; the filter starts when it
+// ends and then navigates within a few metres of the (withheld) truth.
+TEST(Replay, WithoutGroundTruthTheFilterStartsAfterAnAligningPhase) {
+  const auto dir = navimpact::test::tempDir();
+  auto d = emulate60("model");
+  const auto truth = d.reference;
+  const auto origin = d.origin;
+  d.reference.clear();
+  // no GNSS fix at the first IMU sample
+  ASSERT_NEAR(d.gnss.front().t, d.imu.front().t - (d.imu[1].t - d.imu[0].t), 1e-6);
+  d.gnss.erase(d.gnss.begin());
+  const auto path = (dir / "nogt.rawlog").string();
+  navimpact::rawlog::writeRawlog(path, d);
+  an::ReplayConfig c;
+  c.rawlog = path;
+  c.use_gnss_velocity = true;
+  const auto r = an::runReplay(c);
+  ASSERT_TRUE(r.alignment.has_value());
+  std::printf("aligned at %.3f s: levelling %s, heading %s\n", r.aided_from_s, r.alignment->levelling.c_str(),
+              r.alignment->heading.c_str());
+  EXPECT_GE(r.aided_from_s, 1.0);
+  EXPECT_LT(r.aided_from_s, 30.0);
+  EXPECT_FALSE(r.score.has_value());
+  ASSERT_FALSE(r.run.epochs.empty());
+  EXPECT_NEAR(r.run.epochs.front().t - r.t_zero, r.aided_from_s, 1e-9);
+  // the last estimate against the withheld truth (GT at 10 Hz, 0.1 s grid)
+  const auto& e = r.run.epochs.back();
+  const navimpact::ReferenceRecord* g = nullptr;
+  for (const auto& x : truth)
+    if (std::abs(x.t - e.t) < 1e-6) g = &x;
+  ASSERT_NE(g, nullptr);
+  const Eigen::Vector3d p = navimpact::earth::geodeticToNed(navimpact::earth::nedToGeodetic(origin, g->p_L),
+                                                            e.est.geodetic());
+  std::printf("position error at the end %.2f m\n", p.norm());
+  EXPECT_LT(p.norm(), 10.0);
+}
+
+// The new configuration keys load with their units and ranges; bad values name the key.
+TEST(Replay, ConfigLoadsScoringAlignmentAndAids) {
+  const auto dir = navimpact::test::tempDir();
+  const auto path = (dir / "c.yaml").string();
+  std::ofstream(path) << "outages_every: {period_s: 120, duration_s: 30}\n"
+                         "reference_sigma: {horizontal_m: 0.05, vertical_m: 0.1}\n"
+                         "alignment: {yaw_deg: 90, yaw_sigma_deg: 2, max_align_s: 300}\n"
+                         "imu_at_rest: {gyro_sigma_rad_s: [1e-3, 2e-3, 3e-3], acc_sigma_mps2: 0.02, window_s: 0.4}\n"
+                         "aids: {zupt: {sigma_mps: 0.01}, nhc: {sigma_lateral_mps: 0.2, point_B_m: [-1, 0, 0.5]}}\n";
+  const an::ReplayConfig c = an::loadReplayConfig(path);
+  ASSERT_TRUE(c.outages_every.has_value());
+  EXPECT_EQ(c.outages_every->period_s, 120.0);
+  EXPECT_EQ(c.reference_sigma_v_m, 0.1);
+  ASSERT_TRUE(c.alignment.yaw_rad.has_value());
+  EXPECT_NEAR(*c.alignment.yaw_rad, M_PI / 2, 1e-12);
+  EXPECT_NEAR(c.alignment.yaw_sigma_rad, 2.0 * M_PI / 180.0, 1e-12);
+  EXPECT_EQ(c.alignment.detector.gyro_sigma_rad_s.z(), 3e-3);
+  EXPECT_EQ(c.alignment.detector.acc_sigma_mps2.x(), 0.02);
+  EXPECT_TRUE(c.aids.zupt);
+  EXPECT_EQ(c.aids.zupt_sigma_mps, 0.01);
+  EXPECT_EQ(c.aids.zupt_detector.window_s, 0.4);
+  EXPECT_TRUE(c.aids.nhc);
+  EXPECT_EQ(c.aids.nhc_point_B.x(), -1.0);
+  for (const std::string& bad : {"outages_every: {period_s: 10, duration_s: 30}\n", "aids: {zupt: {sigma_mps: -1}}\n",
+                                 "aids: {nhc: {speed: 1}}\n", "imu_at_rest: {false_alarm: 0.7}\n"}) {
+    std::ofstream(path) << bad;
+    EXPECT_THROW(an::loadReplayConfig(path), navimpact::Error) << bad;
+  }
+}
+
+// Aids wired into the run: the non-holonomic constraint is applied at its
+// interval while moving; in flight the static detector never fires, so no ZUPT.
+TEST(Replay, AidsAreAppliedOnlyWhenTheirConditionHolds) {
+  const auto dir = navimpact::test::tempDir();
+  const auto path = (dir / "aids.rawlog").string();
+  navimpact::rawlog::writeRawlog(path, emulate60("model"));
+  an::ReplayConfig c;
+  c.rawlog = path;
+  c.aids.zupt = true;
+  c.aids.nhc = true;
+  c.aids.nhc_sigma_lateral_mps = c.aids.nhc_sigma_vertical_mps = 50.0;  // a UAV is no ground vehicle: loose
+  c.aids.nhc_interval_s = 1.0;
+  const auto r = an::runReplay(c);
+  EXPECT_EQ(r.run.zupt_updates, 0u);
+  EXPECT_GE(r.run.nhc_updates, 55u);
+  EXPECT_LE(r.run.nhc_updates, 60u);
 }

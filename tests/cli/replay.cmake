@@ -20,3 +20,16 @@ navimpact_cli_fail(cli_replay_bad_outage_text
 navimpact_cli_fail(cli_replay_not_a_rawlog
   ARGS replay --rawlog ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz --out ${_rdir}/notraw
   REGEX "uav_flight_260s.csv.gz: entry 0" NOOUT ${_rdir}/notraw)
+
+# Outages all along the committed rawlog, scored against its GT: 6 outages of
+# 15 s every 40 s from the start, the summary's reference_errors and flat
+# per-outage keys, the outage-end and trajectory figures; a bad pattern is refused.
+navimpact_cli_check(cli_replay_outages_every CHECK run_json
+  ARGS replay --rawlog ${_rlog} --outages-every 40:15 --out ${_rdir}/every --overwrite
+  DEFINES OUT=${_rdir}/every JSON_FILE=summary.json
+  JSON "outage_distribution/count=^6$" "outages/5/start_s=^225(\\.0*)?$" "outages/0/duration_s=^15(\\.0*)?$"
+       "reference_errors/horizontal_rms_m=^0\\.[0-9]+" "outages/0/horizontal_error_m=^[0-9.]+" "outages/0/nees=^[0-9.]+"
+  FILES trajectory.png outage_end_error.png errors_full.png)
+navimpact_cli_fail(cli_replay_outages_every_bad
+  ARGS replay --rawlog ${_rlog} --outages-every 15:40 --out ${_rdir}/everybad
+  REGEX "PERIOD > DURATION" NOOUT ${_rdir}/everybad)

@@ -315,7 +315,7 @@ TEST(Alignment, RoverAtRestThenDrivingWithPositionOnlyGnss) {
 
 // Airborne start: moving from the first sample (8-25 m/s, climbing, turning),
 // GNSS position and velocity at 1-5 Hz: levelling by the GNSS velocity change,
-// heading from the velocity course, in the first GNSS interval.
+// heading from the velocity course, over the first two GNSS intervals.
 TEST(Alignment, MovingStartWithGnssVelocity) {
   const std::uint64_t seed = 5151;
   std::mt19937_64 rng(seed);
@@ -352,7 +352,7 @@ TEST(Alignment, MovingStartWithGnssVelocity) {
                 o.err(6) / kDeg, o.err(7) / kDeg, o.sigma(6) / kDeg);
     EXPECT_EQ(o.rep.levelling, "gnss_velocity") << buf;
     EXPECT_EQ(o.rep.heading, "gnss_velocity_course") << buf;
-    EXPECT_LE(o.rep.t_end, 2.0 * gnss_dt + 0.1) << buf;
+    EXPECT_LE(o.rep.t_end, 3.0 * gnss_dt + 0.1) << buf;  // two intervals after the first fix
     expectWithin(o, 4.0, buf);
   }
 }

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
@@ -64,28 +65,56 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
   // Truth epochs before the first sample end that are not at x0.t are skipped.
   while (it < truth.t.size() && truth.t[it] < in.x0.t - 0.5 * dt0) ++it;
 
+  auto check = [&](const filter::UpdateResult& u, const char* kind) {
+    if (!u.accepted) res.rejected.push_back({u.t, kind, u.nis, u.gate});
+    return u.accepted;
+  };
   auto applyAiding = [&](double t_now, double half_dt) {
     while (ig < ng && (*in.gnss)[ig].t <= t_now + half_dt) {
       const GnssFix& f = (*in.gnss)[ig++];
       if (f.t < in.x0.t - half_dt) continue;  // before the run
       if (inOutage(f.t, opt.outages)) continue;
       if (!f.cov_pos_N) throw Error("navigation run: GNSS fix at " + formatNumber(f.t, 10) + " s has no position covariance");
+      // the fix's own epoch relative to the filter time (0 when on a sample)
+      const double dt_meas = std::abs(f.t - t_now) > 1e-9 ? f.t - t_now : 0.0;
       const Eigen::Vector3d sp = f.cov_pos_N->diagonal().cwiseSqrt();
-      ekf.updateGnssPosition(f.pos, sp, opt.lever_arm_B);
+      bool used = check(ekf.updateGnssPosition(f.pos, sp, opt.lever_arm_B, dt_meas), "gnss_position");
       if (opt.use_gnss_velocity && f.v_N) {
         if (!f.cov_vel_N) throw Error("navigation run: GNSS fix at " + formatNumber(f.t, 10) + " s has no velocity covariance");
         const Eigen::Vector3d sv = f.cov_vel_N->diagonal().cwiseSqrt();
-        ekf.updateGnssVelocity(*f.v_N, sv, opt.lever_arm_B);
+        used = check(ekf.updateGnssVelocity(*f.v_N, sv, opt.lever_arm_B, dt_meas), "gnss_velocity") || used;
       }
-      ++res.gnss_updates;
+      if (used) ++res.gnss_updates;
     }
     while (ib < nb && (*in.baro)[ib].t <= t_now + half_dt) {
       const BaroSample& b = (*in.baro)[ib++];
       if (b.t < in.x0.t - half_dt) continue;
       if (!opt.baro_in_outage && inOutage(b.t, opt.outages)) continue;
       if (!b.sigma_m) throw Error("navigation run: baro sample at " + formatNumber(b.t, 10) + " s has no sigma");
-      ekf.updateBaro(b.h, *b.sigma_m);
-      ++res.baro_updates;
+      if (check(ekf.updateBaro(b.h, *b.sigma_m), "baro")) ++res.baro_updates;
+    }
+  };
+  // ground-vehicle aids (off by default)
+  std::optional<filter::StaticDetector> detector;
+  if (opt.zupt) {
+    if (!(opt.zupt_sigma_mps > 0.0) || !(opt.zupt_interval_s > 0.0))
+      throw Error("navigation run: ZUPT sigma and interval must be > 0");
+    detector.emplace(opt.zupt_detector, 1.0 / imu.front().dt);
+  }
+  if (opt.nhc && (!(opt.nhc_sigma_lateral_mps > 0.0) || !(opt.nhc_sigma_vertical_mps > 0.0) ||
+                  !(opt.nhc_interval_s > 0.0) || !(opt.nhc_min_speed_mps >= 0.0)))
+    throw Error("navigation run: non-holonomic sigmas and interval must be > 0, minimum speed >= 0");
+  double next_zupt = -1e300, next_nhc = -1e300;
+  auto applyAids = [&](const ins::ImuSample& s) {
+    if (detector && detector->push(s) && s.t >= next_zupt) {
+      next_zupt = s.t + opt.zupt_interval_s - 0.5 * s.dt;
+      if (check(ekf.updateZeroVelocity(opt.zupt_sigma_mps), "zupt")) ++res.zupt_updates;
+    }
+    if (opt.nhc && s.t >= next_nhc && ekf.state().v_N.head<2>().norm() >= opt.nhc_min_speed_mps) {
+      next_nhc = s.t + opt.nhc_interval_s - 0.5 * s.dt;
+      if (check(ekf.updateNonHolonomic(opt.nhc_sigma_lateral_mps, opt.nhc_sigma_vertical_mps, opt.nhc_point_B),
+                "nhc"))
+        ++res.nhc_updates;
     }
   };
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -101,6 +130,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       e.err.setConstant(kNaN);
       const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
+      e.P_pos = P9.topLeftCorner<3, 3>();
       e.nees.fill(kNaN);
       res.epochs.push_back(e);
       return;
@@ -116,6 +146,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       e.err = filter::navError(ekf.state(), truth.x[it]);
       const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
+      e.P_pos = P9.topLeftCorner<3, 3>();
       e.nees = navNees(e.err, P9);
       res.epochs.push_back(e);
       ++it;
@@ -131,6 +162,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
                   " s) does not follow the previous one at " + formatNumber(t_prev, 10) + " s");
     ekf.predict(s);
     ++res.steps;
+    applyAids(s);
     applyAiding(s.t, 0.5 * s.dt);
     record(s.t, 0.5 * s.dt);
     t_prev = s.t;

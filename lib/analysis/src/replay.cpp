@@ -60,12 +60,14 @@ static ReplayConfig loadReplayConfigImpl(const std::string& path) {
   const fs::path dir = fs::path(path).parent_path();
   if (!root.IsMap()) throw keyError(path, "(root)", "expected a map");
   const std::set<std::string> allowed = {"rawlog", "model", "outages", "filter", "initial_sigma", "noise",
-                                         "gnss_lever_arm_B_m", "initial_attitude_deg", "record_interval_s"};
+                                         "gnss_lever_arm_B_m", "initial_attitude_deg", "record_interval_s",
+                                         "outages_every", "reference_sigma", "alignment", "imu_at_rest", "aids"};
   for (const auto& kv : root)
     if (!allowed.count(kv.first.as<std::string>()))
       throw keyError(path, kv.first.as<std::string>(),
                      "unknown key (expected rawlog, model, outages, filter, initial_sigma, noise, gnss_lever_arm_B_m, "
-                     "initial_attitude_deg, record_interval_s)");
+                     "initial_attitude_deg, record_interval_s, outages_every, reference_sigma, alignment, "
+                     "imu_at_rest, aids)");
   auto num = [&](const YAML::Node& n, const std::string& key) {
     try {
       return n.as<double>();
@@ -145,6 +147,84 @@ static ReplayConfig loadReplayConfigImpl(const std::string& path) {
                                              num(a[2], "initial_attitude_deg"));
   }
   if (root["record_interval_s"]) c.record_interval_s = pos(root["record_interval_s"], "record_interval_s");
+  auto nonneg = [&](const YAML::Node& n, const std::string& key) {
+    const double v = num(n, key);
+    if (!(v >= 0.0) || !std::isfinite(v)) throw keyError(path, key, "must be >= 0");
+    return v;
+  };
+  auto vec3 = [&](const YAML::Node& n, const std::string& key) {
+    if (!n.IsSequence() || n.size() != 3) throw keyError(path, key, "expected [x, y, z]");
+    return Eigen::Vector3d(num(n[0], key), num(n[1], key), num(n[2], key));
+  };
+  auto sigma3 = [&](const YAML::Node& n, const std::string& key) {
+    if (n.IsSequence()) {
+      const Eigen::Vector3d v = vec3(n, key);
+      if (!(v.array() > 0.0).all()) throw keyError(path, key, "must be > 0");
+      return v;
+    }
+    return Eigen::Vector3d::Constant(pos(n, key)).eval();
+  };
+  if (const auto o = root["outages_every"]) {
+    subKeys(o, "outages_every", {"period_s", "duration_s"});
+    if (!o["period_s"] || !o["duration_s"]) throw keyError(path, "outages_every", "needs period_s and duration_s [s]");
+    OutagePattern p{pos(o["period_s"], "outages_every.period_s"), pos(o["duration_s"], "outages_every.duration_s")};
+    if (!(p.period_s > p.duration_s))
+      throw keyError(path, "outages_every.period_s", "must exceed duration_s (GNSS time to reconverge)");
+    c.outages_every = p;
+  }
+  if (const auto r = root["reference_sigma"]) {
+    subKeys(r, "reference_sigma", {"horizontal_m", "vertical_m"});
+    if (r["horizontal_m"]) c.reference_sigma_h_m = nonneg(r["horizontal_m"], "reference_sigma.horizontal_m");
+    if (r["vertical_m"]) c.reference_sigma_v_m = nonneg(r["vertical_m"], "reference_sigma.vertical_m");
+  }
+  if (const auto a = root["alignment"]) {
+    subKeys(a, "alignment", {"yaw_deg", "yaw_sigma_deg", "max_align_s", "max_course_sigma_deg", "min_static_s",
+                             "max_level_s", "sideslip_sigma_deg"});
+    if (a["yaw_deg"]) {
+      c.alignment.yaw_rad = num(a["yaw_deg"], "alignment.yaw_deg") * kDeg;
+      c.alignment.yaw_source = "configuration";
+    }
+    if (a["yaw_sigma_deg"]) c.alignment.yaw_sigma_rad = pos(a["yaw_sigma_deg"], "alignment.yaw_sigma_deg") * kDeg;
+    if (a["max_align_s"]) c.alignment.max_align_s = pos(a["max_align_s"], "alignment.max_align_s");
+    if (a["max_course_sigma_deg"])
+      c.alignment.max_course_sigma_rad = pos(a["max_course_sigma_deg"], "alignment.max_course_sigma_deg") * kDeg;
+    if (a["sideslip_sigma_deg"])
+      c.alignment.sideslip_sigma_rad = pos(a["sideslip_sigma_deg"], "alignment.sideslip_sigma_deg") * kDeg;
+    if (a["min_static_s"]) c.alignment.min_static_s = pos(a["min_static_s"], "alignment.min_static_s");
+    if (a["max_level_s"]) c.alignment.max_level_s = pos(a["max_level_s"], "alignment.max_level_s");
+  }
+  if (const auto r = root["imu_at_rest"]) {
+    subKeys(r, "imu_at_rest", {"gyro_sigma_rad_s", "acc_sigma_mps2", "window_s", "false_alarm", "max_mean_rate_rad_s"});
+    auto& d = c.alignment.detector;
+    if (r["gyro_sigma_rad_s"]) d.gyro_sigma_rad_s = sigma3(r["gyro_sigma_rad_s"], "imu_at_rest.gyro_sigma_rad_s");
+    if (r["acc_sigma_mps2"]) d.acc_sigma_mps2 = sigma3(r["acc_sigma_mps2"], "imu_at_rest.acc_sigma_mps2");
+    if (r["window_s"]) d.window_s = pos(r["window_s"], "imu_at_rest.window_s");
+    if (r["false_alarm"]) {
+      d.false_alarm = num(r["false_alarm"], "imu_at_rest.false_alarm");
+      if (!(d.false_alarm > 0.0 && d.false_alarm < 0.5)) throw keyError(path, "imu_at_rest.false_alarm", "must be in (0, 0.5)");
+    }
+    if (r["max_mean_rate_rad_s"]) d.max_mean_rate_rad_s = pos(r["max_mean_rate_rad_s"], "imu_at_rest.max_mean_rate_rad_s");
+  }
+  c.aids.zupt_detector = c.alignment.detector;
+  if (const auto a = root["aids"]) {
+    subKeys(a, "aids", {"zupt", "nhc"});
+    if (const auto z = a["zupt"]) {
+      subKeys(z, "aids.zupt", {"sigma_mps", "interval_s"});
+      c.aids.zupt = true;
+      if (z["sigma_mps"]) c.aids.zupt_sigma_mps = pos(z["sigma_mps"], "aids.zupt.sigma_mps");
+      if (z["interval_s"]) c.aids.zupt_interval_s = pos(z["interval_s"], "aids.zupt.interval_s");
+    }
+    if (const auto n = a["nhc"]) {
+      subKeys(n, "aids.nhc", {"sigma_lateral_mps", "sigma_vertical_mps", "interval_s", "min_speed_mps", "point_B_m"});
+      c.aids.nhc = true;
+      if (n["sigma_lateral_mps"]) c.aids.nhc_sigma_lateral_mps = pos(n["sigma_lateral_mps"], "aids.nhc.sigma_lateral_mps");
+      if (n["sigma_vertical_mps"])
+        c.aids.nhc_sigma_vertical_mps = pos(n["sigma_vertical_mps"], "aids.nhc.sigma_vertical_mps");
+      if (n["interval_s"]) c.aids.nhc_interval_s = pos(n["interval_s"], "aids.nhc.interval_s");
+      if (n["min_speed_mps"]) c.aids.nhc_min_speed_mps = nonneg(n["min_speed_mps"], "aids.nhc.min_speed_mps");
+      if (n["point_B_m"]) c.aids.nhc_point_B = vec3(n["point_B_m"], "aids.nhc.point_B_m");
+    }
+  }
   return c;
 }
 
@@ -159,103 +239,6 @@ ReplayConfig loadReplayConfig(const std::string& path) {
   }
 }
 
-namespace {
-/// Initial state without GT: GNSS fix at time zero, levelling, GNSS course (see replay.hpp).
-ins::NavState initialWithoutTruth(const Recording& d, const ReplayConfig& cfg, double t_zero,
-                                  double dt, const Eigen::Vector3d& lever_B, filter::Matrix9d& P0,
-                                  std::vector<std::string>& notices) {
-  const GnssFix* fix = nullptr;
-  for (const auto& f : d.gnss)
-    if (std::abs(f.t - t_zero) <= 0.5 * dt) {
-      fix = &f;
-      break;
-    }
-  if (!fix)
-    throw Error(cfg.rawlog + ": no ground truth (label GT) and no GNSS fix at the start of the IMU data (t = " +
-                formatNumber(t_zero, 10) + " s) to initialise the filter from");
-  if (!fix->v_N)
-    throw Error(cfg.rawlog + ": no ground truth and the first GNSS fix has no velocity (GGA only)");
-  Eigen::Vector3d rpy;
-  std::string how;
-  if (cfg.initial_attitude_deg) {
-    rpy = *cfg.initial_attitude_deg * kDeg;
-    how = "attitude from initial_attitude_deg";
-  } else {
-    // Yaw from the GNSS course at time zero (no sideslip assumed). Roll and
-    // pitch: C_BtoN(0) maps the specific force integrated over the first GNSS
-    // interval, resolved in the time-zero body frame with the gyros
-    // (u = sum dC_k f_B,k dt), onto the measured velocity change minus gravity
-    // (v = v1 - v0 - g_N T; Coriolis and transport rate neglected) - levelling
-    // (Groves 2013 eq. 5.101) corrected for the vehicle's own acceleration.
-    const Eigen::Vector3d& v0 = *fix->v_N;
-    const double vh = v0.head<2>().norm();
-    if (vh < 1.0)
-      throw Error(cfg.rawlog + ": no ground truth and a horizontal GNSS speed of " + formatNumber(vh, 10) +
-                  " m/s at the start, too slow for a course: give initial_attitude_deg: [roll, pitch, yaw]");
-    rpy[2] = std::atan2(v0.y(), v0.x());
-    const GnssFix* fix1 = nullptr;
-    for (const auto& f : d.gnss)
-      if (f.t > fix->t + 0.5 * dt && f.v_N) {
-        fix1 = &f;
-        break;
-      }
-    if (!fix1 || fix1->t - fix->t > 5.0)
-      throw Error(cfg.rawlog + ": no ground truth and no second GNSS fix within 5 s of the start to level with: "
-                  "give initial_attitude_deg: [roll, pitch, yaw]");
-    Eigen::Quaterniond dq = Eigen::Quaterniond::Identity();
-    Eigen::Vector3d u = Eigen::Vector3d::Zero();
-    double prev = t_zero;
-    for (const auto& s : d.imu) {
-      if (s.t > fix1->t + 0.5 * dt) break;
-      const double h = s.t - prev;
-      dq = (dq * ins::quatFromRotVec(s.w_IB_B * h)).normalized();
-      u += dq * (s.f_B * h);
-      prev = s.t;
-    }
-    const double T = fix1->t - fix->t;
-    const Eigen::Vector3d v = *fix1->v_N - v0 - earth::gravity_N(fix->pos.lat, fix->pos.h) * T;
-    const Eigen::Vector3d uh = u.normalized(), vhat = v.normalized();
-    auto resid = [&](double r, double p) {
-      ins::NavState a;
-      a.setRollPitchYaw(r, p, rpy[2]);
-      return Eigen::Vector3d(a.C_BtoN() * uh - vhat);
-    };
-    double r = 0.0, p = 0.0;
-    for (int it = 0; it < 20; ++it) {  // Gauss-Newton on (roll, pitch)
-      const Eigen::Vector3d e = resid(r, p);
-      Eigen::Matrix<double, 3, 2> J;
-      J.col(0) = (resid(r + 1e-6, p) - e) / 1e-6;
-      J.col(1) = (resid(r, p + 1e-6) - e) / 1e-6;
-      const Eigen::Vector2d step = (J.transpose() * J).ldlt().solve(-J.transpose() * e);
-      r += step[0];
-      p = std::max(-1.5, std::min(1.5, p + step[1]));
-      if (step.norm() < 1e-10) break;
-    }
-    rpy[0] = ins::wrapAngle(r);
-    rpy[1] = p;
-    how = "yaw from the GNSS course, roll and pitch from the specific force over the first GNSS interval "
-          "matched to the GNSS velocity change minus gravity";
-  }
-  ins::NavState x;
-  x.t = t_zero;
-  x.setRollPitchYaw(rpy[0], rpy[1], rpy[2]);
-  // antenna -> IMU: p_imu = p_ant - C l (NED offset), velocity lever-arm term neglected
-  const earth::Geodetic p = earth::nedToGeodetic(fix->pos, -(x.C_BtoN() * lever_B));
-  x.lat = p.lat;
-  x.lon = p.lon;
-  x.h = p.h;
-  x.v_N = *fix->v_N;
-  const double rp = std::max(cfg.p0_roll_pitch_deg, 2.0) * kDeg, yw = std::max(cfg.p0_yaw_deg, 5.0) * kDeg;
-  P0.setZero();
-  P0.topLeftCorner<3, 3>() = fix->cov_pos_N->diagonal().asDiagonal();
-  P0.block<3, 3>(3, 3) = fix->cov_vel_N->diagonal().asDiagonal();
-  P0.diagonal().tail<3>() << rp * rp, rp * rp, yw * yw;
-  notices.push_back("no ground truth in the rawlog: filter initialised from the GNSS fix at time zero, " + how +
-                    " (initial sigmas " + formatNumber(rp / kDeg, 10) + " deg roll/pitch, " + formatNumber(yw / kDeg, 10) +
-                    " deg yaw); errors and NEES are not available");
-  return x;
-}
-}  // namespace
 
 ReplayResult runReplay(const ReplayConfig& cfg) {
   if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
@@ -394,20 +377,46 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   if (cfg.lever_arm_B) lever = *cfg.lever_arm_B;
   opt.lever_arm_B = lever;
 
-  // Truth series from GT (tangent-plane NED at the origin -> geodetic).
+  // Reference series (GT: tangent-plane NED at the origin -> geodetic). A
+  // reference without velocity or attitude is scored on what it has (the
+  // missing parts NaN); the filter starts from it only when it is complete
+  // and has an entry at time zero, else after an aligning phase.
   const bool hasTruth = !d.reference.empty();
   TruthSeries truth;
+  bool fullRef = true;
+  ReferenceInfo refInfo;
+  refInfo.sigma_h_m = cfg.reference_sigma_h_m;
+  refInfo.sigma_v_m = cfg.reference_sigma_v_m;
+  bool refSigmaFromData = cfg.reference_sigma_h_m == 0.0 && cfg.reference_sigma_v_m == 0.0;
   for (const auto& g : d.reference) {
     if (g.t < r.t_zero - 0.5 * dt || g.t > t_last + 0.5 * dt) continue;
-    if (!g.v_N || !g.q_BtoN)
-      throw Error(cfg.rawlog + ": the reference (GT) at t = " + formatNumber(g.t, 10) +
-                  " s has no velocity or attitude; a replay scores against a full reference");
+    ins::NavState x;
+    x.t = g.t;
+    const earth::Geodetic p = earth::nedToGeodetic(d.origin, g.p_L);
+    x.lat = p.lat;
+    x.lon = p.lon;
+    x.h = p.h;
+    x.v_N = g.v_N ? *g.v_N : Eigen::Vector3d::Constant(NAN);
+    x.q_BtoN = g.q_BtoN ? g.q_BtoN->normalized() : Eigen::Quaterniond(NAN, NAN, NAN, NAN);
+    refInfo.has_velocity = refInfo.has_velocity && g.v_N.has_value();
+    refInfo.has_attitude = refInfo.has_attitude && g.q_BtoN.has_value();
+    fullRef = fullRef && g.v_N && g.q_BtoN;
+    if (refSigmaFromData && g.sigma_p_L) {  // the reference's own sigma as recorded (largest seen)
+      refInfo.sigma_h_m = std::max(refInfo.sigma_h_m, g.sigma_p_L->head<2>().maxCoeff());
+      refInfo.sigma_v_m = std::max(refInfo.sigma_v_m, (*g.sigma_p_L)[2]);
+    }
     truth.t.push_back(g.t);
-    truth.x.push_back(ins::navStateOf(g, d.origin));
+    truth.x.push_back(x);
   }
-  if (hasTruth && (truth.t.empty() || std::abs(truth.t.front() - r.t_zero) > 0.5 * dt))
-    throw Error(cfg.rawlog + ": no GT entry at the start of the IMU data (t = " + formatNumber(r.t_zero, 10) +
-                " s) to initialise the filter from");
+  if (hasTruth && truth.t.empty())
+    throw Error(cfg.rawlog + ": the reference (GT) has no entry inside the IMU data");
+  const bool startFromRef = hasTruth && fullRef && std::abs(truth.t.front() - r.t_zero) <= 0.5 * dt;
+  if (hasTruth && !startFromRef)
+    r.notices.push_back(std::string("the reference ") +
+                        (fullRef ? "has no entry at the start of the IMU data"
+                                 : std::string("has no ") + (refInfo.has_velocity ? "" : "velocity ") +
+                                       (refInfo.has_attitude ? "" : "attitude ")) +
+                        ": the filter starts after an aligning phase and is scored on what the reference has");
 
   NavRunInput in;
   in.imu = &imu;
@@ -422,13 +431,82 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   const double ph = cfg.p0_pos_h_m, pv = cfg.p0_pos_v_m, vv = cfg.p0_vel_mps;
   const double rp = cfg.p0_roll_pitch_deg * kDeg, yw = cfg.p0_yaw_deg * kDeg;
   opt.P0_nav.diagonal() << ph * ph, ph * ph, pv * pv, vv * vv, vv * vv, vv * vv, rp * rp, rp * rp, yw * yw;
-  if (hasTruth) {
+  opt.zupt = cfg.aids.zupt;
+  opt.zupt_detector = cfg.alignment.detector;
+  opt.zupt_sigma_mps = cfg.aids.zupt_sigma_mps;
+  opt.zupt_interval_s = cfg.aids.zupt_interval_s;
+  opt.nhc = cfg.aids.nhc;
+  opt.nhc_sigma_lateral_mps = cfg.aids.nhc_sigma_lateral_mps;
+  opt.nhc_sigma_vertical_mps = cfg.aids.nhc_sigma_vertical_mps;
+  opt.nhc_interval_s = cfg.aids.nhc_interval_s;
+  opt.nhc_min_speed_mps = cfg.aids.nhc_min_speed_mps;
+  opt.nhc_point_B = cfg.aids.nhc_point_B;
+  std::vector<GnssFix> gnssAfter;
+  if (startFromRef) {
     in.x0 = truth.x.front();
     in.x0.t = r.t_zero;
   } else {
-    in.x0 = initialWithoutTruth(d, cfg, r.t_zero, dt, lever, opt.P0_nav, r.notices);
+    // The aligning phase: from time zero until the aligner has an attitude,
+    // a position and a velocity; the filter starts at that IMU sample.
+    filter::AlignmentOptions ao = cfg.alignment;
+    ao.lever_arm_B = lever;
+    if (!ao.yaw_rad && cfg.initial_attitude_deg) {
+      ao.yaw_rad = (*cfg.initial_attitude_deg)[2] * kDeg;
+      ao.yaw_source = "configuration (initial_attitude_deg)";
+    }
+    std::size_t k = 0, ig = 0;
+    try {
+      filter::CoarseAligner al(ao, r.t_zero, r.imu_rate_hz);
+      for (; k < imu.size() && !al.done(); ++k) {
+        al.addImu(imu[k]);
+        while (!al.done() && ig < d.gnss.size() && d.gnss[ig].t <= imu[k].t + 1e-9) {
+          const GnssFix& f = d.gnss[ig++];
+          bool out = false;
+          for (const auto& o : opt.outages) out = out || (f.t > o.start && f.t <= o.end);
+          if (out) continue;
+          filter::AlignmentFix af;
+          af.t = f.t;
+          af.pos = f.pos;
+          af.sigma_pos_N = f.cov_pos_N->diagonal().cwiseSqrt();
+          if (cfg.use_gnss_velocity && f.v_N && f.cov_vel_N) {
+            af.v_N = *f.v_N;
+            af.sigma_vel_N = f.cov_vel_N->diagonal().cwiseSqrt();
+          }
+          al.addFix(af);
+        }
+      }
+      if (!al.done())
+        throw Error("the IMU data end before the aligning phase does: " + al.missing());
+      if (k >= imu.size()) throw Error("the aligning phase ends with the IMU data: nothing left to navigate");
+      in.x0 = al.state();
+      opt.P0_nav = al.P0();
+      r.alignment = al.report();
+      for (const auto& f : d.gnss)
+        if (f.t > al.usedFixTime() + 1e-9) gnssAfter.push_back(f);
+    } catch (const Error& e) {
+      throw Error(cfg.rawlog + ": aligning (no complete reference at the start): " + e.what());
+    }
+    imu.erase(imu.begin(), imu.begin() + static_cast<std::ptrdiff_t>(k));
+    in.gnss = &gnssAfter;
+    r.aided_from_s = in.x0.t - r.t_zero;
+    r.notices.push_back(std::string(hasTruth ? "" : "no ground truth in the rawlog: ") + "aligning phase from 0 to " +
+                        formatNumber(r.aided_from_s, 10) + " s (levelling " + r.alignment->levelling + ", heading from " +
+                        r.alignment->heading + "), the filter runs from there" +
+                        (hasTruth ? "" : "; errors and NEES are not available"));
+    for (const auto& n : r.alignment->notes) r.notices.push_back("alignment: " + n);
+  }
+  // Outages all along the run, each after period - duration of GNSS from the filter start.
+  if (cfg.outages_every) {
+    for (const auto& w : outagesEvery(*cfg.outages_every, in.x0.t, t_last)) {
+      opt.outages.push_back({w.first, w.second});
+      r.cfg.outages.push_back({w.first - r.t_zero, w.second - w.first});
+    }
+    if (opt.outages.size() == cfg.outages.size())
+      r.notices.push_back("outages every " + formatNumber(cfg.outages_every->period_s, 10) + ":" +
+                          formatNumber(cfg.outages_every->duration_s, 10) + " s: none fits in the data after the filter start");
   }
   r.run = runNav(in, model, opt);
+  if (hasTruth) r.score = scoreRun(r.run, r.t_zero, in.x0.t, refInfo);
   std::size_t i = 0;
   for (const auto& e : r.run.epochs) {
     r.estimate.push_back(e.est);

@@ -186,16 +186,16 @@ void CoarseAligner::levelQuasiStatic() {
                        " deg from an assumed acceleration of " + formatNumber(opt_.accel_sigma_mps2, 3) + " m/s^2)");
 }
 
-bool CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
+int CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
   const double T = b.fix.t - a.fix.t;
-  if (!(T > 0.0) || T > 10.0) return false;
+  if (!(T > 0.0) || T > 10.0) return 0;
   // Course at a (unless the heading is given at t0).
   double course = 0.0, sigma_course = 0.0;
   const Vector3d va = *a.fix.v_N;
   if (!heading_) {
     const double speed = va.head<2>().norm();
     sigma_course = speed > 0.0 ? a.fix.sigma_vel_N.head<2>().maxCoeff() / speed : 1e9;
-    if (sigma_course > opt_.max_course_sigma_rad) return false;
+    if (sigma_course > opt_.max_course_sigma_rad) return 0;
     course = std::atan2(va.y(), va.x());
     rep_.course_speed_mps = speed;
     rep_.course_t = a.fix.t;
@@ -204,7 +204,7 @@ bool CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
   // velocity change minus gravity (Coriolis and transport rate neglected):
   // levelling corrected for the vehicle's own acceleration.
   const Vector3d v = *b.fix.v_N - va - earth::gravity_N(b.fix.pos.lat, b.fix.pos.h) * T;
-  if (u_B0_.norm() < 1e-9 || v.norm() < 1e-9) return false;
+  if (u_B0_.norm() < 1e-9 || v.norm() < 1e-9) return 0;
   const Vector3d uh = u_B0_.normalized(), vh = v.normalized();
   auto yawFor = [&](double r, double p) {
     return heading_ ? yaw0_ : ins::wrapAngle(course - yawOf(quatLevel(r, p) * a.q_BtoB0));
@@ -223,23 +223,42 @@ bool CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
     p = std::max(-1.5, std::min(1.5, p + step[1]));
     if (step.norm() < 1e-10) break;
   }
-  rp0_ = Eigen::Vector2d(r, p);
   const double sv = std::max(a.fix.sigma_vel_N.maxCoeff(), b.fix.sigma_vel_N.maxCoeff());
-  sigma_tilt_ = std::hypot(std::sqrt(2.0) * sv / (kG * T), opt_.acc_bias_sigma_mps2 / kG);
+  double s_tilt = std::hypot(std::sqrt(2.0) * sv / (kG * T), opt_.acc_bias_sigma_mps2 / kG);
+  const double yaw = yawFor(r, p);
+  double s_yaw = heading_ ? sigma_yaw_ : std::hypot(sigma_course, opt_.sideslip_sigma_rad);
+  const Quaterniond q = quatZ(yaw) * quatLevel(r, p);
+  if (!vel_first_) {  // keep it; confirm over the next interval
+    vel_first_ = VelLevel{q, s_tilt, s_yaw, b.fix.t};
+    return 1;
+  }
+  // two solutions for the same body attitude at t0: they must agree
+  const double dis = Eigen::AngleAxisd(vel_first_->q_B0toN.conjugate() * q).angle();
+  const double comb = std::sqrt(std::pow(std::hypot(s_tilt, s_yaw), 2) +
+                                std::pow(std::hypot(vel_first_->sigma_tilt, vel_first_->sigma_yaw), 2));
+  if (dis > 3.0 * comb) {
+    rep_.notes.push_back("the GNSS-velocity levellings over two consecutive intervals disagree by " +
+                         formatNumber(dis * kRad2Deg, 3) + " deg (3 combined sigmas: " + formatNumber(3.0 * comb * kRad2Deg, 3) +
+                         " deg; sideslip or unmodelled acceleration): attitude sigmas raised to it");
+    s_tilt = std::max(s_tilt, dis);
+    s_yaw = std::max(s_yaw, dis);
+  }
+  rp0_ = Eigen::Vector2d(r, p);
+  sigma_tilt_ = s_tilt;
   levelled_ = true;
   t_levelled_ = t_last_;
   rep_.levelling = "gnss_velocity";
   rep_.level_span_s = T;
   rep_.notes.push_back("moving at the start: levelled by matching the specific force over " + formatNumber(T, 4) +
-                       " s to the GNSS velocity change minus gravity");
+                       " s to the GNSS velocity change minus gravity (checked against the interval before)");
   if (!heading_) {
-    yaw0_ = yawFor(r, p);
+    yaw0_ = yaw;
     heading_ = true;
-    sigma_yaw_ = std::hypot(sigma_course, opt_.sideslip_sigma_rad);
     t_heading_ = a.fix.t;
     rep_.heading = "gnss_velocity_course";
   }
-  return true;
+  sigma_yaw_ = s_yaw;
+  return 2;
 }
 
 void CoarseAligner::tryHeading(const FixRec& r) {
@@ -451,8 +470,10 @@ void CoarseAligner::addFix(const AlignmentFix& f) {
   }
   if (!levelled_ && !static_start_) {
     if (f.v_N) {
-      if (!vel_a_ || !levelWithVelocities(*vel_a_, r)) {
-        if (vel_a_ && !heading_) want_quasi_static_ = true;  // too slow for a course: level as if at rest
+      const int lv = vel_a_ ? levelWithVelocities(*vel_a_, r) : 0;
+      if (lv != 2) {
+        // too slow for a course: level as if at rest
+        if (lv == 0 && vel_a_ && !heading_ && !vel_first_) want_quasi_static_ = true;
         vel_a_ = r;
         u_B0_.setZero();
       }

@@ -46,6 +46,115 @@ Eigen::Vector3d eulerSigma(const ins::NavState& truth, const Eigen::Vector3d& si
   return S.diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 
+/// Per-outage zoomed figures are written for the first this many outages.
+constexpr std::size_t kMaxOutageFigures = 12;
+
+/// Horizontal track in metres from the first epoch: estimate (and reference),
+/// the estimate during each outage drawn over it, its end marked.
+void writeTrajectoryFigure(const ReplayResult& r, OutputSet& out) {
+  const auto& ep = r.run.epochs;
+  if (ep.empty()) return;
+  const earth::Geodetic o0 = r.run.has_truth ? r.truth.front().geodetic() : ep.front().est.geodetic();
+  auto ne = [&](const ins::NavState& x) { return earth::geodeticToNed(o0, x.geodetic()); };
+  plot::Axes ax;
+  ax.xlabel = "east [m]";
+  ax.ylabel = "north [m]";
+  plot::Series est{"estimate", {}, {}, plot::palette(0), plot::LineStyle::Solid, plot::Marker::None, 1.4};
+  plot::Series ref{"reference", {}, {}, plot::palette(6), plot::LineStyle::Dashed, plot::Marker::None, 1.2};
+  plot::Series ends{"outage end (estimate)", {}, {}, plot::palette(1), plot::LineStyle::None, plot::Marker::Cross, 2.0};
+  std::vector<plot::Series> outs;
+  for (std::size_t k = 0; k < ep.size(); ++k) {
+    const Eigen::Vector3d p = ne(ep[k].est);
+    est.x.push_back(p.y());
+    est.y.push_back(p.x());
+    if (r.run.has_truth) {
+      const Eigen::Vector3d q = ne(r.truth[k]);
+      ref.x.push_back(q.y());
+      ref.y.push_back(q.x());
+    }
+  }
+  for (std::size_t i = 0; i < r.run.outages.size(); ++i) {
+    const auto& w = r.run.outages[i];
+    plot::Series s{i == 0 ? "estimate in a GNSS outage" : "", {}, {}, plot::palette(1), plot::LineStyle::Solid,
+                   plot::Marker::None, 2.4};
+    for (const auto& e : ep)
+      if (e.t > w.window.start && e.t <= w.window.end + 1e-9) {
+        const Eigen::Vector3d p = ne(e.est);
+        s.x.push_back(p.y());
+        s.y.push_back(p.x());
+      }
+    if (w.end_epoch >= 0) {
+      const Eigen::Vector3d p = ne(ep[static_cast<std::size_t>(w.end_epoch)].est);
+      ends.x.push_back(p.y());
+      ends.y.push_back(p.x());
+    }
+    if (!s.x.empty()) outs.push_back(s);
+  }
+  if (r.run.has_truth) ax.series.push_back(ref);
+  ax.series.push_back(est);
+  for (auto& s : outs) ax.series.push_back(s);
+  if (!ends.x.empty()) ax.series.push_back(ends);
+  // equal scales: pad the shorter extent
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+  for (const auto& s : ax.series)
+    for (std::size_t k = 0; k < s.x.size(); ++k) {
+      x0 = std::min(x0, s.x[k]);
+      x1 = std::max(x1, s.x[k]);
+      y0 = std::min(y0, s.y[k]);
+      y1 = std::max(y1, s.y[k]);
+    }
+  const int W = 1400, H = 1100;
+  const double half = 0.55 * std::max({x1 - x0, (y1 - y0) * W / H, 1.0});
+  const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+  ax.xlim = std::make_pair(cx - half, cx + half);
+  ax.ylim = std::make_pair(cy - half * H / W, cy + half * H / W);
+  plot::Figure fig;
+  fig.width = W;
+  fig.height = H;
+  fig.title = "Horizontal track" + std::string(r.run.has_truth ? " against the reference" : "") + ", " +
+              std::to_string(r.run.outages.size()) + " GNSS outage(s) in red";
+  fig.axes.push_back(ax);
+  plot::savePng(fig, out.stage("trajectory.png").string());
+}
+
+/// Error at each outage end against the filter's predicted sigma (reference
+/// sigma included), horizontal and vertical, with the 1/2/3-sigma lines.
+void writeOutageEndFigure(const RunScore& sc, OutputSet& out) {
+  plot::Figure fig;
+  fig.width = 1800;
+  fig.height = 800;
+  fig.rows = 1;
+  fig.cols = 2;
+  fig.title = "Error at the end of each GNSS outage against its predicted σ (" +
+              std::to_string(sc.outages.size()) + " outages)";
+  const double rh = sc.reference.sigma_h_m, rv = sc.reference.sigma_v_m;
+  for (int v = 0; v < 2; ++v) {
+    plot::Axes ax;
+    ax.title = v == 0 ? "horizontal" : "vertical";
+    ax.xlabel = v == 0 ? "predicted horizontal σ (√(σN²+σE²), reference included) [m]"
+                       : "predicted vertical σ (reference included) [m]";
+    ax.ylabel = "error at outage end [m]";
+    plot::Series pts{"outages", {}, {}, plot::palette(0), plot::LineStyle::None, plot::Marker::FilledCircle, 2.0};
+    double mx = 0.0;
+    for (const auto& o : sc.outages) {
+      const double sig = v == 0 ? std::sqrt(o.horizontal_sigma_m * o.horizontal_sigma_m + 2.0 * rh * rh)
+                                : std::hypot(o.vertical_sigma_m, rv);
+      pts.x.push_back(sig);
+      pts.y.push_back(v == 0 ? o.horizontal_error_m : o.vertical_error_m);
+      mx = std::max({mx, sig, pts.y.back()});
+    }
+    mx = std::max(mx, 1e-3) * 1.05;
+    for (int k = 1; k <= 3; ++k)
+      ax.series.push_back({std::to_string(k) + "σ", {0.0, mx}, {0.0, k * mx}, plot::palette(k + 1),
+                           plot::LineStyle::Dashed, plot::Marker::None, 1.4});
+    ax.series.push_back(pts);
+    ax.xlim = std::make_pair(0.0, mx);
+    ax.ylim = std::make_pair(0.0, mx * 1.5);
+    fig.axes.push_back(ax);
+  }
+  plot::savePng(fig, out.stage("outage_end_error.png").string());
+}
+
 void writeReplayFigures(const ReplayResult& r, OutputSet& out) {
   const auto& ep = r.run.epochs;
   const std::size_t n = ep.size();
@@ -98,13 +207,15 @@ void writeReplayFigures(const ReplayResult& r, OutputSet& out) {
     }
     return fig;
   };
+  writeTrajectoryFigure(r, out);
+  if (r.score && !r.score->outages.empty()) writeOutageEndFigure(*r.score, out);
   const double tEnd = n ? t.back() : 1.0;
   plot::savePng(figure(0.0, tEnd,
                        (r.run.has_truth ? "Navigation errors (estimate − truth), filter model: "
                                         : "Predicted ±1σ (no ground truth in the rawlog), filter model: ") +
                            r.model_source),
                 out.stage("errors_full.png").string());
-  for (std::size_t i = 0; i < r.cfg.outages.size(); ++i) {
+  for (std::size_t i = 0; i < r.cfg.outages.size() && i < kMaxOutageFigures; ++i) {
     const auto& o = r.cfg.outages[i];
     const double a = std::max(0.0, o.start_s - 0.1 * o.duration_s());
     const double b = std::min(tEnd, o.start_s + 1.1 * o.duration_s());
@@ -193,6 +304,22 @@ std::string summaryJson(const ReplayResult& r) {
       continue;
     }
     const std::size_t ke = static_cast<std::size_t>(o.end_epoch);
+    if (r.score) {  // the scored outage (reference sigma counted in the NEES)
+      for (const auto& q : r.score->outages)
+        if (std::abs(q.start_s - r.cfg.outages[i].start_s) < 1e-9 &&
+            std::abs(q.duration_s - r.cfg.outages[i].duration_s) < 1e-6) {
+          jo["end_s"] = q.end_s;
+          jo["horizontal_error_m"] = q.horizontal_error_m;
+          jo["vertical_error_m"] = q.vertical_error_m;
+          jo["horizontal_sigma_m"] = q.horizontal_sigma_m;
+          jo["vertical_sigma_m"] = q.vertical_sigma_m;
+          jo["max_drift_horizontal_m"] = q.max_drift_h_m;
+          jo["max_drift_vertical_m"] = q.max_drift_v_m;
+          jo["nees"] = q.nees;
+          jo["nees_in_95_band"] = q.nees_in_band;
+          break;
+        }
+    }
     if (!r.run.has_truth) {  // predicted sigmas only
       const auto& e = ep[ke];
       const Eigen::Vector3d attSig = eulerSigma(r.estimate[ke], e.sigma.segment<3>(6)) / kDeg;
@@ -244,6 +371,60 @@ std::string summaryJson(const ReplayResult& r) {
     outs.push_back(jo);
   }
   j["outages"] = outs;
+  j["rejected_updates"] = r.run.rejected.size();
+  {
+    json rej = json::array();
+    for (std::size_t k = 0; k < r.run.rejected.size() && k < 1000; ++k) {
+      const auto& u = r.run.rejected[k];
+      rej.push_back({{"t_s", u.t - r.t_zero}, {"kind", u.kind}, {"nis", u.nis}, {"gate", u.gate}});
+    }
+    j["rejected"] = rej;  // the first 1000
+  }
+  j["zupt_updates"] = r.run.zupt_updates;
+  j["nhc_updates"] = r.run.nhc_updates;
+  j["filter_start_s"] = r.aided_from_s;
+  if (r.alignment) {
+    const auto& a = *r.alignment;
+    j["alignment"] = {{"phase", "aligning"},
+                      {"start_s", a.t_start - r.t_zero},
+                      {"end_s", a.t_end - r.t_zero},
+                      {"levelling", a.levelling},
+                      {"level_span_s", a.level_span_s},
+                      {"heading", a.heading},
+                      {"course_speed_mps", a.course_speed_mps},
+                      {"roll_pitch_yaw_deg", {a.rpy[0] / kDeg, a.rpy[1] / kDeg, a.rpy[2] / kDeg}},
+                      {"roll_pitch_yaw_sigma_deg", {a.sigma_rpy[0] / kDeg, a.sigma_rpy[1] / kDeg, a.sigma_rpy[2] / kDeg}},
+                      {"static_at_end", a.static_at_end},
+                      {"notes", a.notes}};
+  }
+  if (r.score) {
+    const auto& sc = *r.score;
+    auto fin = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
+    j["reference_errors"] = {{"horizontal_rms_m", fin(sc.horizontal_rms_m)},
+                             {"vertical_rms_m", fin(sc.vertical_rms_m)},
+                             {"velocity_rms_mps", fin(sc.velocity_rms_mps)},
+                             {"attitude_rms_deg_psi_NED",
+                              {fin(sc.attitude_rms_rad[0] / kDeg), fin(sc.attitude_rms_rad[1] / kDeg),
+                               fin(sc.attitude_rms_rad[2] / kDeg)}},
+                             {"epochs", sc.aided_epochs},
+                             {"over", "reference epochs with GNSS (outside the outages, from the filter start)"},
+                             {"reference_sigma_m", {{"horizontal", sc.reference.sigma_h_m},
+                                                    {"vertical", sc.reference.sigma_v_m}}}};
+    const auto& d = sc.distribution;
+    j["outage_distribution"] = {
+        {"count", d.count},
+        {"horizontal_error_median_m", fin(d.median_h_m)},
+        {"horizontal_error_p95_m", fin(d.p95_h_m)},
+        {"vertical_error_median_m", fin(d.median_v_m)},
+        {"vertical_error_p95_m", fin(d.p95_v_m)},
+        {"coverage_1_2_3_sigma", {fin(d.coverage[0]), fin(d.coverage[1]), fin(d.coverage[2])}},
+        {"coverage_expected", {d.coverage_expected[0], d.coverage_expected[1], d.coverage_expected[2]}},
+        {"coverage_note", "fraction of the per-axis end errors (N, E, D) within k predicted sigma, reference sigma included"},
+        {"mean_nees", fin(d.mean_nees)},
+        {"mean_nees_95_band", {fin(d.mean_nees_lo), fin(d.mean_nees_hi)}},
+        {"nees_in_95_band", d.nees_in_band},
+        {"nees_95_band", {d.nees_band_lo, d.nees_band_hi}}};
+  }
   if (!r.run.has_truth) {
     j["note"] = "the rawlog has no ground truth (label GT): errors, NEES and RMS are not available; "
                 "solution.csv holds the estimate and the predicted sigmas, its error and NEES columns are empty";
@@ -281,7 +462,28 @@ std::string replaySummary(const ReplayResult& r) {
                 r.model_source.c_str(), r.read_s, r.run.wall_s);
   s += b;
   if (!r.run.has_truth) s += "no ground truth in the rawlog: estimate and predicted sigmas only\n";
-  for (std::size_t i = 0; i < r.run.outages.size(); ++i) {
+  if (!r.run.rejected.empty()) {
+    std::snprintf(b, sizeof b, "%zu update(s) rejected by the NIS gate (first at %.3f s, %s, NIS %.1f > %.1f)\n",
+                  r.run.rejected.size(), r.run.rejected.front().t - r.t_zero, r.run.rejected.front().kind.c_str(),
+                  r.run.rejected.front().nis, r.run.rejected.front().gate);
+    s += b;
+  }
+  if (r.score) {
+    const auto& sc = *r.score;
+    std::snprintf(b, sizeof b, "against the reference with GNSS: horizontal RMS %.3f m, vertical RMS %.3f m (%zu epochs)\n",
+                  sc.horizontal_rms_m, sc.vertical_rms_m, sc.aided_epochs);
+    s += b;
+    const auto& d = sc.distribution;
+    if (d.count > 1) {
+      std::snprintf(b, sizeof b,
+                    "%zu outages: horizontal error at end median %.2f m, p95 %.2f m; vertical median %.2f m, p95 %.2f m; "
+                    "within 1/2/3 sigma %.0f/%.0f/%.0f %% (expected 68/95/99.7); mean NEES %.2f (95%% band %.2f..%.2f)\n",
+                    d.count, d.median_h_m, d.p95_h_m, d.median_v_m, d.p95_v_m, 100 * d.coverage[0],
+                    100 * d.coverage[1], 100 * d.coverage[2], d.mean_nees, d.mean_nees_lo, d.mean_nees_hi);
+      s += b;
+    }
+  }
+  for (std::size_t i = 0; i < r.run.outages.size() && i < 20; ++i) {
     const auto& w = r.run.outages[i];
     if (w.end_epoch < 0) continue;
     const auto& e = r.run.epochs[static_cast<std::size_t>(w.end_epoch)];

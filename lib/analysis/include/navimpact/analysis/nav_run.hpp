@@ -19,7 +19,9 @@
  * the small-angle vector psi with C_est = (I + [psi x]) C_true [rad].
  *
  * Timing: measurements apply when the filter time reaches them (to within
- * half an IMU interval), after the prediction to that sample; at one epoch
+ * half an IMU interval), after the prediction to that sample; a GNSS fix
+ * between samples is compared with the prediction carried to its own epoch
+ * (ErrorStateEkf dt_meas), so fixes need not fall on IMU samples; at one epoch
  * GNSS position, then GNSS velocity, then baro are applied, then the epoch
  * is recorded. GNSS outage windows are half-open on the left: a fix at time
  * t is dropped when start < t <= end, so with fixes at whole seconds and an
@@ -45,6 +47,7 @@
 #include "navimpact/core/recording.hpp"
 #include "navimpact/core/outage.hpp"
 #include "navimpact/emulation/sensors.hpp"
+#include "navimpact/filter/alignment.hpp"
 #include "navimpact/filter/ekf.hpp"
 #include "navimpact/ins/nav_state.hpp"
 #include "navimpact/stochastic/model_file.hpp"
@@ -83,6 +86,28 @@ struct NavRunOptions {
   /// Record interval without truth [s], > 0: epochs at the IMU samples nearest
   /// x0.t + k * record_interval_s (ignored when NavRunInput::truth is given).
   double record_interval_s = 0.1;
+  /// Ground-vehicle aids, off by default (Groves 2013 §15.3-15.4).
+  /// Zero-velocity update at every IMU sample where the static detector
+  /// (filter/alignment.hpp) says "at rest", at most every zupt_interval_s.
+  bool zupt = false;
+  filter::StaticDetectorOptions zupt_detector;  ///< at-rest sigmas of the IMU, window, false alarm
+  double zupt_sigma_mps = 0.02;                 ///< pseudo-measurement 1-sigma per axis [m/s], > 0
+  double zupt_interval_s = 0.1;                 ///< [s], > 0
+  /// Non-holonomic constraint every nhc_interval_s while moving faster than
+  /// nhc_min_speed_mps (no sideways or vertical velocity of the point nhc_point_B).
+  bool nhc = false;
+  double nhc_sigma_lateral_mps = 0.1, nhc_sigma_vertical_mps = 0.1;  ///< [m/s], > 0
+  double nhc_interval_s = 0.1;                  ///< [s], > 0
+  double nhc_min_speed_mps = 0.5;               ///< [m/s], >= 0
+  Eigen::Vector3d nhc_point_B = Eigen::Vector3d::Zero();  ///< constrained point, body FRD from the IMU [m]
+};
+
+/// An update the chi-square gate rejected.
+struct RejectedUpdate {
+  double t = 0.0;        ///< filter time [s]
+  std::string kind;      ///< "gnss_position", "gnss_velocity", "baro", "zupt", "nhc"
+  double nis = 0.0;      ///< its NIS
+  double gate = 0.0;     ///< the gate's threshold
 };
 
 /// Errors, sigmas and NEES at one record epoch.
@@ -91,6 +116,7 @@ struct NavEpoch {
   ins::NavState est;                ///< the filter's estimate at t (after the updates of t)
   filter::Vector9d err;             ///< estimate minus truth: dp NED [m], dv NED [m/s], psi [rad]; NaN without truth
   filter::Vector9d sigma;           ///< predicted 1-sigma of the same nine errors
+  Eigen::Matrix3d P_pos = Eigen::Matrix3d::Zero();  ///< predicted position covariance N, E, D [m^2]
   std::array<double, 4> nees{};     ///< position (3 dof), velocity (3), attitude (3), all (9); NaN if P singular or no truth
 };
 
@@ -112,6 +138,9 @@ struct NavRunResult {
   std::size_t gnss_updates = 0;     ///< GNSS fixes applied
   std::size_t baro_updates = 0;     ///< baro samples applied
   int rejections = 0;               ///< updates rejected by the chi-square gate
+  std::vector<RejectedUpdate> rejected;  ///< each of them
+  std::size_t zupt_updates = 0;     ///< zero-velocity updates applied
+  std::size_t nhc_updates = 0;      ///< non-holonomic updates applied
   double wall_s = 0.0;              ///< wall-clock time of the run [s]
 };
 

@@ -32,16 +32,25 @@
  * Without `noise`, the covariances recorded with each GNSS fix and the
  * scenario's barometer sigma are used.
  *
- * Rawlogs without ground truth (label GT absent, e.g. a real flight): the
- * filter starts from the GNSS fix at time zero (position, velocity; lever arm
- * removed), yaw from the GNSS course (needs >= 1 m/s horizontal speed, no
- * sideslip assumed), roll and pitch from levelling corrected for the vehicle's
- * acceleration (the gyro-rotated specific force over the first GNSS interval
- * matched to the GNSS velocity change minus gravity), unless given by
- * `initial_attitude_deg: [roll, pitch, yaw]`; its initial attitude sigmas are
- * then at least 2 deg (roll, pitch) and 5 deg (yaw). The estimate and the
+ * outages_every: {period_s: 120, duration_s: 30}  # or --outages-every 120:30
+ * reference_sigma: {horizontal_m: 0.05, vertical_m: 0.1}   # the reference's own 1-sigma
+ * alignment: {yaw_deg: 40, yaw_sigma_deg: 2, max_align_s: 600, max_course_sigma_deg: 3}
+ * imu_at_rest: {gyro_sigma_rad_s: 1e-3, acc_sigma_mps2: 1e-2, window_s: 0.5, false_alarm: 0.01}
+ * aids: {zupt: {sigma_mps: 0.02, interval_s: 0.1},
+ *        nhc: {sigma_lateral_mps: 0.1, sigma_vertical_mps: 0.1, interval_s: 0.1,
+ *              min_speed_mps: 0.5, point_B_m: [0, 0, 0]}}   # each present = on
+ *
+ * Rawlogs without ground truth (label GT absent, e.g. a real run): an
+ * aligning phase (filter/alignment.hpp: static or GNSS-velocity levelling,
+ * heading from `alignment.yaw_deg` / `initial_attitude_deg`'s yaw or the GNSS
+ * course once moving) runs from time zero until it has an attitude, a
+ * position and a velocity; the filter starts there (no fix is needed at the
+ * first IMU sample) and the phase is reported. The estimate and the
  * predicted sigmas are recorded every `record_interval_s` (default 0.1 s);
  * errors and NEES are empty in solution.csv and absent from summary.json.
+ *
+ * With ground truth the run is scored (analysis/scoring.hpp), counting the
+ * reference's own sigma; `outages_every` outages are laid from the filter start.
  */
 #pragma once
 
@@ -50,7 +59,9 @@
 #include <vector>
 
 #include "navimpact/analysis/nav_run.hpp"
+#include "navimpact/analysis/scoring.hpp"
 #include "navimpact/core/recording.hpp"
+#include "navimpact/filter/alignment.hpp"
 
 namespace navimpact::analysis {
 
@@ -76,6 +87,11 @@ struct ReplayConfig {
   std::optional<Eigen::Vector3d> initial_attitude_deg;  ///< roll, pitch, yaw [deg]; used without GT
   double record_interval_s = 0.1;               ///< record interval without GT [s], > 0
   double max_imu_gap_s = 0.0;                   ///< longest IMU gap propagated across [s]; 0 = gaps are errors
+  std::optional<OutagePattern> outages_every;   ///< more outages all along the run (after the explicit ones)
+  double reference_sigma_h_m = 0.0;             ///< the reference's own 1-sigma per horizontal axis [m]
+  double reference_sigma_v_m = 0.0;             ///< its vertical 1-sigma [m]
+  filter::AlignmentOptions alignment;           ///< the aligning phase without GT (lever arm and yaw set by the replay)
+  NavRunOptions aids;                           ///< only its zupt* / nhc* fields are used (ground-vehicle aids)
 };
 
 /// Read a replay configuration. @throws navimpact::Error naming file and key.
@@ -94,6 +110,11 @@ struct ReplayResult {
   double read_s = 0.0;                      ///< CPU time of reading the rawlog [s]
   std::size_t imu_gaps = 0;                 ///< IMU gaps propagated across (allowed by max_imu_gap_s)
   std::vector<std::string> notices;
+  /// The aligning phase (rawlogs without GT): from time zero to report.t_end the
+  /// filter does not run; absent when the filter started from GT.
+  std::optional<filter::AlignmentReport> alignment;
+  double aided_from_s = 0.0;                ///< filter start, from time zero [s]
+  std::optional<RunScore> score;            ///< scored against the reference (GT) when there is one
 };
 
 /**

@@ -31,8 +31,11 @@
  *     least min_static_s of rest; the mean gyro output there is taken as bias
  *     plus Earth rate and removed while it integrates the body rotation
  *     afterwards), else, with GNSS velocities, by matching the specific force
- *     integrated over the first GNSS velocity interval to the velocity change
+ *     integrated over a GNSS velocity interval to the velocity change
  *     minus gravity (levelling corrected for the vehicle's own acceleration),
+ *     solved over two consecutive intervals: when the two attitudes of the
+ *     body at t0 disagree by more than 3 combined sigmas (sideslip at a launch,
+ *     unmodelled acceleration) the sigmas are raised to the disagreement,
  *     else over the first level_window_s as if at rest (sigma inflated by the
  *     assumed acceleration);
  *  2. takes the heading from AlignmentOptions::yaw (configuration or a
@@ -205,7 +208,9 @@ class CoarseAligner {
   Eigen::Vector3d imuVelocity(const FixRec& r) const;
   void levelStatic(const Sums& sums);
   void levelQuasiStatic();
-  bool levelWithVelocities(const FixRec& a, const FixRec& b);
+  /// 0: not possible over (a, b]; 1: first solution kept, confirm over the next
+  /// interval; 2: confirmed (levelled, heading set unless given).
+  int levelWithVelocities(const FixRec& a, const FixRec& b);
   void tryHeading(const FixRec& r);
   void finish(const FixRec& r);
 
@@ -233,6 +238,12 @@ class CoarseAligner {
   Eigen::Vector3d w_last_ = Eigen::Vector3d::Zero();
   // levelling with GNSS velocities: specific force integrated in B0 since fix a
   std::optional<FixRec> vel_a_;
+  // first GNSS-velocity solution, awaiting its confirmation over the next interval
+  struct VelLevel {
+    Eigen::Quaterniond q_B0toN;   // attitude of the body at t0
+    double sigma_tilt = 0.0, sigma_yaw = 0.0, t = 0.0;
+  };
+  std::optional<VelLevel> vel_first_;
   Eigen::Vector3d u_B0_ = Eigen::Vector3d::Zero();
   // heading: yaw of the body at t0
   bool heading_ = false;

@@ -23,7 +23,8 @@ std::string summaryJson(const analysis::ReplayResult& r);
 /// Notices, what was replayed, and per outage the error (or predicted sigma) at its end.
 std::string replaySummary(const analysis::ReplayResult& r);
 
-/// Stage solution.csv, summary.json, errors_full.png and errors_outage_K.png in @p out; the caller commits.
+/// Stage solution.csv, summary.json, errors_full.png, errors_outage_K.png (the first 12
+/// outages), trajectory.png and, when scored, outage_end_error.png in @p out; the caller commits.
 void writeReplayOutputs(const analysis::ReplayResult& r, OutputSet& out);
 
 }  // namespace navimpact::report

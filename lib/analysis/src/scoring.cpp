@@ -1,0 +1,155 @@
+// A navigation run scored against a reference (see scoring.hpp).
+#include "navimpact/analysis/scoring.hpp"
+
+#include <Eigen/Cholesky>
+#include <boost/math/distributions/chi_squared.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
+#include "navimpact/core/text_io.hpp"
+
+namespace navimpact::analysis {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double chi2q(double dof, double p) { return boost::math::quantile(boost::math::chi_squared(dof), p); }
+
+}  // namespace
+
+OutagePattern parseOutagePattern(const std::string& text) {
+  const auto c = text.find(':');
+  OutagePattern p;
+  if (c == std::string::npos || !parseDouble(trim(std::string_view(text).substr(0, c)), p.period_s) ||
+      !parseDouble(trim(std::string_view(text).substr(c + 1)), p.duration_s))
+    throw Error("outages every '" + text + "': expected PERIOD:DURATION in seconds, e.g. 120:30");
+  if (!(p.duration_s > 0.0) || !(p.period_s > p.duration_s) || !std::isfinite(p.period_s))
+    throw Error("outages every '" + text +
+                "': DURATION must be > 0 s and PERIOD > DURATION (GNSS time between outages to reconverge)");
+  return p;
+}
+
+std::vector<std::pair<double, double>> outagesEvery(const OutagePattern& p, double aided_from, double end) {
+  if (!(p.duration_s > 0.0) || !(p.period_s > p.duration_s))
+    throw Error("outages every " + formatNumber(p.period_s, 10) + ":" + formatNumber(p.duration_s, 10) + ": PERIOD must exceed DURATION > 0");
+  std::vector<std::pair<double, double>> out;
+  for (long k = 0;; ++k) {
+    // start_k = aided_from + (k + 1) period - duration, computed from k (no accumulated rounding)
+    const double a = aided_from + double(k + 1) * p.period_s - p.duration_s, b = a + p.duration_s;
+    if (b > end + 1e-9) break;
+    out.emplace_back(a, b);
+  }
+  return out;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const double h = q * double(v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(std::floor(h));
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (h - double(lo)) * (v[hi] - v[lo]);
+}
+
+RunScore scoreRun(const NavRunResult& run, double t_zero, double aided_from, const ReferenceInfo& ref) {
+  if (!run.has_truth) throw Error("scoring: the run has no reference");
+  if (!(ref.sigma_h_m >= 0.0) || !(ref.sigma_v_m >= 0.0) || !std::isfinite(ref.sigma_h_m) ||
+      !std::isfinite(ref.sigma_v_m))
+    throw Error("scoring: reference sigmas must be finite and >= 0");
+  RunScore s;
+  s.reference = ref;
+  const Eigen::Vector3d R_ref(ref.sigma_h_m * ref.sigma_h_m, ref.sigma_h_m * ref.sigma_h_m,
+                              ref.sigma_v_m * ref.sigma_v_m);
+  auto inOutage = [&](double t) {
+    for (const auto& o : run.outages)
+      if (t > o.window.start && t <= o.window.end + 1e-9) return true;
+    return false;
+  };
+
+  // Errors along the run over the GNSS-aided time.
+  double sh = 0.0, sv = 0.0, svel = 0.0;
+  Eigen::Vector3d satt = Eigen::Vector3d::Zero();
+  for (const NavEpoch& e : run.epochs) {
+    if (e.t < aided_from - 1e-9 || inOutage(e.t)) continue;
+    ++s.aided_epochs;
+    sh += e.err.head<2>().squaredNorm();
+    sv += e.err[2] * e.err[2];
+    svel += e.err.segment<3>(3).squaredNorm();
+    satt += e.err.segment<3>(6).cwiseAbs2();
+  }
+  const double n = double(std::max<std::size_t>(s.aided_epochs, 1));
+  s.horizontal_rms_m = s.aided_epochs ? std::sqrt(sh / n) : kNaN;
+  s.vertical_rms_m = s.aided_epochs ? std::sqrt(sv / n) : kNaN;
+  s.velocity_rms_mps = s.aided_epochs && ref.has_velocity ? std::sqrt(svel / n) : kNaN;
+  s.attitude_rms_rad = s.aided_epochs && ref.has_attitude ? Eigen::Vector3d((satt / n).cwiseSqrt())
+                                                           : Eigen::Vector3d::Constant(kNaN);
+
+  // Per outage, at its end.
+  OutageDistribution& d = s.distribution;
+  d.nees_band_lo = chi2q(3.0, 0.025);
+  d.nees_band_hi = chi2q(3.0, 0.975);
+  std::vector<double> eh, ev, z;
+  double nees_sum = 0.0;
+  for (std::size_t i = 0; i < run.outages.size(); ++i) {
+    const OutageSummary& o = run.outages[i];
+    if (o.end_epoch < 0) {
+      s.unscored.push_back(i);
+      continue;
+    }
+    const NavEpoch& e = run.epochs.at(static_cast<std::size_t>(o.end_epoch));
+    OutageScore q;
+    q.start_s = o.window.start - t_zero;
+    q.duration_s = o.window.end - o.window.start;
+    q.end_s = e.t - t_zero;
+    q.err_N = e.err.head<3>();
+    q.sigma_N = e.P_pos.diagonal().cwiseMax(0.0).cwiseSqrt();
+    q.horizontal_error_m = q.err_N.head<2>().norm();
+    q.vertical_error_m = std::abs(q.err_N[2]);
+    q.horizontal_sigma_m = std::sqrt(std::max(0.0, e.P_pos(0, 0) + e.P_pos(1, 1)));
+    q.vertical_sigma_m = q.sigma_N[2];
+    for (const NavEpoch& k : run.epochs) {
+      if (k.t <= o.window.start || k.t > o.window.end + 1e-9) continue;
+      q.max_drift_h_m = std::max(q.max_drift_h_m, k.err.head<2>().norm());
+      q.max_drift_v_m = std::max(q.max_drift_v_m, std::abs(k.err[2]));
+    }
+    const Eigen::Matrix3d S = e.P_pos + Eigen::Matrix3d(R_ref.asDiagonal());
+    Eigen::LLT<Eigen::Matrix3d> llt(S);
+    q.nees = llt.info() == Eigen::Success ? q.err_N.dot(llt.solve(q.err_N)) : kNaN;
+    q.nees_in_band = q.nees >= d.nees_band_lo && q.nees <= d.nees_band_hi;
+    eh.push_back(q.horizontal_error_m);
+    ev.push_back(q.vertical_error_m);
+    for (int a = 0; a < 3; ++a) z.push_back(std::abs(q.err_N[a]) / std::sqrt(S(a, a)));
+    nees_sum += q.nees;
+    d.nees_in_band += q.nees_in_band ? 1 : 0;
+    s.outages.push_back(q);
+  }
+
+  // Distribution over the outages.
+  d.count = s.outages.size();
+  d.coverage_expected = {std::erf(1.0 / std::sqrt(2.0)), std::erf(2.0 / std::sqrt(2.0)),
+                         std::erf(3.0 / std::sqrt(2.0))};
+  if (d.count == 0) {
+    d.median_h_m = d.p95_h_m = d.median_v_m = d.p95_v_m = d.mean_nees = kNaN;
+    d.coverage = {kNaN, kNaN, kNaN};
+    d.mean_nees_lo = d.mean_nees_hi = kNaN;
+    return s;
+  }
+  d.median_h_m = percentile(eh, 0.5);
+  d.p95_h_m = percentile(eh, 0.95);
+  d.median_v_m = percentile(ev, 0.5);
+  d.p95_v_m = percentile(ev, 0.95);
+  for (int k = 0; k < 3; ++k)
+    d.coverage[k] = double(std::count_if(z.begin(), z.end(), [&](double x) { return x <= k + 1.0; })) / z.size();
+  const double K = double(d.count);
+  d.mean_nees = nees_sum / K;
+  d.mean_nees_lo = chi2q(3.0 * K, 0.025) / K;
+  d.mean_nees_hi = chi2q(3.0 * K, 0.975) / K;
+  return s;
+}
+
+}  // namespace navimpact::analysis
