@@ -94,3 +94,15 @@ set_tests_properties(cli_import_uav_same_outage PROPERTIES FIXTURES_REQUIRED imp
 navimpact_cli_fail(cli_replay_missing_imu_label
   ARGS replay --rawlog ${CMAKE_SOURCE_DIR}/tests/data/imu_label_xsens.rawlog --imu-label NOPE --out ${_idir}/nolabel
   REGEX "imu_label_xsens.rawlog: no IMU entries with label 'NOPE' \\(labels found: XSENS \\(64\\)\\)" NOOUT ${_idir}/nolabel)
+# The imported Katwijk run replayed (config/replay/katwijk.yaml): no GNSS fix at
+# the first IMU sample and a position-only reference (the RTK antenna track):
+# static levelling over the first 19 s at rest, heading from the GNSS chord,
+# then 6 outages of 20 s scored against the reference at its antenna point.
+navimpact_cli_check(cli_replay_katwijk_outages CHECK run_json
+  ARGS replay --config ${CMAKE_SOURCE_DIR}/config/replay/katwijk.yaml --rawlog ${_idir}/katwijk.rawlog
+       --outages-every 40:20 --out ${_idir}/katwijk_replay --overwrite
+  DEFINES OUT=${_idir}/katwijk_replay JSON_FILE=summary.json
+  JSON "alignment/levelling=^static$" "alignment/heading=^gnss_chord_course$" "outage_distribution/count=^6$"
+       "reference_errors/horizontal_rms_m=^0\\.0[0-9]+" "outages/0/horizontal_error_m=^[0-9.]+"
+  FILES trajectory.png outage_end_error.png)
+set_tests_properties(cli_replay_katwijk_outages PROPERTIES FIXTURES_REQUIRED import_katwijk)

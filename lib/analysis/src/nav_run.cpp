@@ -136,7 +136,8 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       return;
     }
     while (it < truth.t.size() && truth.t[it] <= t_now + half_dt) {
-      if (std::abs(truth.t[it] - t_now) > half_dt)
+      // nearest sample; an epoch exactly between two samples may land on either
+      if (std::abs(truth.t[it] - t_now) > half_dt * (1.0 + 1e-6) + 1e-9)
         throw Error("navigation run: truth epoch " + formatNumber(truth.t[it], 10) +
                     " s does not fall on an IMU sample (nearest " + formatNumber(t_now, 10) + " s)");
       ekf.flushPropagation();
@@ -144,6 +145,7 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       e.t = truth.t[it];
       e.est = ekf.state();
       e.err = filter::navError(ekf.state(), truth.x[it]);
+      if (opt.reference_lever_B.squaredNorm() > 0.0) e.err.head<3>() += ekf.state().C_BtoN() * opt.reference_lever_B;
       const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
       e.P_pos = P9.topLeftCorner<3, 3>();

@@ -61,13 +61,14 @@ static ReplayConfig loadReplayConfigImpl(const std::string& path) {
   if (!root.IsMap()) throw keyError(path, "(root)", "expected a map");
   const std::set<std::string> allowed = {"rawlog", "model", "outages", "filter", "initial_sigma", "noise",
                                          "gnss_lever_arm_B_m", "initial_attitude_deg", "record_interval_s",
-                                         "outages_every", "reference_sigma", "alignment", "imu_at_rest", "aids"};
+                                         "outages_every", "reference_sigma", "reference_lever_arm_B_m", "alignment",
+                                         "imu_at_rest", "aids"};
   for (const auto& kv : root)
     if (!allowed.count(kv.first.as<std::string>()))
       throw keyError(path, kv.first.as<std::string>(),
                      "unknown key (expected rawlog, model, outages, filter, initial_sigma, noise, gnss_lever_arm_B_m, "
-                     "initial_attitude_deg, record_interval_s, outages_every, reference_sigma, alignment, "
-                     "imu_at_rest, aids)");
+                     "initial_attitude_deg, record_interval_s, outages_every, reference_sigma, reference_lever_arm_B_m, "
+                     "alignment, imu_at_rest, aids)");
   auto num = [&](const YAML::Node& n, const std::string& key) {
     try {
       return n.as<double>();
@@ -177,6 +178,7 @@ static ReplayConfig loadReplayConfigImpl(const std::string& path) {
     if (r["horizontal_m"]) c.reference_sigma_h_m = nonneg(r["horizontal_m"], "reference_sigma.horizontal_m");
     if (r["vertical_m"]) c.reference_sigma_v_m = nonneg(r["vertical_m"], "reference_sigma.vertical_m");
   }
+  if (root["reference_lever_arm_B_m"]) c.reference_lever_arm_B = vec3(root["reference_lever_arm_B_m"], "reference_lever_arm_B_m");
   if (const auto a = root["alignment"]) {
     subKeys(a, "alignment", {"yaw_deg", "yaw_sigma_deg", "max_align_s", "max_course_sigma_deg", "min_static_s",
                              "max_level_s", "sideslip_sigma_deg"});
@@ -414,8 +416,10 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   if (hasTruth && !startFromRef)
     r.notices.push_back(std::string("the reference ") +
                         (fullRef ? "has no entry at the start of the IMU data"
-                                 : std::string("has no ") + (refInfo.has_velocity ? "" : "velocity ") +
-                                       (refInfo.has_attitude ? "" : "attitude ")) +
+                                 : std::string("has no ") +
+                                       (!refInfo.has_velocity && !refInfo.has_attitude ? "velocity and attitude"
+                                        : refInfo.has_velocity                         ? "attitude"
+                                                                                       : "velocity")) +
                         ": the filter starts after an aligning phase and is scored on what the reference has");
 
   NavRunInput in;
@@ -431,6 +435,7 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   const double ph = cfg.p0_pos_h_m, pv = cfg.p0_pos_v_m, vv = cfg.p0_vel_mps;
   const double rp = cfg.p0_roll_pitch_deg * kDeg, yw = cfg.p0_yaw_deg * kDeg;
   opt.P0_nav.diagonal() << ph * ph, ph * ph, pv * pv, vv * vv, vv * vv, vv * vv, rp * rp, rp * rp, yw * yw;
+  opt.reference_lever_B = cfg.reference_lever_arm_B;
   opt.zupt = cfg.aids.zupt;
   opt.zupt_detector = cfg.alignment.detector;
   opt.zupt_sigma_mps = cfg.aids.zupt_sigma_mps;

@@ -83,6 +83,10 @@ struct NavRunOptions {
   Eigen::Vector3d lever_arm_B = Eigen::Vector3d::Zero();   ///< GNSS antenna in body FRD [m]
   bool baro_in_outage = true;                   ///< keep baro updates during GNSS outages
   bool use_gnss_velocity = true;                ///< apply GNSS velocity besides position
+  /// The point the truth / reference positions refer to, body FRD from the IMU [m]
+  /// (e.g. a reference that is the GNSS antenna track): position errors are
+  /// (estimate + C_BtoN_est l) - reference.
+  Eigen::Vector3d reference_lever_B = Eigen::Vector3d::Zero();
   /// Record interval without truth [s], > 0: epochs at the IMU samples nearest
   /// x0.t + k * record_interval_s (ignored when NavRunInput::truth is given).
   double record_interval_s = 0.1;

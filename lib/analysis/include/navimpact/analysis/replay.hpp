@@ -34,6 +34,7 @@
  *
  * outages_every: {period_s: 120, duration_s: 30}  # or --outages-every 120:30
  * reference_sigma: {horizontal_m: 0.05, vertical_m: 0.1}   # the reference's own 1-sigma
+ * reference_lever_arm_B_m: [0, 0, 0]        # the reference's point (e.g. the antenna) from the IMU
  * alignment: {yaw_deg: 40, yaw_sigma_deg: 2, max_align_s: 600, max_course_sigma_deg: 3}
  * imu_at_rest: {gyro_sigma_rad_s: 1e-3, acc_sigma_mps2: 1e-2, window_s: 0.5, false_alarm: 0.01}
  * aids: {zupt: {sigma_mps: 0.02, interval_s: 0.1},
@@ -90,6 +91,7 @@ struct ReplayConfig {
   std::optional<OutagePattern> outages_every;   ///< more outages all along the run (after the explicit ones)
   double reference_sigma_h_m = 0.0;             ///< the reference's own 1-sigma per horizontal axis [m]
   double reference_sigma_v_m = 0.0;             ///< its vertical 1-sigma [m]
+  Eigen::Vector3d reference_lever_arm_B = Eigen::Vector3d::Zero();  ///< the reference's point from the IMU, body FRD [m]
   filter::AlignmentOptions alignment;           ///< the aligning phase without GT (lever arm and yaw set by the replay)
   NavRunOptions aids;                           ///< only its zupt* / nhc* fields are used (ground-vehicle aids)
 };
