@@ -467,7 +467,7 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
         while (!al.done() && ig < d.gnss.size() && d.gnss[ig].t <= imu[k].t + 1e-9) {
           const GnssFix& f = d.gnss[ig++];
           bool out = false;
-          for (const auto& o : opt.outages) out = out || (f.t > o.start && f.t <= o.end);
+          for (const auto& o : opt.outages) out = out || o.covers(f.t);
           if (out) continue;
           filter::AlignmentFix af;
           af.t = f.t;

@@ -67,7 +67,7 @@ RunScore scoreRun(const NavRunResult& run, double t_zero, double aided_from, con
                               ref.sigma_v_m * ref.sigma_v_m);
   auto inOutage = [&](double t) {
     for (const auto& o : run.outages)
-      if (t > o.window.start && t <= o.window.end + 1e-9) return true;
+      if (t > o.window.start_s && t <= o.window.end_s + 1e-9) return true;
     return false;
   };
 
@@ -103,8 +103,8 @@ RunScore scoreRun(const NavRunResult& run, double t_zero, double aided_from, con
     }
     const NavEpoch& e = run.epochs.at(static_cast<std::size_t>(o.end_epoch));
     OutageScore q;
-    q.start_s = o.window.start - t_zero;
-    q.duration_s = o.window.end - o.window.start;
+    q.start_s = o.window.start_s - t_zero;
+    q.duration_s = o.window.end_s - o.window.start_s;
     q.end_s = e.t - t_zero;
     q.err_N = e.err.head<3>();
     q.sigma_N = e.P_pos.diagonal().cwiseMax(0.0).cwiseSqrt();
@@ -113,7 +113,7 @@ RunScore scoreRun(const NavRunResult& run, double t_zero, double aided_from, con
     q.horizontal_sigma_m = std::sqrt(std::max(0.0, e.P_pos(0, 0) + e.P_pos(1, 1)));
     q.vertical_sigma_m = q.sigma_N[2];
     for (const NavEpoch& k : run.epochs) {
-      if (k.t <= o.window.start || k.t > o.window.end + 1e-9) continue;
+      if (k.t <= o.window.start_s || k.t > o.window.end_s + 1e-9) continue;
       q.max_drift_h_m = std::max(q.max_drift_h_m, k.err.head<2>().norm());
       q.max_drift_v_m = std::max(q.max_drift_v_m, std::abs(k.err[2]));
     }
