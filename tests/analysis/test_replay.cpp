@@ -165,7 +165,7 @@ TEST(Replay, OutagesEveryAreScoredAgainstTheReference) {
   ASSERT_EQ(r.cfg.outages.size(), 4u);
   for (std::size_t k = 0; k < 4; ++k) {
     EXPECT_NEAR(r.cfg.outages[k].start_s, 10.0 + 15.0 * k, 1e-9);
-    EXPECT_NEAR(r.cfg.outages[k].duration_s, 5.0, 1e-9);
+    EXPECT_NEAR(r.cfg.outages[k].duration_s(), 5.0, 1e-9);
   }
   ASSERT_TRUE(r.score.has_value());
   const auto& sc = *r.score;

@@ -78,7 +78,7 @@ void writeTrajectoryFigure(const ReplayResult& r, OutputSet& out) {
     plot::Series s{i == 0 ? "estimate in a GNSS outage" : "", {}, {}, plot::palette(1), plot::LineStyle::Solid,
                    plot::Marker::None, 2.4};
     for (const auto& e : ep)
-      if (e.t > w.window.start && e.t <= w.window.end + 1e-9) {
+      if (e.t > w.window.start_s && e.t <= w.window.end_s + 1e-9) {
         const Eigen::Vector3d p = ne(e.est);
         s.x.push_back(p.y());
         s.y.push_back(p.x());
@@ -307,7 +307,7 @@ std::string summaryJson(const ReplayResult& r) {
     if (r.score) {  // the scored outage (reference sigma counted in the NEES)
       for (const auto& q : r.score->outages)
         if (std::abs(q.start_s - r.cfg.outages[i].start_s) < 1e-9 &&
-            std::abs(q.duration_s - r.cfg.outages[i].duration_s) < 1e-6) {
+            std::abs(q.duration_s - r.cfg.outages[i].duration_s()) < 1e-6) {
           jo["end_s"] = q.end_s;
           jo["horizontal_error_m"] = q.horizontal_error_m;
           jo["vertical_error_m"] = q.vertical_error_m;
