@@ -164,7 +164,24 @@ TEST(AllocationLimit, RefusesOneLargeRequestOnItsThreadOnly) {
       EXPECT_THROW(std::vector<char>(2048), std::bad_alloc);
     }
     EXPECT_NO_THROW(std::vector<char>(2048));  // back to the outer limit
+    {
+      AllocationLimit looser(1 << 30);  // a nested limit never loosens the one in force
+      EXPECT_EQ(AllocationLimit::current(), std::size_t(1) << 20);
+      EXPECT_THROW(std::vector<char>(std::size_t(2) << 20), std::bad_alloc);
+    }
   }
   EXPECT_EQ(AllocationLimit::current(), 0u);
   EXPECT_NO_THROW(std::vector<char>(std::size_t(8) << 20));
+}
+
+// The gzip trailer's ISIZE is the file's claim, not a fact: a claim above the
+// deflate bound of 1032:1 (RFC 1951) is cut to that bound, a true one is kept.
+TEST(GzInput, StatedSizeIsBoundedByTheDeflateRatio) {
+  const std::string text = randomText(4096, 77);
+  std::string z = gz(text);
+  const auto honest = write("honest.gz", z);
+  EXPECT_EQ(GzInput(honest).statedSize(), text.size());
+  for (int k = 1; k <= 4; ++k) z[z.size() - k] = static_cast<char>(0xff);  // ISIZE = 4 GiB - 1
+  const auto liar = write("liar.gz", z);
+  EXPECT_EQ(GzInput(liar).statedSize(), std::uint64_t(1032) * z.size());
 }

@@ -41,7 +41,10 @@ void* allocateAligned(std::size_t n, std::size_t align) {
 }
 }  // namespace
 
-AllocationLimit::AllocationLimit(std::size_t max_bytes) : previous_(t_limit) { t_limit = max_bytes; }
+AllocationLimit::AllocationLimit(std::size_t max_bytes) : previous_(t_limit) {
+  // nested limits: the tighter one holds (0 = none)
+  t_limit = (previous_ != 0 && (max_bytes == 0 || previous_ < max_bytes)) ? previous_ : max_bytes;
+}
 AllocationLimit::~AllocationLimit() { t_limit = previous_; }
 
 std::size_t AllocationLimit::takeRefused() {

@@ -42,7 +42,8 @@ GzInput::GzInput(std::string path) : path_(std::move(path)), z_(std::make_unique
       unsigned char t[4];
       if (::pread(fileno(f_), t, 4, static_cast<off_t>(fileSize_ - 4)) == 4) {
         const std::uint64_t isize = t[0] | (t[1] << 8) | (t[2] << 16) | (std::uint64_t(t[3]) << 24);
-        statedSize_ = std::max(isize, fileSize_);
+        // deflate expands at most 1032:1, so a larger claim is a lie of the file (RFC 1951)
+        statedSize_ = std::max(std::min(isize, std::uint64_t(1032) * fileSize_), fileSize_);
       }
     }
     if (inflateInit2(&z_->s, 15 + 16) != Z_OK) throw Error(path_ + ": cannot start gzip decompression");
