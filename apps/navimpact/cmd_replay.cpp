@@ -1,7 +1,10 @@
 // navimpact replay: run the EKF over a rawlog (IMU, GNSS, BARO, GT) with GNSS outages injected.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "navimpact/analysis/replay.hpp"
@@ -66,7 +69,18 @@ navimpact::cli::Registrar reg({
         navimpact::report::writeReplayOutputs(r, out);
         out.commit();
         std::fputs(navimpact::report::replaySummary(r).c_str(), stdout);
-        std::printf("wrote %s/{solution.csv, summary.json, trajectory.png, errors_*.png}\n", o->out.c_str());
+        // what the folder holds now (the per-outage figures counted, not listed)
+        std::vector<std::string> names;
+        std::size_t per_outage = 0;
+        for (const auto& e : std::filesystem::directory_iterator(o->out)) {
+          const std::string n = e.path().filename().string();
+          if (n.rfind("errors_outage_", 0) == 0) ++per_outage; else names.push_back(n);
+        }
+        std::sort(names.begin(), names.end());
+        if (per_outage) names.push_back("errors_outage_*.png (" + std::to_string(per_outage) + ")");
+        std::string list;
+        for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+        std::printf("wrote %s/{%s}\n", o->out.c_str(), list.c_str());
         return 0;
       };
     }});
