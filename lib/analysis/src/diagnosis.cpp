@@ -10,6 +10,7 @@
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
@@ -17,6 +18,7 @@
 #include "diagnosis_internal.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/golden_section.hpp"
 #include "navimpact/detect/change_points.hpp"
 #include "navimpact/detect/lines.hpp"
 #include "navimpact/detect/null_model.hpp"
@@ -236,24 +238,7 @@ double bestScale(const WvData& d, const std::vector<double>& base, const std::ve
   }
   double a = l0 + (l1 - l0) * std::max(0, gi - 1) / G;
   double b = l0 + (l1 - l0) * std::min(G, gi + 1) / G;
-  const double r = 0.5 * (std::sqrt(5.0) - 1.0);
-  double c = b - r * (b - a), e = a + r * (b - a);
-  double fc = dev(c), fe = dev(e);
-  for (int it = 0; it < 40; ++it) {
-    if (fc < fe) {
-      b = e;
-      e = c;
-      fe = fc;
-      c = b - r * (b - a);
-      fc = dev(c);
-    } else {
-      a = c;
-      c = e;
-      fc = fe;
-      e = a + r * (b - a);
-      fe = dev(e);
-    }
-  }
+  std::tie(a, b) = goldenSectionBracket(dev, a, b, 40);
   double la = 0.5 * (a + b), best = dev(la);
   if (gbest < best) {
     la = l0 + (l1 - l0) * gi / G;

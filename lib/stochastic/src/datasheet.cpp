@@ -5,9 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "kind.hpp"
+#include "navimpact/core/golden_section.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
 namespace navimpact::stochastic {
@@ -91,23 +93,7 @@ DatasheetFigures datasheetFigures(const Model& m, double max_averaging_s) {
   }
   // Golden-section refinement of the minimum between the grid neighbours.
   double a = lm[std::max(pick - 1, 0)], b = lm[std::min(pick + 1, n_pts - 1)];
-  const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
-  double c = b - gr * (b - a), d = a + gr * (b - a), fc = adevAt(c), fd = adevAt(d);
-  for (int it = 0; it < 60 && b - a > 1e-12; ++it) {
-    if (fc < fd) {
-      b = d;
-      d = c;
-      fd = fc;
-      c = b - gr * (b - a);
-      fc = adevAt(c);
-    } else {
-      a = c;
-      c = d;
-      fc = fd;
-      d = a + gr * (b - a);
-      fd = adevAt(d);
-    }
-  }
+  std::tie(a, b) = goldenSectionBracket(adevAt, a, b, 60, 1e-12);
   double x = 0.5 * (a + b), v = adevAt(x);
   if (adev[pick] < v) x = lm[pick], v = adev[pick];
   f.bias_instability = v / 0.664;
