@@ -31,6 +31,16 @@ struct Prepared {
   Recording d;
   an::TruthSeries truth;
   ins::NavState x0;
+  /// runNav's input pointing into this (which must outlive it).
+  an::NavRunInput input() const {
+    an::NavRunInput in;
+    in.x0 = x0;
+    in.imu = &imu;
+    in.gnss = &d.gnss;
+    in.baro = &d.baro;
+    in.truth = &truth;
+    return in;
+  }
 };
 
 Prepared prepare(const std::string& path) {
@@ -82,12 +92,7 @@ static void BM_ReplayFilter(benchmark::State& st) {
   const Prepared p = prepare(path);
   const stochastic::ImuModel m =
       stochastic::loadImuModel(std::string(NAVIMPACT_SOURCE_DIR) + "/config/models/navchip_table1.yaml:ref");
-  an::NavRunInput in;
-  in.x0 = p.x0;
-  in.imu = &p.imu;
-  in.gnss = &p.d.gnss;
-  in.baro = &p.d.baro;
-  in.truth = &p.truth;
+  const an::NavRunInput in = p.input();
   an::NavRunOptions opt;
   opt.ekf.propagate_every = static_cast<int>(st.range(0));
   opt.outages = {{p.x0.t + 200.0, p.x0.t + 260.0}};
@@ -116,12 +121,7 @@ static void BM_ReplayScored(benchmark::State& st) {
   const Prepared p = prepare(path);
   const stochastic::ImuModel m =
       stochastic::loadImuModel(std::string(NAVIMPACT_SOURCE_DIR) + "/config/models/navchip_table1.yaml:ref");
-  an::NavRunInput in;
-  in.x0 = p.x0;
-  in.imu = &p.imu;
-  in.gnss = &p.d.gnss;
-  in.baro = &p.d.baro;
-  in.truth = &p.truth;
+  const an::NavRunInput in = p.input();
   an::NavRunOptions opt;
   opt.ekf.propagate_every = 10;
   for (const auto& w : an::outagesEvery({60.0, 20.0}, p.x0.t, p.imu.back().t)) opt.outages.push_back({w.first, w.second});
