@@ -12,7 +12,13 @@
  *  - lever-arm components [-100, 100] m;
  *  - durations (0, 7 days];
  *  - IMU error states per axis at most 32 (a model has a handful);
- *  - Monte Carlo runs of a study at most 10^6.
+ *  - Monte Carlo runs of a study at most 10^6;
+ *  - sensor effects of an emulation and the extra filter states that model
+ *    them (emulation::SensorEffects): scale factors [-0.05, 0.05] (ratio,
+ *    +-50 000 ppm), misalignment and non-orthogonality angles [-0.05, 0.05] rad,
+ *    IMU-GNSS time offset [-1, 1] s, lever-arm error components [-10, 10] m,
+ *    in-motion white-noise factor [1, 100], motion thresholds
+ *    [1e-3, 10] rad/s and [0.05, 100] m/s^2.
  * README ("Ranges and budgets") lists them with the budgets.
  */
 #pragma once
@@ -35,6 +41,18 @@ inline constexpr Range kPositionSigmaM{0.0, 1.0e4, true, "m"};
 inline constexpr Range kVelocitySigmaMps{0.0, 1.0e3, true, "m/s"};
 inline constexpr Range kLeverArmM{-100.0, 100.0, false, "m"};
 inline constexpr Range kDurationS{0.0, 7.0 * 86400.0, true, "s"};
+
+// Sensor effects (emulation::SensorEffects) and the prior sigmas of the filter
+// states that estimate them. Scale factors and small angles are first-order
+// effects: beyond a few percent the linear models of emulation and filter
+// stop agreeing to second order, so the ranges stop there.
+inline constexpr Range kScaleFactor{-0.05, 0.05, false, "(ratio)"};
+inline constexpr Range kMisalignmentRad{-0.05, 0.05, false, "rad"};
+inline constexpr Range kTimeOffsetS{-1.0, 1.0, false, "s"};
+inline constexpr Range kLeverArmErrorM{-10.0, 10.0, false, "m"};
+inline constexpr Range kMotionNoiseFactor{1.0, 100.0, false, "(factor)"};
+inline constexpr Range kMotionRateThresholdRadS{1.0e-3, 10.0, false, "rad/s"};
+inline constexpr Range kMotionAccThresholdMps2{0.05, 100.0, false, "m/s^2"};
 
 /// Most Monte Carlo runs of one study (monte_carlo.runs).
 inline constexpr long long kMaxMonteCarloRuns = 1000000;
