@@ -6,6 +6,8 @@
 //                      --model FILE[:NAME] | fit:SPEC | fit:auto [--robust [--eff E]]  --out DIR
 //                      [--trajectory FILE --outage START:DURATION ... [--nav-runs R]]
 //                      [--simulations N] [--seed S] [--alpha A] [--threads N]
+//   navimpact diagnose --run RUN.rawlog --model FILE[:NAME] [--config REPLAY.yaml] [--static STATIC.csv ...]
+//                      [--durations 10,30,60] [--reconverge S] [--realisations N] --out DIR
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -17,10 +19,12 @@
 #include "cli_common.hpp"
 #include "input.hpp"
 #include "navimpact/analysis/diagnosis.hpp"
+#include "navimpact/analysis/run_diagnosis.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/gmwm/channels.hpp"
 #include "navimpact/report/diagnosis_report.hpp"
+#include "navimpact/report/run_diagnosis_report.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 
 namespace {
@@ -43,7 +47,52 @@ struct Opts {
   bool overwrite = false;
   bool robust = false;  ///< fit:SPEC: robust GMWM
   double eff = 0.6;
+  // --run: a real run (rawlog with a reference) instead of a static recording
+  std::string run_rawlog, replay_config, static_file, static_gyro_unit, static_acc_unit, static_axes;
+  double static_rate = 0.0;
+  std::vector<double> durations{10.0, 30.0, 60.0};
+  double reconverge = 30.0;
+  int realisations = 50;
 };
+
+/// `diagnose --run`: predicted against measured outage errors of a real run.
+int runOnRun(const Opts& o) {
+  na::RunDiagnosisOptions ro;
+  if (!o.replay_config.empty()) ro.replay = na::loadReplayConfig(o.replay_config);
+  ro.replay.rawlog = o.run_rawlog;
+  ro.replay.model_spec = o.model;
+  ro.durations_s = o.durations;
+  ro.reconverge_s = o.reconverge;
+  ro.realisations = o.realisations;
+  ro.seed = o.seed;
+  ro.alpha = o.alpha;
+  ro.threads = o.threads;
+  if (!o.static_file.empty()) {
+    ro.static_file = o.static_file;
+    if (o.static_rate > 0) ro.static_csv.rate_hz = o.static_rate;
+    ro.static_csv.gyro_unit = o.static_gyro_unit;
+    ro.static_csv.acc_unit = o.static_acc_unit;
+    ro.static_csv.axes = o.static_axes;
+  }
+  if (o.model.rfind("fit:", 0) == 0) throw navimpact::Error("--run needs --model FILE[:NAME] (fit: applies to --input)");
+  st::loadImuModel(o.model);  // model problems before the long work
+  navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
+  navimpact::cli::Progress bar("diagnose --run", 1000);
+  ro.progress = [&bar](double f, const std::string&) { bar.update(static_cast<std::size_t>(f * 1000)); };
+  const na::RunDiagnosis d = na::diagnoseRun(ro);
+  bar.finish();
+  nlohmann::json in = {{"run", o.run_rawlog},       {"model", o.model},         {"config", o.replay_config},
+                       {"static", o.static_file},   {"durations_s", o.durations}, {"reconverge_s", o.reconverge},
+                       {"realisations", o.realisations}, {"seed", o.seed},     {"alpha", o.alpha}};
+  const std::size_t figs = navimpact::report::writeRunDiagnosisOutputs(
+      d, in.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), out);
+  out.commit();
+  for (const auto& n : d.notices) std::cerr << "navimpact: notice: " << n << "\n";
+  std::cout << navimpact::report::runDiagnosisSummary(d);
+  std::cout << "wrote " << (std::filesystem::path(o.out) / "run_diagnosis.json").string() << ", report.md and "
+            << figs << " figure(s)\n";
+  return 0;
+}
 
 /// `fit:SPEC`: the options of fitting SPEC to every channel of the data first (GMWM).
 navimpact::gmwm::RecordingFitOptions fitOptions(const std::string& spec, const Opts& o) {
@@ -69,6 +118,8 @@ std::vector<navimpact::Outage> checkOutages(const Opts& o) {
 }
 
 int run(const Opts& o) {
+  if (!o.run_rawlog.empty()) return runOnRun(o);
+  if (o.in.input.empty()) throw navimpact::Error("diagnose needs --input STATIC (a static recording) or --run RUN.rawlog");
   if (o.simulations < 0 || o.simulations == 1)
     throw navimpact::Error("--simulations must be 0 or >= 2");
   if (!(o.alpha > 0 && o.alpha < 0.5)) throw navimpact::Error("--alpha must be in (0, 0.5)");
@@ -159,6 +210,27 @@ navimpact::cli::Registrar reg(
      [](CLI::App& app) {
        auto o = std::make_shared<Opts>();
        navimpact::cli::addInputOptions(app, o->in);
+       app.get_option("--input")->required(false);
+       auto* runOpt = app.add_option("--run", o->run_rawlog,
+                                     "a real run: rawlog with IMU, GNSS and a reference (GT), e.g. from navimpact "
+                                     "import; predicted against measured GNSS-outage errors")
+                          ->excludes("--input");
+       app.add_option("--config", o->replay_config,
+                      "--run: replay configuration (filter, noise, aids, alignment; as navimpact replay --config)")
+           ->needs(runOpt);
+       app.add_option("--static", o->static_file,
+                      "--run: simulate with windows of this static recording (CSV) instead of the model's errors")
+           ->needs(runOpt);
+       app.add_option("--static-rate", o->static_rate, "--static: sampling rate [Hz] of a CSV without time column");
+       app.add_option("--static-gyro-unit", o->static_gyro_unit, "--static: gyroscope unit");
+       app.add_option("--static-acc-unit", o->static_acc_unit, "--static: accelerometer unit");
+       app.add_option("--static-axes", o->static_axes, "--static: sensor-to-body FRD axes");
+       app.add_option("--durations", o->durations, "--run: outage durations [s], comma separated")
+           ->delimiter(',')
+           ->capture_default_str();
+       app.add_option("--reconverge", o->reconverge, "--run: GNSS time before each outage [s]")->capture_default_str();
+       app.add_option("--realisations", o->realisations, "--run: simulated realisations (seeded by --seed)")
+           ->capture_default_str();
        app.add_option("--model", o->model,
                       "model simulated today: FILE[:NAME], or fit:SPEC (e.g. fit:WN+GM) to fit "
                       "that structure to the data first, or fit:auto (the structure chosen by the WIC "

@@ -92,3 +92,24 @@ navimpact_cli_check(cli_diagnose_fit_auto CHECK run_json
 navimpact_cli_fail(cli_diagnose_robust_needs_fit EXIT 1 NOOUT ${_dg_out}/bad_robust
   ARGS ${_dg_short_args} --robust --out ${_dg_out}/bad_robust
   REGEX "^navimpact: --robust applies to --model fit:SPEC")
+
+# diagnose --run: a run with a reference (the committed emulated UAV rawlog)
+# against the simulation with its own model; outputs and contract keys.
+set(_dg_model ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref)
+navimpact_cli_check(cli_diagnose_run CHECK run_json
+  ARGS diagnose --run ${_dg_rawlog} --model ${_dg_model} --durations 20,40 --reconverge 30 --realisations 4
+       --out ${_dg_out}/run
+  DEFINES OUT=${_dg_out}/run JSON_FILE=run_diagnosis.json
+  JSON "verdict=^(adequate|inadequate)$" "comparisons/0/quantity=^horizontal_position$" "comparisons/0/duration_s=^20"
+       "comparisons/0/ratio_interval/1=^[0-9]" "durations/1/duration_s=^40" "simulation/realisations=^4$"
+       "gain/significant=^(false|OFF)$"
+  FILES report.md predicted_vs_measured.png)
+navimpact_cli_fail(cli_diagnose_run_fit_model EXIT 1 NOOUT ${_dg_out}/bad11
+  ARGS diagnose --run ${_dg_rawlog} --model fit:WN --out ${_dg_out}/bad11
+  REGEX "^navimpact: --run needs --model FILE")
+navimpact_cli_fail(cli_diagnose_run_too_long EXIT 1 NOOUT ${_dg_out}/bad12
+  ARGS diagnose --run ${_dg_rawlog} --model ${_dg_model} --durations 400 --out ${_dg_out}/bad12
+  REGEX "^navimpact: .*no outage of 400 s")
+navimpact_cli_fail(cli_diagnose_neither_input_nor_run EXIT 1 NOOUT ${_dg_out}/bad13
+  ARGS diagnose --model ${_dg_model} --out ${_dg_out}/bad13
+  REGEX "^navimpact: diagnose needs --input")

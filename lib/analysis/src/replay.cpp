@@ -383,7 +383,7 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   // reference without velocity or attitude is scored on what it has (the
   // missing parts NaN); the filter starts from it only when it is complete
   // and has an entry at time zero, else after an aligning phase.
-  const bool hasTruth = !d.reference.empty();
+  const bool hasTruth = cfg.use_reference && !d.reference.empty();
   TruthSeries truth;
   bool fullRef = true;
   ReferenceInfo refInfo;
@@ -511,6 +511,9 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
                           formatNumber(cfg.outages_every->duration_s, 10) + " s: none fits in the data after the filter start");
   }
   r.run = runNav(in, model, opt);
+  r.nav = opt;
+  r.gnss = *in.gnss;
+  r.baro = d.baro;
   if (hasTruth) r.score = scoreRun(r.run, r.t_zero, in.x0.t, refInfo);
   std::size_t i = 0;
   for (const auto& e : r.run.epochs) {

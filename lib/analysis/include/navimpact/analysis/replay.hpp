@@ -94,6 +94,10 @@ struct ReplayConfig {
   Eigen::Vector3d reference_lever_arm_B = Eigen::Vector3d::Zero();  ///< the reference's point from the IMU, body FRD [m]
   filter::AlignmentOptions alignment;           ///< the aligning phase without GT (lever arm and yaw set by the replay)
   NavRunOptions aids;                           ///< only its zupt* / nhc* fields are used (ground-vehicle aids)
+  /// false: the rawlog's reference (GT) is ignored, as for a rawlog without
+  /// one (aligning phase, estimate recorded every record_interval_s); used to
+  /// get the GNSS-aided solution densely when the reference is sparse.
+  bool use_reference = true;
 };
 
 /// Read a replay configuration. @throws navimpact::Error naming file and key.
@@ -117,6 +121,9 @@ struct ReplayResult {
   std::optional<filter::AlignmentReport> alignment;
   double aided_from_s = 0.0;                ///< filter start, from time zero [s]
   std::optional<RunScore> score;            ///< scored against the reference (GT) when there is one
+  NavRunOptions nav;                        ///< the filter options the run used (outages, P0, lever arm, aids)
+  std::vector<GnssFix> gnss;                ///< the GNSS fixes given to the filter (covariances as applied)
+  std::vector<BaroSample> baro;             ///< the barometer samples given to the filter
 };
 
 /**

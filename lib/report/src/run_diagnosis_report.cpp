@@ -1,0 +1,210 @@
+// Outputs of navimpact diagnose --run: run_diagnosis.json, report.md, figure.
+#include "navimpact/report/run_diagnosis_report.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "navimpact/core/format.hpp"
+#include "navimpact/plot/figure.hpp"
+
+namespace navimpact::report {
+
+using analysis::RunDiagnosis;
+
+namespace {
+
+nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+std::string r3(double x) { return formatReadable(x, 3); }
+
+}  // namespace
+
+std::string runDiagnosisJson(const RunDiagnosis& d, const std::string& input_json) {
+  nlohmann::json j;
+  j["input"] = nlohmann::json::parse(input_json);
+  j["verdict"] = d.verdict;
+  j["verdict_test"] = {
+      {"family_false_alarm_rate", d.alpha},
+      {"tests", d.tests},
+      {"level_per_test", d.test_level},
+      {"method",
+       "Bonferroni over two-sided F tests of measured against simulated mean squared outage-end errors "
+       "(dof = components x outages) and chi-square bands of the measured mean position NEES"},
+      {"reasons", d.reasons}};
+  j["findings"] = nlohmann::json::array();
+  // The extension and its held-out gain come with the cause analysis; none yet.
+  j["gain"] = {{"outage_error_before_m", nullptr},
+               {"outage_error_after_m", nullptr},
+               {"anees_before", nullptr},
+               {"anees_after", nullptr},
+               {"significant", false},
+               {"note", "no cause fitted: no extension to compare"}};
+  j["run"] = {{"rawlog", d.rawlog},
+              {"model", d.model_source},
+              {"imu_rate_hz", d.imu_rate_hz},
+              {"aided_from_s", d.aided_from_s},
+              {"end_s", d.run_end_s},
+              {"reference_sigma_h_m", d.reference.sigma_h_m},
+              {"reference_sigma_v_m", d.reference.sigma_v_m},
+              {"reference_has_velocity", d.reference.has_velocity},
+              {"reference_has_attitude", d.reference.has_attitude}};
+  j["simulation"] = {{"errors", d.errors_source},
+                     {"trajectory", d.trajectory_source},
+                     {"realisations", d.realisations},
+                     {"seed", d.seed},
+                     {"reconverge_s", d.reconverge_s}};
+  nlohmann::json durs = nlohmann::json::array();
+  for (const auto& dd : d.durations) {
+    nlohmann::json o = nlohmann::json::array();
+    for (const auto& s : dd.measured)
+      o.push_back({{"start_s", s.start_s},
+                   {"end_s", s.end_s},
+                   {"horizontal_error_m", s.horizontal_error_m},
+                   {"vertical_error_m", s.vertical_error_m},
+                   {"horizontal_sigma_m", s.horizontal_sigma_m},
+                   {"vertical_sigma_m", s.vertical_sigma_m},
+                   {"nees", num(s.nees)}});
+    durs.push_back({{"duration_s", dd.duration_s},
+                    {"period_s", dd.period_s},
+                    {"measured_outages", dd.measured.size()},
+                    {"simulated_outages", dd.simulated_outages},
+                    {"measured_anees", num(dd.anees)},
+                    {"anees_band", {num(dd.anees_lo), num(dd.anees_hi)}},
+                    {"anees_outside_band", dd.anees_rejects},
+                    {"predicted_anees", num(dd.predicted_anees)},
+                    {"coverage", dd.distribution.coverage},
+                    {"coverage_expected", dd.distribution.coverage_expected},
+                    {"outages", o}});
+  }
+  j["durations"] = durs;
+  nlohmann::json cmp = nlohmann::json::array();
+  for (const auto& c : d.comparisons)
+    cmp.push_back({{"quantity", c.quantity},
+                   {"unit", c.unit},
+                   {"duration_s", c.duration_s},
+                   {"measured_count", c.measured.size()},
+                   {"predicted_count", c.predicted.size()},
+                   {"measured_rms", num(c.measured_rms)},
+                   {"predicted_rms", num(c.predicted_rms)},
+                   {"predicted_p05", num(c.predicted_p05)},
+                   {"predicted_p50", num(c.predicted_p50)},
+                   {"predicted_p95", num(c.predicted_p95)},
+                   {"ratio", num(c.ratio)},
+                   {"ratio_interval", {num(c.ratio_lo), num(c.ratio_hi)}},
+                   {"interval_method", "F distribution, level " + formatNumber(1.0 - d.test_level, 6)},
+                   {"p_value", num(c.p_value)},
+                   {"rejects", c.rejects}});
+  j["comparisons"] = cmp;
+  j["notices"] = d.notices;
+  j["timing"] = {{"wall_s", d.wall_s}};
+  return j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+std::string runDiagnosisMarkdown(const RunDiagnosis& d) {
+  std::ostringstream s;
+  s << "# Run diagnosis: " << d.rawlog << "\n\n";
+  s << "Model: " << d.model_source << ". Simulation: " << d.realisations << " realisations (seed " << d.seed
+    << "), IMU errors " << d.errors_source << "; trajectory: " << d.trajectory_source << ".\n\n";
+  s << "**Verdict: " << d.verdict << "** (" << d.tests << " tests, each at level " << formatReadable(d.test_level, 3)
+    << ", family-wise false-alarm rate at most " << formatNumber(d.alpha) << ").\n\n";
+  for (const auto& r : d.reasons) s << "- " << r << "\n";
+  if (!d.reasons.empty()) s << "\n";
+  s << "## Measured against predicted at the outage ends\n\n";
+  s << "Ratio = measured RMS / predicted RMS; interval from the F distribution at level "
+    << formatNumber(1.0 - d.test_level, 4)
+    << " (counts: error components x outages; outages of one run counted as independent, which they are not "
+       "entirely).\n\n";
+  s << "| duration [s] | quantity | measured outages | measured RMS | predicted RMS | predicted 5-95 % | ratio | "
+       "interval | p |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& c : d.comparisons)
+    s << "| " << formatNumber(c.duration_s) << " | " << c.quantity << " | " << c.measured.size() << " | "
+      << r3(c.measured_rms) << " " << c.unit << " | " << r3(c.predicted_rms) << " " << c.unit << " | "
+      << r3(c.predicted_p05) << " - " << r3(c.predicted_p95) << " | " << r3(c.ratio) << " | [" << r3(c.ratio_lo)
+      << ", " << r3(c.ratio_hi) << "] | " << formatReadable(c.p_value, 2) << (c.rejects ? " (rejects)" : "")
+      << " |\n";
+  s << "\n## Measured NEES and coverage (the filter's own sigma)\n\n";
+  s << "| duration [s] | outages | mean position NEES | band | simulated mean NEES | coverage 1/2/3 sigma |\n"
+       "|---|---|---|---|---|---|\n";
+  for (const auto& dd : d.durations)
+    s << "| " << formatNumber(dd.duration_s) << " | " << dd.measured.size() << " | " << r3(dd.anees) << " | ["
+      << r3(dd.anees_lo) << ", " << r3(dd.anees_hi) << "]" << (dd.anees_rejects ? " outside" : "") << " | "
+      << r3(dd.predicted_anees) << " | " << formatFixed(100 * dd.distribution.coverage[0], 0) << " / "
+      << formatFixed(100 * dd.distribution.coverage[1], 0) << " / " << formatFixed(100 * dd.distribution.coverage[2], 0)
+      << " % (expected 68 / 95 / 99.7) |\n";
+  s << "\nFigure: predicted_vs_measured.png (simulated 5-95 % band and median, measured outages as points).\n";
+  s << "\n## Causes and the extension\n\nNo cause analysis in this report: no extension and no gain.\n";
+  if (!d.notices.empty()) {
+    s << "\n## Notices\n\n";
+    for (const auto& n : d.notices) s << "- " << n << "\n";
+  }
+  return s.str();
+}
+
+std::string runDiagnosisSummary(const RunDiagnosis& d) {
+  std::ostringstream s;
+  s << "run diagnosis of " << d.rawlog << " with " << d.model_source << ": " << d.verdict << " (" << d.tests
+    << " tests, family-wise false-alarm rate " << formatNumber(d.alpha) << ")\n";
+  for (const auto& c : d.comparisons)
+    s << "  " << formatNumber(c.duration_s) << " s " << c.quantity << ": measured/predicted RMS " << r3(c.ratio) << " ["
+      << r3(c.ratio_lo) << ", " << r3(c.ratio_hi) << "]" << (c.rejects ? " rejects" : "") << "\n";
+  for (const auto& dd : d.durations)
+    s << "  " << formatNumber(dd.duration_s) << " s mean NEES " << r3(dd.anees) << " band [" << r3(dd.anees_lo) << ", "
+      << r3(dd.anees_hi) << "]" << (dd.anees_rejects ? " outside" : "") << "\n";
+  s << "  " << formatFixed(d.wall_s, 1) << " s\n";
+  return s.str();
+}
+
+std::size_t writeRunDiagnosisOutputs(const RunDiagnosis& d, const std::string& input_json, OutputSet& out) {
+  out.writeText("run_diagnosis.json", runDiagnosisJson(d, input_json));
+  out.writeText("report.md", runDiagnosisMarkdown(d));
+  // One panel per (quantity, duration): x = measured outage index, the simulated
+  // 5-95 % band and median across, the measured end errors as points.
+  std::vector<std::string> qs;
+  for (const auto& c : d.comparisons)
+    if (std::find(qs.begin(), qs.end(), c.quantity) == qs.end()) qs.push_back(c.quantity);
+  const std::size_t D = d.durations.size();
+  plot::Figure fig;
+  fig.rows = static_cast<int>(qs.size());
+  fig.cols = static_cast<int>(D);
+  fig.width = std::max(700, 420 * fig.cols);
+  fig.height = std::max(500, 330 * fig.rows);
+  fig.title = "Outage-end error: simulation (" + std::to_string(d.realisations) + " realisations) vs measured";
+  for (const auto& q : qs)
+    for (const auto& dd : d.durations) {
+      plot::Axes ax;
+      const analysis::QuantityComparison* c = nullptr;
+      for (const auto& x : d.comparisons)
+        if (x.quantity == q && x.duration_s == dd.duration_s) c = &x;
+      ax.title = formatNumber(dd.duration_s) + " s, " + q;
+      ax.xlabel = "outage";
+      ax.ylabel = c ? "error [" + c->unit + "]" : "";
+      if (c) {
+        const double n = static_cast<double>(c->measured.size());
+        plot::Band b{"simulated 5-95 %", {0.5, n + 0.5}, {c->predicted_p05, c->predicted_p05},
+                     {c->predicted_p95, c->predicted_p95}, plot::palette(0), 0.25};
+        ax.bands.push_back(b);
+        ax.hlines.push_back({"simulated median", c->predicted_p50, plot::palette(0), plot::LineStyle::Dashed});
+        plot::Series m{"measured", {}, {}, plot::palette(1), plot::LineStyle::None, plot::Marker::FilledCircle, 2.0};
+        for (std::size_t k = 0; k < c->measured.size(); ++k) {
+          m.x.push_back(double(k + 1));
+          m.y.push_back(c->measured[k]);
+        }
+        ax.series.push_back(m);
+        ax.xlim = std::make_pair(0.5, n + 0.5);
+        double top = c->predicted_p95;
+        for (double v : c->measured) top = std::max(top, v);
+        ax.ylim = std::make_pair(0.0, top > 0 ? 1.1 * top : 1.0);
+      }
+      fig.axes.push_back(ax);
+    }
+  if (!fig.axes.empty()) {
+    plot::savePng(fig, out.stage("predicted_vs_measured.png").string());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace navimpact::report
