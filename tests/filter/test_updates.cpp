@@ -126,6 +126,54 @@ TEST(Updates, ChiSquareGateRejectsOutlierAndCounts) {
   EXPECT_TRUE(ekf2.updateGnssPosition(far, Vector3d(1, 1, 1)).accepted);
 }
 
+// Lock-out and re-admission (EkfConfig::gate_readmit_after, Simon 2006 §7.4).
+// Baro, P_DD = 1, sigma = 1, h_est = 100, the true height 110: dz = -10,
+// S = 2, NIS = 50 > g = chi2_1^-1(0.999) = 10.83 every time.
+//  readmit_after = 0: every fix rejected, the filter never moves (lock-out).
+//  readmit_after = 2: fixes 1 and 2 rejected; fix 3 applied with P scaled by
+//  lambda = 50 / g: P_DD = lambda, K = lambda / (lambda + 1),
+//  h = 100 + 10 K, P_DD' = lambda / (lambda + 1), P_NN' = lambda (uncorrelated);
+//  fix 4 then has NIS = (10 - 10 K)^2 / (P_DD' + 1) < g and is accepted.
+TEST(Updates, GateReadmitsAfterARunOfRejections) {
+  ins::NavState x = staticState();
+  x.h = 100.0;
+  filter::EkfConfig cfg;
+  cfg.gate_probability = 0.999;
+  const double g = 10.827566170662733;  // chi2_1 quantile at 0.999
+  cfg.gate_readmit_after = 0;
+  filter::ErrorStateEkf locked(x, diagP(1.0, 1.0, 1e-4), stochastic::ImuModel{}, cfg);
+  for (int k = 0; k < 10; ++k) EXPECT_FALSE(locked.updateBaro(110.0, 1.0).accepted);
+  EXPECT_EQ(locked.rejections(), 10);
+  EXPECT_EQ(locked.state().h, 100.0);
+
+  cfg.gate_readmit_after = 2;
+  filter::ErrorStateEkf ekf(x, diagP(1.0, 1.0, 1e-4), stochastic::ImuModel{}, cfg);
+  EXPECT_FALSE(ekf.updateBaro(110.0, 1.0).accepted);
+  EXPECT_FALSE(ekf.updateBaro(110.0, 1.0).accepted);
+  const filter::UpdateResult r = ekf.updateBaro(110.0, 1.0);
+  const double lambda = 50.0 / g, K = lambda / (lambda + 1.0);
+  EXPECT_TRUE(r.accepted);
+  EXPECT_TRUE(r.readmitted);
+  EXPECT_NEAR(r.nis, 50.0, 1e-9);
+  EXPECT_NEAR(r.gate, g, 1e-9);
+  EXPECT_NEAR(r.inflation, lambda, 1e-9);
+  EXPECT_NEAR(ekf.state().h, 100.0 + 10.0 * K, 1e-6);
+  EXPECT_NEAR(ekf.P()(2, 2), lambda / (lambda + 1.0), 1e-9);
+  EXPECT_NEAR(ekf.P()(0, 0), lambda, 1e-9);
+  EXPECT_EQ(ekf.rejections(), 2);
+  const filter::UpdateResult r4 = ekf.updateBaro(110.0, 1.0);
+  EXPECT_TRUE(r4.accepted);
+  EXPECT_FALSE(r4.readmitted);
+  EXPECT_NEAR(r4.nis, std::pow(10.0 - 10.0 * K, 2) / (lambda / (lambda + 1.0) + 1.0), 1e-6);
+  EXPECT_LT(r4.nis, g);
+  // an isolated outlier after an accepted fix starts a new count: rejected
+  EXPECT_FALSE(ekf.updateBaro(200.0, 1.0).accepted);
+  EXPECT_EQ(ekf.rejections(), 3);
+  // the range is checked
+  cfg.gate_readmit_after = -1;
+  EXPECT_THROW(filter::ErrorStateEkf(x, diagP(1.0, 1.0, 1e-4), stochastic::ImuModel{}, cfg), Error);
+}
+
 TEST(Updates, NanDataThrowsNamingTheTime) {
   ins::NavState x = staticState();
   filter::ErrorStateEkf ekf(x, diagP(1.0, 1.0, 1e-4), stochastic::ImuModel{});

@@ -66,7 +66,8 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
   while (it < truth.t.size() && truth.t[it] < in.x0.t - 0.5 * dt0) ++it;
 
   auto check = [&](const filter::UpdateResult& u, const char* kind) {
-    if (!u.accepted) res.rejected.push_back({u.t, kind, u.nis, u.gate});
+    if (!u.accepted) res.rejected.push_back({u.t, kind, u.nis, u.gate, 1.0});
+    if (u.readmitted) res.readmitted.push_back({u.t, kind, u.nis, u.gate, u.inflation});
     return u.accepted;
   };
   auto applyAiding = [&](double t_now, double half_dt) {

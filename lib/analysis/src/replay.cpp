@@ -101,7 +101,8 @@ static ReplayConfig loadReplayConfigImpl(const std::string& path) {
     }
   }
   if (const auto f = root["filter"]) {
-    subKeys(f, "filter", {"propagate_every", "use_gnss_velocity", "gate_probability", "max_imu_gap_s"});
+    subKeys(f, "filter", {"propagate_every", "use_gnss_velocity", "gate_probability", "gate_readmit_after",
+                           "max_imu_gap_s"});
     if (f["max_imu_gap_s"]) {
       c.max_imu_gap_s = limits::check(path, "filter.max_imu_gap_s", num(f["max_imu_gap_s"], "filter.max_imu_gap_s"),
                                       limits::Range{0.0, kMaxImuGapS, false, "s"});
@@ -112,6 +113,13 @@ static ReplayConfig loadReplayConfigImpl(const std::string& path) {
     }
     if (f["use_gnss_velocity"]) c.use_gnss_velocity = f["use_gnss_velocity"].as<bool>();
     if (f["gate_probability"]) c.gate_probability = num(f["gate_probability"], "filter.gate_probability");
+    if (f["gate_readmit_after"]) {
+      const double v = limits::check(path, "filter.gate_readmit_after",
+                                     num(f["gate_readmit_after"], "filter.gate_readmit_after"),
+                                     limits::Range{0.0, 1000.0, false, ""});
+      if (v != std::floor(v)) throw keyError(path, "filter.gate_readmit_after", "must be an integer in 0..1000");
+      c.gate_readmit_after = static_cast<int>(v);
+    }
   }
   if (const auto p = root["initial_sigma"]) {
     subKeys(p, "initial_sigma", {"pos_h_m", "pos_v_m", "vel_mps", "roll_pitch_deg", "yaw_deg"});
@@ -430,6 +438,7 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   opt.record_interval_s = cfg.record_interval_s;
   opt.ekf.propagate_every = cfg.propagate_every;
   opt.ekf.gate_probability = cfg.gate_probability;
+  opt.ekf.gate_readmit_after = cfg.gate_readmit_after;
   opt.use_gnss_velocity = cfg.use_gnss_velocity;
   opt.P0_nav.setZero();
   const double ph = cfg.p0_pos_h_m, pv = cfg.p0_pos_v_m, vv = cfg.p0_vel_mps;

@@ -103,6 +103,8 @@ ErrorStateEkf::ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
   if (!(cfg.gate_probability >= 0.0 && cfg.gate_probability < 1.0))
     throw Error("gate_probability must be in [0, 1) (0 = gate off), got " +
                 formatNumber(cfg.gate_probability, 9));
+  if (cfg.gate_readmit_after < 0 || cfg.gate_readmit_after > 1000)
+    throw Error("gate_readmit_after must be in 0..1000 (0 = never), got " + std::to_string(cfg.gate_readmit_after));
   if (!P0_nav.allFinite() || (P0_nav - P0_nav.transpose()).cwiseAbs().maxCoeff() >
                                  1e-12 * (1.0 + P0_nav.cwiseAbs().maxCoeff()) ||
       (P0_nav.diagonal().array() < 0.0).any())
@@ -612,12 +614,27 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
     const boost::math::chi_squared chi2(mz);
     res.gate = boost::math::quantile(chi2, cfg_.gate_probability);
     if (res.nis > res.gate) {
-      res.accepted = false;
-      ++rejections_;
-      last_ = res;
-      return res;
+      if (cfg_.gate_readmit_after == 0 || consecutive_rejections_ < cfg_.gate_readmit_after) {
+        res.accepted = false;
+        ++rejections_;
+        ++consecutive_rejections_;
+        last_ = res;
+        return res;
+      }
+      // Re-admission (fading memory, Simon 2006 §7.4): P <- lambda P with
+      // lambda = NIS / gate, then the ordinary update with the inflated P.
+      res.readmitted = true;
+      res.inflation = res.nis / res.gate;
+      P_ *= res.inflation;
+      PHt *= res.inflation;
+      MatrixXd S2 = R;
+      S2.noalias() += H * PHt;
+      llt.compute(S2);
+      if (llt.info() != Eigen::Success || !S2.allFinite())
+        throw Error("innovation covariance not positive definite at t = " + formatNumber(res.t, 9) + " s");
     }
   }
+  consecutive_rejections_ = 0;
   MatrixXd& K = c.K;
   K = llt.solve(PHt.transpose()).transpose();  // K = P H' S^-1 (Groves 3.21)
   // Joseph form (I-KH) P (I-KH)' + K R K' (Groves 3.58), expanded:

@@ -380,6 +380,16 @@ std::string summaryJson(const ReplayResult& r) {
     }
     j["rejected"] = rej;  // the first 1000
   }
+  j["readmitted_updates"] = r.run.readmitted.size();
+  {
+    json rea = json::array();
+    for (std::size_t k = 0; k < r.run.readmitted.size() && k < 1000; ++k) {
+      const auto& u = r.run.readmitted[k];
+      rea.push_back({{"t_s", u.t - r.t_zero}, {"kind", u.kind}, {"nis", u.nis}, {"gate", u.gate},
+                     {"p_inflation", u.inflation}});
+    }
+    j["readmitted"] = rea;  // the first 1000
+  }
   j["zupt_updates"] = r.run.zupt_updates;
   j["nhc_updates"] = r.run.nhc_updates;
   j["filter_start_s"] = r.aided_from_s;
@@ -466,6 +476,16 @@ std::string replaySummary(const ReplayResult& r) {
     std::snprintf(b, sizeof b, "%zu update(s) rejected by the NIS gate (first at %.3f s, %s, NIS %.1f > %.1f)\n",
                   r.run.rejected.size(), r.run.rejected.front().t - r.t_zero, r.run.rejected.front().kind.c_str(),
                   r.run.rejected.front().nis, r.run.rejected.front().gate);
+    s += b;
+  }
+  if (!r.run.readmitted.empty()) {
+    double worst = 1.0;
+    for (const auto& u : r.run.readmitted) worst = std::max(worst, u.inflation);
+    std::snprintf(b, sizeof b,
+                  "%zu update(s) re-admitted after %d rejections in a row, the covariance scaled by NIS/gate "
+                  "first (up to %.3g; first at %.3f s, %s): the filter was overconfident\n",
+                  r.run.readmitted.size(), r.cfg.gate_readmit_after, worst,
+                  r.run.readmitted.front().t - r.t_zero, r.run.readmitted.front().kind.c_str());
     s += b;
   }
   if (r.score) {

@@ -106,12 +106,14 @@ struct NavRunOptions {
   Eigen::Vector3d nhc_point_B = Eigen::Vector3d::Zero();  ///< constrained point, body FRD from the IMU [m]
 };
 
-/// An update the chi-square gate rejected.
+/// An update the chi-square gate rejected, or re-admitted after a run of
+/// rejections with P scaled by `inflation` (filter::EkfConfig::gate_readmit_after).
 struct RejectedUpdate {
   double t = 0.0;        ///< filter time [s]
   std::string kind;      ///< "gnss_position", "gnss_velocity", "baro", "zupt", "nhc"
   double nis = 0.0;      ///< its NIS
   double gate = 0.0;     ///< the gate's threshold
+  double inflation = 1.0;  ///< re-admitted: the factor P was scaled by (NIS / gate); rejected: 1
 };
 
 /// Errors, sigmas and NEES at one record epoch.
@@ -143,6 +145,7 @@ struct NavRunResult {
   std::size_t baro_updates = 0;     ///< baro samples applied
   int rejections = 0;               ///< updates rejected by the chi-square gate
   std::vector<RejectedUpdate> rejected;  ///< each of them
+  std::vector<RejectedUpdate> readmitted;  ///< updates applied after a lock-out, P inflated first
   std::size_t zupt_updates = 0;     ///< zero-velocity updates applied
   std::size_t nhc_updates = 0;      ///< non-holonomic updates applied
   double wall_s = 0.0;              ///< wall-clock time of the run [s]

@@ -16,7 +16,8 @@
  * rawlog: ../../datasets/uav_flight_260s_ref.rawlog
  * model: ../models/navchip_table1.yaml:ref   # filter's IMU model; default: the rawlog's scenario model
  * outages: [{start_s: 200, duration_s: 60}]  # [s] from time zero
- * filter: {propagate_every: 10, use_gnss_velocity: true, gate_probability: 0, max_imu_gap_s: 0}
+ * filter: {propagate_every: 10, use_gnss_velocity: true, gate_probability: 0, gate_readmit_after: 3,
+ *          max_imu_gap_s: 0}
  * initial_sigma: {pos_h_m: 1, pos_v_m: 1, vel_mps: 0.1, roll_pitch_deg: 0.1, yaw_deg: 0.5}
  * noise: {sigma_pos_h_m: 2, sigma_pos_v_m: 4, sigma_vel_h_mps: 0.05, sigma_vel_v_mps: 0.1, sigma_baro_m: 0.5}
  * gnss_lever_arm_B_m: [0, 0, 0]              # default: the scenario's
@@ -81,6 +82,7 @@ struct ReplayConfig {
   int propagate_every = 10;                     ///< covariance propagation every k IMU samples
   bool use_gnss_velocity = true;
   double gate_probability = 0.0;
+  int gate_readmit_after = 3;                   ///< filter::EkfConfig::gate_readmit_after (0..1000, 0 = never)
   double p0_pos_h_m = 1.0, p0_pos_v_m = 1.0, p0_vel_mps = 0.1;
   double p0_roll_pitch_deg = 0.1, p0_yaw_deg = 0.5;
   std::optional<double> sigma_pos_h_m, sigma_pos_v_m, sigma_vel_h_mps, sigma_vel_v_mps, sigma_baro_m;

@@ -67,6 +67,13 @@ struct EkfConfig {
   /// Chi-square innovation gate: reject when NIS > quantile(gate_probability, m).
   /// 0 = off (default); else in (0, 1), e.g. 0.999.
   double gate_probability = 0.0;
+  /// Re-admission after a lock-out: once this many gated updates in a row were
+  /// rejected, the next one that fails the gate is applied after scaling P by
+  /// lambda = NIS / gate (> 1), the fading-memory step of Simon (2006) §7.4:
+  /// a run of rejections is evidence that the covariance, not the measurement,
+  /// is wrong. Without it (0), a filter whose error has outgrown its covariance
+  /// rejects every later fix and diverges. 0 = never; else 1..1000. Default 3.
+  int gate_readmit_after = 3;
   ImuErrorOptions imu;                 ///< turn-on bias states
   ins::MechanizationOptions mechanization;
 };
@@ -87,6 +94,10 @@ struct UpdateResult {
   double nis = 0.0;             ///< dz' S^-1 dz
   double gate = 0.0;            ///< NIS threshold of the chi-square gate (0: gate off)
   double t = 0.0;               ///< filter time [s]
+  /// Applied although NIS > gate, after gate_readmit_after rejections in a row;
+  /// P was scaled by `inflation` first (nis, S and innovation are those before).
+  bool readmitted = false;
+  double inflation = 1.0;       ///< lambda = NIS / gate of a re-admission (1 otherwise)
 };
 
 class ErrorStateEkf {
@@ -270,6 +281,7 @@ class ErrorStateEkf {
   Eigen::Matrix3d iv_Qv_ = Eigen::Matrix3d::Zero(), iv_Qa_ = Eigen::Matrix3d::Zero();  // sum C diag(psd) C' dt
   UpdateResult last_;
   int rejections_ = 0;
+  int consecutive_rejections_ = 0;  ///< gated rejections since the last applied update
   // cache for covariance-only propagation along a constant nominal
   struct Cache;
   std::shared_ptr<Cache> cache_;
