@@ -41,7 +41,7 @@ _cov_bad(unknown_model "model_file: ${_models}\n${_base}model_sets: [{name: a, m
 _cov_bad(wrong_unit "model_file: ${_models}\nduration_s: 2\nstatic_state: {lat_rad: 0.8, lon_deg: 6.5, h_m: 400}\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
          "static_state\\.lat_rad.*unknown key.*lat_deg")
 _cov_bad(wrong_type "model_file: ${_models}\nduration_s: sixty\nstatic_state: {lat_deg: 46.5}\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
-         "duration_s.*expected a number in s")
+         "key 'duration_s': must be a number in .* s, got 'sixty'")
 _cov_bad(duplicate_set_name "model_file: ${_models}\n${_base}model_sets: [{name: a, models: [acc_ref]}, {name: a, models: [gyro_ref]}]\n"
          "model_sets\\[1\\]\\.name.*'a' is used by an earlier model set")
 _cov_bad(negative_baro_sigma "model_file: ${_models}\n${_base}baro: {rate_hz: 10, sigma_m: -1}\nmodel_sets: [{name: a, models: [acc_ref]}]\n"

@@ -1,8 +1,6 @@
 // Covariance analysis in static conditions (paper Figures 5 and 6).
 #include "navimpact/analysis/covariance_study.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
@@ -27,53 +26,14 @@ using Eigen::Vector3d;
 
 namespace {
 
-std::string join(const std::set<std::string>& s) {
-  std::string r;
-  for (const auto& k : s) r += (r.empty() ? "" : ", ") + k;
-  return r;
-}
-
-struct Reader {
-  std::string file;
-  void keys(const YAML::Node& n, const std::string& prefix, const std::set<std::string>& allowed) const {
-    if (!n.IsMap()) throw keyError(file, prefix.empty() ? "(top level)" : prefix, "expected a mapping");
-    for (const auto& kv : n) {
-      const std::string k = kv.first.as<std::string>();
-      if (!allowed.count(k))
-        throw keyError(file, prefix.empty() ? k : prefix + "." + k,
-                       "unknown key (accepted here: " + join(allowed) + ")");
-    }
-  }
-  double num(const YAML::Node& n, const std::string& key, const std::string& prefix, double def,
-             const char* unit) const {
-    const std::string path = prefix.empty() ? key : prefix + "." + key;
-    if (!n[key]) return def;
-    const YAML::Node v = n[key];
-    double x = 0.0;
-    try {
-      if (!v.IsScalar()) throw YAML::Exception(YAML::Mark(), "not a scalar");
-      x = v.as<double>();
-    } catch (const YAML::Exception&) {
-      throw keyError(file, path, std::string("expected a number in ") + unit);
-    }
-    if (!std::isfinite(x)) throw keyError(file, path, "must be finite");
-    return x;
-  }
-  std::string str(const YAML::Node& n, const std::string& key, const std::string& prefix,
-                  const std::string& def) const {
-    if (!n[key]) return def;
-    try {
-      if (!n[key].IsScalar()) throw YAML::Exception(YAML::Mark(), "not a scalar");
-      return n[key].as<std::string>();
-    } catch (const YAML::Exception&) {
-      throw keyError(file, prefix.empty() ? key : prefix + "." + key, "expected a string");
-    }
-  }
-};
-
-void nonNegative(const std::string& file, const std::string& key, double v) {
-  if (!(v >= 0.0)) throw keyError(file, key, "must be >= 0, got " + std::to_string(v));
-}
+/// Angles of the static state [deg]; latitude and pitch are further kept off the poles.
+constexpr limits::Range kAngleDeg{-360.0, 360.0, false, "deg"};
+/// Initial sigmas (0 allowed: a perfectly known start).
+constexpr limits::Range kSigma0M{0.0, limits::kPositionSigmaM.hi, false, "m"};
+constexpr limits::Range kSigma0Mps{0.0, limits::kVelocitySigmaMps.hi, false, "m/s"};
+constexpr limits::Range kSigma0Deg{0.0, 180.0, false, "deg"};
+/// Barometer rate, 0 = no barometer [Hz].
+constexpr limits::Range kBaroRateHz{0.0, limits::kAidingRateHz.hi, false, "Hz"};
 
 std::string modelText(const stochastic::ImuModel& m) {
   const std::string g = stochastic::formatTerms(m.axis[0].terms);
@@ -83,71 +43,52 @@ std::string modelText(const stochastic::ImuModel& m) {
 
 }  // namespace
 
-static CovarianceStudyConfig loadCovarianceStudyConfigImpl(const std::string& path) {
+CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
   InputScope scope(path);
   CovarianceStudyConfig c;
   c.source = path;
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw fileError(path, 0, "cannot open configuration file");
-  } catch (const YAML::Exception& e) {
-    throw fileError(path, e.mark.line + 1, std::string("YAML syntax error: ") + printable(e.msg, 120));
-  }
-  const Reader r{path};
-  r.keys(root, "", {"model_file", "duration_s", "imu_rate_hz", "output_rate_hz", "summary_times_s",
-                    "static_state", "initial_sigma", "baro", "filter", "model_sets"});
+  c.loadFrom(ConfigNode::load(path));
+  return c;
+}
+
+void CovarianceStudyConfig::loadFrom(const ConfigNode& root) {
+  CovarianceStudyConfig& c = *this;
+  const std::string& path = root.file();
+  root.allowKeys({"model_file", "duration_s", "imu_rate_hz", "output_rate_hz", "summary_times_s", "static_state",
+                  "initial_sigma", "baro", "filter", "model_sets"});
   nlohmann::json echo;
 
   // model file, relative to the configuration file
-  const std::string mf = r.str(root, "model_file", "", "");
-  if (mf.empty()) throw keyError(path, "model_file", "required: path of the IMU error model file");
-  fs::path mp(mf);
-  if (mp.is_relative()) mp = fs::path(path).parent_path() / mp;
-  c.model_file = mp.lexically_normal().string();
+  const std::string mf = root.has("model_file") ? root.text("model_file") : std::string();
+  if (mf.empty()) throw root.error("model_file", "required: path of the IMU error model file");
+  c.model_file = root.resolve(mf);
   echo["model_file"] = mf;
 
-  c.duration_s = limits::check(path, "duration_s", r.num(root, "duration_s", "", 60.0, "s"), limits::kDurationS);
-  c.imu_rate_hz = limits::check(path, "imu_rate_hz", r.num(root, "imu_rate_hz", "", 200.0, "Hz"), limits::kImuRateHz);
-  c.output_rate_hz =
-      limits::check(path, "output_rate_hz", r.num(root, "output_rate_hz", "", 10.0, "Hz"), limits::kAidingRateHz);
-  if (c.output_rate_hz > c.imu_rate_hz)
-    throw keyError(path, "output_rate_hz", "must not exceed imu_rate_hz");
+  root.read("duration_s", c.duration_s, limits::kDurationS);
+  root.read("imu_rate_hz", c.imu_rate_hz, limits::kImuRateHz);
+  root.read("output_rate_hz", c.output_rate_hz, limits::kAidingRateHz);
+  if (c.output_rate_hz > c.imu_rate_hz) throw root.error("output_rate_hz", "must not exceed imu_rate_hz");
   echo["duration_s"] = c.duration_s;
   echo["imu_rate_hz"] = c.imu_rate_hz;
   echo["output_rate_hz"] = c.output_rate_hz;
 
-  if (root["summary_times_s"]) {
-    const YAML::Node s = root["summary_times_s"];
-    if (!s.IsSequence()) throw keyError(path, "summary_times_s", "expected a list of times in s");
+  if (root.has("summary_times_s")) {
     c.summary_times_s.clear();
-    for (std::size_t i = 0; i < s.size(); ++i) {
-      double t = 0;
-      try {
-        t = s[i].as<double>();
-      } catch (const YAML::Exception&) {
-        throw keyError(path, "summary_times_s[" + std::to_string(i) + "]", "expected a number in s");
-      }
-      if (!(t >= 0.0 && t <= c.duration_s))
-        throw keyError(path, "summary_times_s[" + std::to_string(i) + "]",
-                       "must be within [0, duration_s]");
-      c.summary_times_s.push_back(t);
-    }
+    root.read("summary_times_s", c.summary_times_s, limits::Range{0.0, c.duration_s, false, "s (within duration_s)"});
   }
   echo["summary_times_s"] = c.summary_times_s;
 
-  const YAML::Node st = root["static_state"];
-  if (!st) throw keyError(path, "static_state", "required (lat_deg, lon_deg, h_m, roll_deg, pitch_deg, yaw_deg)");
-  r.keys(st, "static_state", {"lat_deg", "lon_deg", "h_m", "roll_deg", "pitch_deg", "yaw_deg"});
-  const double lat = r.num(st, "lat_deg", "static_state", 0.0, "deg");
-  const double lon = r.num(st, "lon_deg", "static_state", 0.0, "deg");
-  const double h = r.num(st, "h_m", "static_state", 0.0, "m");
-  const double roll = r.num(st, "roll_deg", "static_state", 0.0, "deg");
-  const double pitch = r.num(st, "pitch_deg", "static_state", 0.0, "deg");
-  const double yaw = r.num(st, "yaw_deg", "static_state", 0.0, "deg");
-  if (!(std::abs(lat) < 89.0)) throw keyError(path, "static_state.lat_deg", "must be within (-89, 89) deg");
-  if (!(std::abs(pitch) < 89.0)) throw keyError(path, "static_state.pitch_deg", "must be within (-89, 89) deg");
+  const ConfigNode st = root.map("static_state", "lat_deg, lon_deg, h_m, roll_deg, pitch_deg, yaw_deg");
+  st.allowKeys({"lat_deg", "lon_deg", "h_m", "roll_deg", "pitch_deg", "yaw_deg"});
+  double lat = 0.0, lon = 0.0, h = 0.0, roll = 0.0, pitch = 0.0, yaw = 0.0;
+  st.read("lat_deg", lat, limits::kLatitudeDeg);
+  st.read("lon_deg", lon, limits::kLongitudeDeg);
+  st.read("h_m", h, limits::kHeightM);
+  st.read("roll_deg", roll, kAngleDeg);
+  st.read("pitch_deg", pitch, kAngleDeg);
+  st.read("yaw_deg", yaw, kAngleDeg);
+  if (!(std::abs(lat) < 89.0)) throw st.error("lat_deg", "must be within (-89, 89) deg");
+  if (!(std::abs(pitch) < 89.0)) throw st.error("pitch_deg", "must be within (-89, 89) deg");
   c.nominal.lat = lat * units::kDeg;
   c.nominal.lon = lon * units::kDeg;
   c.nominal.h = h;
@@ -155,76 +96,58 @@ static CovarianceStudyConfig loadCovarianceStudyConfigImpl(const std::string& pa
   echo["static_state"] = {{"lat_deg", lat}, {"lon_deg", lon}, {"h_m", h},
                           {"roll_deg", roll}, {"pitch_deg", pitch}, {"yaw_deg", yaw}};
 
-  if (const YAML::Node is = root["initial_sigma"]) {
-    r.keys(is, "initial_sigma", {"position_m", "velocity_mps", "attitude_deg"});
-    c.sigma0_position_m = r.num(is, "position_m", "initial_sigma", 0.0, "m");
-    c.sigma0_velocity_mps = r.num(is, "velocity_mps", "initial_sigma", 0.0, "m/s");
-    c.sigma0_attitude_rad = r.num(is, "attitude_deg", "initial_sigma", 0.0, "deg") * units::kDeg;
-    nonNegative(path, "initial_sigma.position_m", c.sigma0_position_m);
-    nonNegative(path, "initial_sigma.velocity_mps", c.sigma0_velocity_mps);
-    nonNegative(path, "initial_sigma.attitude_deg", c.sigma0_attitude_rad);
+  if (const auto is = root.optMap("initial_sigma")) {
+    is->allowKeys({"position_m", "velocity_mps", "attitude_deg"});
+    c.sigma0_position_m = c.sigma0_velocity_mps = c.sigma0_attitude_rad = 0.0;
+    is->read("position_m", c.sigma0_position_m, kSigma0M);
+    is->read("velocity_mps", c.sigma0_velocity_mps, kSigma0Mps);
+    double att = 0.0;
+    is->read("attitude_deg", att, kSigma0Deg);
+    c.sigma0_attitude_rad = att * units::kDeg;
   }
   echo["initial_sigma"] = {{"position_m", c.sigma0_position_m},
                            {"velocity_mps", c.sigma0_velocity_mps},
                            {"attitude_deg", c.sigma0_attitude_rad / units::kDeg}};
 
-  if (const YAML::Node b = root["baro"]) {
-    r.keys(b, "baro", {"rate_hz", "sigma_m"});
-    c.baro_rate_hz = r.num(b, "rate_hz", "baro", 10.0, "Hz");
-    c.baro_sigma_m = r.num(b, "sigma_m", "baro", 1e-3, "m");
-    nonNegative(path, "baro.rate_hz", c.baro_rate_hz);
-    if (c.baro_rate_hz > 0.0) limits::check(path, "baro.rate_hz", c.baro_rate_hz, limits::kAidingRateHz);
-    limits::check(path, "baro.sigma_m", c.baro_sigma_m, limits::kPositionSigmaM);
-    if (c.baro_rate_hz > c.imu_rate_hz) throw keyError(path, "baro.rate_hz", "must not exceed imu_rate_hz");
+  if (const auto b = root.optMap("baro")) {
+    b->allowKeys({"rate_hz", "sigma_m"});
+    c.baro_rate_hz = 10.0;
+    c.baro_sigma_m = 1e-3;
+    b->read("rate_hz", c.baro_rate_hz, kBaroRateHz);
+    if (c.baro_rate_hz > 0.0) limits::check(path, b->keyPath("rate_hz"), c.baro_rate_hz, limits::kAidingRateHz);
+    b->read("sigma_m", c.baro_sigma_m, limits::kPositionSigmaM);
+    if (c.baro_rate_hz > c.imu_rate_hz) throw b->error("rate_hz", "must not exceed imu_rate_hz");
   }
   echo["baro"] = {{"rate_hz", c.baro_rate_hz}, {"sigma_m", c.baro_sigma_m}};
 
   std::string disc = "series";
-  if (const YAML::Node f = root["filter"]) {
-    r.keys(f, "filter", {"discretization", "propagate_every"});
-    disc = r.str(f, "discretization", "filter", "series");
-    try {
-      c.filter.discretization = filter::parseDiscretization(disc);
-    } catch (const Error& e) {
-      throw keyError(path, "filter.discretization", e.what());
-    }
-    const double k = r.num(f, "propagate_every", "filter", 1.0, "IMU samples");
-    if (!(k >= 1.0 && k == std::floor(k)))
-      throw keyError(path, "filter.propagate_every", "must be an integer >= 1 (IMU samples)");
-    c.filter.propagate_every = static_cast<int>(k);
+  if (const auto f = root.optMap("filter")) {
+    f->allowKeys({"discretization", "propagate_every"});
+    f->readChoice("discretization", disc, {"series", "vanloan"});
+    c.filter.discretization = filter::parseDiscretization(disc);
+    c.filter.propagate_every = 1;
+    f->read("propagate_every", c.filter.propagate_every, 1, limits::kMaxPropagateEvery);
   }
   echo["filter"] = {{"discretization", disc}, {"propagate_every", c.filter.propagate_every}};
 
-  const YAML::Node sets = root["model_sets"];
-  if (!sets || !sets.IsSequence() || sets.size() == 0)
-    throw keyError(path, "model_sets", "required: a non-empty list of {name, title, models}");
   echo["model_sets"] = nlohmann::json::array();
-  for (std::size_t i = 0; i < sets.size(); ++i) {
-    const std::string pre = "model_sets[" + std::to_string(i) + "]";
-    r.keys(sets[i], pre, {"name", "title", "models"});
+  for (const ConfigNode& set : root.list("model_sets", 1, SIZE_MAX, "a non-empty list of {name, title, models}")) {
+    set.allowKeys({"name", "title", "models"});
     ModelSet ms;
-    ms.name = r.str(sets[i], "name", pre, "");
+    set.read("name", ms.name);
     if (ms.name.empty() || ms.name.find_first_of("/\\ ,\"") != std::string::npos)
-      throw keyError(path, pre + ".name", "required: a name without spaces, commas, quotes or slashes");
+      throw set.error("name", "required: a name without spaces, commas, quotes or slashes");
     for (const auto& other : c.model_sets)
       if (other.name == ms.name)
-        throw keyError(path, pre + ".name", "'" + ms.name + "' is used by an earlier model set (names must be unique)");
-    ms.title = r.str(sets[i], "title", pre, ms.name);
-    const YAML::Node ml = sets[i]["models"];
-    if (!ml || !ml.IsSequence() || ml.size() == 0)
-      throw keyError(path, pre + ".models", "required: a non-empty list of model names");
-    for (std::size_t j = 0; j < ml.size(); ++j) {
-      const std::string key = pre + ".models[" + std::to_string(j) + "]";
-      std::string name;
-      try {
-        name = ml[j].as<std::string>();
-      } catch (const YAML::Exception&) {
-        throw keyError(path, key, "expected a model name");
-      }
+        throw set.error("name", "'" + ms.name + "' is used by an earlier model set (names must be unique)");
+    ms.title = ms.name;
+    set.read("title", ms.title);
+    for (const ConfigNode& m : set.list("models", 1, SIZE_MAX, "a non-empty list of model names")) {
+      const std::string name = m.asText();
       try {
         (void)stochastic::loadImuModel(c.model_file + ":" + name);  // validates early
       } catch (const Error& e) {
-        throw keyError(path, key, e.what());
+        throw m.error(e.what());
       }
       ms.models.push_back(name);
     }
@@ -232,18 +155,6 @@ static CovarianceStudyConfig loadCovarianceStudyConfigImpl(const std::string& pa
     c.model_sets.push_back(ms);
   }
   c.echo = echo.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  return c;
-}
-
-// A value of the wrong type (yaml-cpp's conversion errors, a list or map used
-// as a key) is an error naming the file and line, never an internal error.
-CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
-  try {
-    return loadCovarianceStudyConfigImpl(path);
-  } catch (const YAML::Exception& e) {
-    throw Error(path + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) : "") +
-                ": " + printable(e.msg, 120) + " (a value or key of the wrong type)");
-  }
 }
 
 Eigen::Vector3d eulerSigmas(const Matrix3d& P_psi, const ins::NavState& x) {

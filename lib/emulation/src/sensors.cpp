@@ -6,6 +6,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
+#include "navimpact/core/units.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 
@@ -131,6 +132,51 @@ std::vector<BaroSample> simulateBaro(const SmoothTrajectory& tr, const BaroOptio
     out[k] = {t, tr.at(t).pos.h + opt.sigma_m * z[k], opt.sigma_m};
   }
   return out;
+}
+
+}  // namespace navimpact::emulation
+
+namespace navimpact::emulation {
+
+void GnssOptions::loadFrom(const ConfigNode& n, bool with_seed) {
+  std::vector<std::string> keys{"rate_hz", "sigma_pos_h_m", "sigma_pos_v_m", "sigma_vel_h_mps", "sigma_vel_v_mps",
+                                "lever_arm_B_m"};
+  if (with_seed) keys.push_back("seed");
+  n.allowKeys(keys);
+  n.read("rate_hz", rate_hz, limits::kAidingRateHz);
+  n.read("sigma_pos_h_m", sigma_pos_h_m, limits::kPositionSigmaM);
+  n.read("sigma_pos_v_m", sigma_pos_v_m, limits::kPositionSigmaM);
+  n.read("sigma_vel_h_mps", sigma_vel_h_mps, limits::kVelocitySigmaMps);
+  n.read("sigma_vel_v_mps", sigma_vel_v_mps, limits::kVelocitySigmaMps);
+  n.read("lever_arm_B_m", lever_arm_B, limits::kLeverArmM);
+  if (with_seed) n.readSeed("seed", seed);
+}
+
+void BaroOptions::loadFrom(const ConfigNode& n, bool with_seed, const std::vector<std::string>& extra_keys) {
+  std::vector<std::string> keys{"rate_hz", "sigma_m"};
+  if (with_seed) keys.push_back("seed");
+  keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
+  n.allowKeys(keys);
+  n.read("rate_hz", rate_hz, limits::kAidingRateHz);
+  n.read("sigma_m", sigma_m, limits::kPositionSigmaM);
+  if (with_seed) n.readSeed("seed", seed);
+}
+
+void StaticRecordingSpec::loadFrom(const ConfigNode& n, bool with_window) {
+  std::vector<std::string> keys{"file", "gyro_unit", "acc_unit", "rate_hz", "axes"};
+  if (with_window) keys.insert(keys.end(), {"offset_s", "seed"});
+  n.allowKeys(keys);
+  file = n.resolve(n.text("file", "the static recording CSV", true));
+  n.readChoice("gyro_unit", csv.gyro_unit, units::acceptedUnits(units::Quantity::AngularRate));
+  n.readChoice("acc_unit", csv.acc_unit, units::acceptedUnits(units::Quantity::SpecificForce));
+  double rate = 0.0;
+  if (n.read("rate_hz", rate, limits::kImuRateHz)) csv.rate_hz = rate;
+  n.read("axes", csv.axes);
+  if (with_window) {
+    double off = 0.0;
+    if (n.read("offset_s", off, limits::Range{0.0, limits::kDurationS.hi, false, "s"})) offset_s = off;
+    n.readSeed("seed", seed);
+  }
 }
 
 }  // namespace navimpact::emulation

@@ -219,3 +219,47 @@ void SmoothTrajectory::increments(double ta, double tb, Eigen::Vector3d& dv_B,
 }
 
 }  // namespace navimpact::emulation
+
+namespace navimpact::emulation {
+
+void TrajectorySpec::loadFrom(const ConfigNode& n) {
+  n.allowKeys({"file", "system", "columns", "latlon_unit", "attitude_unit", "time_unit", "origin", "max_gap_s",
+               "start_s", "end_s"});
+  file = n.resolve(n.text("file", "the trajectory CSV", true));
+  n.readChoice("system", system, {"geodetic", "ned"});
+  if (const auto cols = n.optMap("columns")) {
+    cols->allowKeys({"time", "lat", "lon", "height", "north", "east", "down", "roll", "pitch", "yaw"});
+    cols->read("time", col_time);
+    cols->read("lat", col_lat);
+    cols->read("lon", col_lon);
+    cols->read("height", col_height);
+    cols->read("north", col_north);
+    cols->read("east", col_east);
+    cols->read("down", col_down);
+    cols->read("roll", col_roll);
+    cols->read("pitch", col_pitch);
+    cols->read("yaw", col_yaw);
+  }
+  n.readChoice("latlon_unit", latlon_unit, {"rad", "deg"});
+  n.readChoice("attitude_unit", attitude_unit, {"rad", "deg"});
+  n.readChoice("time_unit", time_unit, {"s", "ms"});
+  if (const auto o = n.optMap("origin")) {
+    o->allowKeys({"lat_deg", "lon_deg", "height_m"});
+    origin = earth::Geodetic{o->number("lat_deg", limits::kLatitudeDeg) * M_PI / 180,
+                             o->number("lon_deg", limits::kLongitudeDeg) * M_PI / 180,
+                             o->number("height_m", limits::kHeightM)};
+  }
+  n.read("max_gap_s", max_gap_s, limits::kDurationS);
+  n.read("start_s", start_s, limits::kFileTimeS);
+  n.read("end_s", end_s, limits::kFileTimeS);
+}
+
+void SmoothingOptions::loadFrom(const ConfigNode& n) {
+  n.allowKeys({"position_cutoff_hz", "attitude_cutoff_hz", "knot_step_s", "penalty_order"});
+  n.read("position_cutoff_hz", position_cutoff_hz, limits::kCutoffHz);
+  n.read("attitude_cutoff_hz", attitude_cutoff_hz, limits::kCutoffHz);
+  n.read("knot_step_s", knot_step_s, limits::kDurationS);
+  n.read("penalty_order", penalty_order, 1, 4);
+}
+
+}  // namespace navimpact::emulation

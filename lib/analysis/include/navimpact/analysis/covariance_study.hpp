@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "navimpact/core/config.hpp"
 #include "navimpact/filter/ekf.hpp"
 
 namespace navimpact::analysis {
@@ -56,6 +57,10 @@ struct CovarianceStudyConfig {
   std::vector<ModelSet> model_sets;
   std::string echo;                  ///< the configuration as JSON text (for summary.json)
   bool allow_large = false;          ///< run even above the work and memory budgets (--allow-large)
+
+  /// Read the keys of a covariance configuration (see config/paper/covariance_static.yaml),
+  /// with the ranges of core/limits.hpp; every model named is loaded once to check it.
+  void loadFrom(const ConfigNode& root);
 };
 
 /// Work and memory a covariance run needs (checked before it starts).

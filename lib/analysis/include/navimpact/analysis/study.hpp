@@ -48,6 +48,7 @@
 #include <Eigen/Core>
 
 #include "navimpact/analysis/nav_run.hpp"
+#include "navimpact/core/config.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/emulation/sensors.hpp"
 #include "navimpact/emulation/trajectory.hpp"
@@ -109,6 +110,10 @@ struct StudyConfig {
   double plot_after_s = 10.0;              ///< figure window after an outage [s]
 
   StudyConfig();
+  /// Read the keys of a study file (see config/paper/study_navchip_uav.yaml and
+  /// README), with the ranges of core/limits.hpp; top-level keys in
+  /// @p extra_keys are accepted and left to the caller (`sweep`).
+  void loadFrom(const ConfigNode& root, const std::vector<std::string>& extra_keys = {});
 };
 
 /**

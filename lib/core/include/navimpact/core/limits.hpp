@@ -10,7 +10,9 @@
  *    truth, records) 0.001 Hz - 10 kHz;
  *  - position and altitude sigmas (0, 10 km]; velocity sigmas (0, 1 km/s];
  *  - lever-arm components [-100, 100] m;
- *  - durations (0, 7 days];
+ *  - durations (0, 7 days]; times on a file's axis [-1e10, 1e10] s;
+ *  - origins: latitude [-90, 90] deg, longitude [-360, 360] deg, height
+ *    [-11 km, 100 km]; smoother cut-offs (0, 10 kHz];
  *  - IMU error states per axis at most 32 (a model has a handful);
  *  - Monte Carlo runs of a study at most 10^6;
  *  - sensor effects of an emulation and the extra filter states that model
@@ -41,6 +43,17 @@ inline constexpr Range kPositionSigmaM{0.0, 1.0e4, true, "m"};
 inline constexpr Range kVelocitySigmaMps{0.0, 1.0e3, true, "m/s"};
 inline constexpr Range kLeverArmM{-100.0, 100.0, false, "m"};
 inline constexpr Range kDurationS{0.0, 7.0 * 86400.0, true, "s"};
+/// A time on a file's own axis (trajectory start_s/end_s: file time, e.g. Unix seconds) [s].
+inline constexpr Range kFileTimeS{-1.0e10, 1.0e10, false, "s"};
+/// Geodetic latitude, longitude and height of an origin [deg, deg, m].
+inline constexpr Range kLatitudeDeg{-90.0, 90.0, false, "deg"};
+inline constexpr Range kLongitudeDeg{-360.0, 360.0, false, "deg"};
+inline constexpr Range kHeightM{-1.1e4, 1.0e5, false, "m"};
+/// Cut-off frequency of a smoother [Hz].
+inline constexpr Range kCutoffHz{0.0, 1.0e4, true, "Hz"};
+
+/// Most IMU samples between two covariance propagations (filter.propagate_every, 1..1000).
+inline constexpr int kMaxPropagateEvery = 1000;
 
 // Sensor effects (emulation::SensorEffects) and the prior sigmas of the filter
 // states that estimate them. Scale factors and small angles are first-order

@@ -50,6 +50,11 @@ struct StaticRecordingSpec {
   CsvImuOptions csv;                ///< units, rate, axes of that file
   std::optional<double> offset_s;   ///< start of the window in the recording [s]; unset: from the seed
   std::uint64_t seed = 0;           ///< picks the window start uniformly when offset_s is unset
+
+  /// Read file (relative to the configuration's folder, required), gyro_unit,
+  /// acc_unit (units::acceptedUnits), rate_hz (IMU rate), axes and, when
+  /// @p with_window, offset_s (a duration from the recording's start) and seed.
+  void loadFrom(const ConfigNode& n, bool with_window);
 };
 
 /**
@@ -81,6 +86,11 @@ struct GnssOptions {
   double sigma_vel_v_mps = 0.10;    ///< vertical velocity noise [m/s]
   Eigen::Vector3d lever_arm_B = Eigen::Vector3d::Zero();  ///< antenna in body FRD from the IMU [m]
   std::uint64_t seed = 2;           ///< noise seed
+
+  /// Read the keys of a `gnss:` map: rate_hz (aiding rate), sigma_pos_h_m,
+  /// sigma_pos_v_m (position sigmas), sigma_vel_h_mps, sigma_vel_v_mps (velocity
+  /// sigmas), lever_arm_B_m (each component a lever arm) and, when @p with_seed, seed.
+  void loadFrom(const ConfigNode& n, bool with_seed = true);
 };
 
 /// Barometer options (defaults: Table 2).
@@ -88,6 +98,10 @@ struct BaroOptions {
   double rate_hz = 10.0;   ///< [Hz]
   double sigma_m = 0.5;    ///< height noise [m]
   std::uint64_t seed = 3;  ///< noise seed
+
+  /// Read rate_hz (aiding rate), sigma_m (altitude sigma) and, when @p with_seed,
+  /// seed of a `baro:` map; keys in @p extra_keys are accepted and left to the caller.
+  void loadFrom(const ConfigNode& n, bool with_seed = true, const std::vector<std::string>& extra_keys = {});
 };
 
 /**

@@ -28,6 +28,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "navimpact/core/config.hpp"
 #include "navimpact/core/earth.hpp"
 #include "navimpact/emulation/pspline.hpp"
 
@@ -49,6 +50,11 @@ struct TrajectorySpec {
   double max_gap_s = 0.25;            ///< largest time step the spline may bridge [s]
   std::optional<double> start_s;      ///< keep samples with time >= start_s (file time) [s]
   std::optional<double> end_s;        ///< keep samples with time <= end_s (file time) [s]
+
+  /// Read the keys of a `trajectory:` map (file, system, columns, latlon_unit,
+  /// attitude_unit, time_unit, origin {lat_deg, lon_deg, height_m}, max_gap_s,
+  /// start_s, end_s); the file is resolved against the configuration's folder.
+  void loadFrom(const ConfigNode& n);
 };
 
 /// Raw samples in SI: tangent-plane NED positions and unwrapped Euler angles.
@@ -75,6 +81,10 @@ struct SmoothingOptions {
   double attitude_cutoff_hz = 2.0;  ///< -6 dB cutoff of the attitude smoother [Hz]
   double knot_step_s = 0.05;        ///< knot spacing of both splines [s]
   int penalty_order = 3;            ///< difference order of the penalty (3: jerk-like)
+
+  /// Read the keys of a `smoothing:` map (position_cutoff_hz, attitude_cutoff_hz
+  /// in (0, 10000] Hz, knot_step_s a duration, penalty_order 1..4).
+  void loadFrom(const ConfigNode& n);
 };
 
 /// The true state and its derivatives at one instant (all SI).

@@ -1,0 +1,380 @@
+// The one strict YAML reader (see config.hpp).
+#include "navimpact/core/config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "navimpact/core/text_io.hpp"
+
+namespace navimpact {
+
+namespace fs = std::filesystem;
+
+struct ConfigNode::Node {
+  YAML::Node n;
+};
+
+struct ConfigNode::Doc {
+  std::string file;
+  fs::path dir;
+};
+
+namespace {
+
+std::string join(const std::string& path, const std::string& k) { return path.empty() ? k : path + "." + k; }
+
+/// What a value looks like, for ", got ...": a scalar quoted and bounded, else its kind.
+std::string got(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "nothing";
+  if (n.IsSequence()) return "a list";
+  if (n.IsMap()) return "a map";
+  return "'" + printable(n.Scalar(), 40) + "'";
+}
+
+std::string joinNames(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+/// Every map of the tree: keys are plain names and appear once.
+void checkKeys(const YAML::Node& n, const std::string& file, const std::string& path) {
+  if (n.IsMap()) {
+    std::map<std::string, int> seen;
+    for (const auto& kv : n) {
+      const int line = kv.first.Mark().line + 1;
+      if (!kv.first.IsScalar())
+        throw Error(file + ":" + std::to_string(line) + ":" + std::to_string(kv.first.Mark().column + 1) + ": key '" +
+                    join(path, "?") + "': a key must be a plain name, not a list or a map");
+      const std::string k = kv.first.Scalar();
+      const auto [it, fresh] = seen.emplace(k, line);
+      if (!fresh)
+        throw keyError(file, join(path, k),
+                       "duplicate key (line " + std::to_string(line) + "; first at line " + std::to_string(it->second) + ")");
+      checkKeys(kv.second, file, join(path, k));
+    }
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) checkKeys(n[i], file, path + "[" + std::to_string(i) + "]");
+  }
+}
+
+bool scalarDouble(const YAML::Node& v, double& x) {
+  if (!v.IsScalar()) return false;
+  try {
+    x = v.as<double>();
+    return true;
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+}
+
+std::string rangeText(const limits::Range& r) {
+  std::string s = limits::describe(r);
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+/// A number of @p v in @p r, or the one error naming @p key.
+double numberOf(const YAML::Node& v, const limits::Range& r, const std::string& file, const std::string& key) {
+  double x = 0.0;
+  if (!scalarDouble(v, x)) throw keyError(file, key, "must be a number in " + rangeText(r) + ", got " + got(v));
+  return limits::check(file, key, x, r);
+}
+
+}  // namespace
+
+ConfigNode::ConfigNode(std::shared_ptr<const Doc> doc, std::shared_ptr<const Node> node, std::string path)
+    : doc_(std::move(doc)), node_(std::move(node)), path_(std::move(path)) {}
+
+ConfigNode ConfigNode::load(const std::string& file) {
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) throw Error(file + ": cannot open (no such file)");
+  return parse(readFileMaybeGz(file), file);
+}
+
+ConfigNode ConfigNode::parse(const std::string& text, const std::string& file) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw Error(file + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                ": YAML syntax error: " + printable(e.msg, 120));
+  }
+  if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap()) throw Error(file + ": expected a map of keys at the top level, got " + got(root));
+  checkKeys(root, file, "");
+  auto doc = std::make_shared<Doc>();
+  doc->file = file;
+  doc->dir = fs::path(file).parent_path();
+  return ConfigNode(doc, std::make_shared<const Node>(Node{root}), "");
+}
+
+const std::string& ConfigNode::file() const { return doc_->file; }
+
+std::string ConfigNode::keyPath(const std::string& k) const { return join(path_, k); }
+
+Error ConfigNode::error(const std::string& k, const std::string& what) const {
+  return keyError(doc_->file, keyPath(k), what);
+}
+
+Error ConfigNode::error(const std::string& what) const {
+  return keyError(doc_->file, path_.empty() ? "(top level)" : path_, what);
+}
+
+bool ConfigNode::isMap() const { return node_->n.IsMap(); }
+bool ConfigNode::isList() const { return node_->n.IsSequence(); }
+bool ConfigNode::isScalar() const { return node_->n.IsScalar(); }
+bool ConfigNode::isNull() const { return !node_->n.IsDefined() || node_->n.IsNull(); }
+
+void ConfigNode::allowKeys(std::initializer_list<const char*> accepted) const {
+  std::vector<std::string> v;
+  for (const char* a : accepted) v.emplace_back(a);
+  allowKeys(v);
+}
+
+void ConfigNode::allowKeys(const std::vector<std::string>& accepted) const {
+  std::vector<std::string> sorted = accepted;
+  std::sort(sorted.begin(), sorted.end());
+  if (!isMap()) throw error("expected a map of keys (" + joinNames(sorted) + "), got " + got(node_->n));
+  for (const auto& kv : node_->n) {
+    const std::string k = kv.first.Scalar();
+    if (!std::binary_search(sorted.begin(), sorted.end(), k))
+      throw error(k, "unknown key (accepted: " + joinNames(sorted) + ")");
+  }
+}
+
+void ConfigNode::requireKeys(std::initializer_list<const char*> keys) const {
+  for (const char* k : keys)
+    if (!has(k)) throw error(k, "missing (required)");
+}
+
+std::vector<std::string> ConfigNode::keys() const {
+  std::vector<std::string> out;
+  if (!isMap()) return out;
+  for (const auto& kv : node_->n) out.push_back(kv.first.Scalar());
+  return out;
+}
+
+bool ConfigNode::has(const std::string& k) const { return isMap() && static_cast<bool>(node_->n[k]); }
+
+ConfigNode ConfigNode::at(const std::string& k) const {
+  return ConfigNode(doc_, std::make_shared<const Node>(Node{node_->n[k]}), keyPath(k));
+}
+
+ConfigNode ConfigNode::child(const std::string& k, const std::string& what_for) const {
+  if (!has(k)) throw error(k, "missing" + (what_for.empty() ? std::string() : " (" + what_for + ")"));
+  return at(k);
+}
+
+ConfigNode ConfigNode::map(const std::string& k, const std::string& what_for) const {
+  ConfigNode c = child(k, what_for);
+  if (!c.isMap()) throw error(k, "must be a map of keys" + (what_for.empty() ? std::string() : " (" + what_for + ")") +
+                                     ", got " + got(c.node_->n));
+  return c;
+}
+
+std::optional<ConfigNode> ConfigNode::optMap(const std::string& k) const {
+  if (!has(k)) return std::nullopt;
+  return map(k);
+}
+
+std::vector<ConfigNode> ConfigNode::items() const {
+  std::vector<ConfigNode> out;
+  if (!isList()) throw error("must be a list, got " + got(node_->n));
+  for (std::size_t i = 0; i < node_->n.size(); ++i)
+    out.push_back(ConfigNode(doc_, std::make_shared<const Node>(Node{node_->n[i]}), path_ + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
+std::vector<ConfigNode> ConfigNode::list(const std::string& k, std::size_t min, std::size_t max,
+                                         const std::string& what) const {
+  if (!has(k)) {
+    if (min > 0) throw error(k, "missing (" + (what.empty() ? "a list" : what) + ")");
+    return {};
+  }
+  const ConfigNode c = at(k);
+  const std::size_t n = c.isList() ? node_->n[k].size() : 0;
+  if (!c.isList() || n < min || n > max) {
+    std::string want = what;
+    if (want.empty()) {
+      want = "a list";
+      if (min > 0 && max != SIZE_MAX) want += " of " + std::to_string(min) + " to " + std::to_string(max) + " items";
+      else if (min > 0) want = "a non-empty list";
+      else if (max != SIZE_MAX) want += " of at most " + std::to_string(max) + " items";
+    }
+    throw error(k, "must be " + want + ", got " + (c.isList() ? std::to_string(n) + " items" : got(node_->n[k])));
+  }
+  return c.items();
+}
+
+double ConfigNode::number(const std::string& k, const limits::Range& r, const std::string& what_for) const {
+  if (!has(k))
+    throw error(k, "missing (a number in " + rangeText(r) + (what_for.empty() ? "" : ": " + what_for) + ")");
+  return numberOf(node_->n[k], r, doc_->file, keyPath(k));
+}
+
+bool ConfigNode::read(const std::string& k, double& out, const limits::Range& r) const {
+  if (!has(k)) return false;
+  out = number(k, r);
+  return true;
+}
+
+bool ConfigNode::read(const std::string& k, std::optional<double>& out, const limits::Range& r) const {
+  if (!has(k)) return false;
+  out = number(k, r);
+  return true;
+}
+
+bool ConfigNode::read(const std::string& k, long long& out, long long lo, long long hi) const {
+  if (!has(k)) return false;
+  const YAML::Node v = node_->n[k];
+  const std::string what = "must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi);
+  long long x = 0;
+  try {
+    if (!v.IsScalar()) throw YAML::Exception(YAML::Mark(), "not a scalar");
+    x = v.as<long long>();
+  } catch (const YAML::Exception&) {
+    throw error(k, what + ", got " + got(v));
+  }
+  if (x < lo || x > hi) throw error(k, what + ", got " + std::to_string(x));
+  out = x;
+  return true;
+}
+
+bool ConfigNode::read(const std::string& k, int& out, long long lo, long long hi) const {
+  long long v = out;
+  if (!read(k, v, lo, hi)) return false;
+  out = static_cast<int>(v);
+  return true;
+}
+
+bool ConfigNode::read(const std::string& k, std::size_t& out, long long lo, long long hi) const {
+  long long v = static_cast<long long>(out);
+  if (!read(k, v, std::max(0LL, lo), hi)) return false;
+  out = static_cast<std::size_t>(v);
+  return true;
+}
+
+bool ConfigNode::readSeed(const std::string& k, std::uint64_t& out) const {
+  if (!has(k)) return false;
+  const YAML::Node v = node_->n[k];
+  try {
+    if (!v.IsScalar()) throw YAML::Exception(YAML::Mark(), "not a scalar");
+    out = v.as<std::uint64_t>();
+  } catch (const YAML::Exception&) {
+    throw error(k, "must be an integer seed in 0.." + std::to_string(std::numeric_limits<std::uint64_t>::max()) +
+                       ", got " + got(v));
+  }
+  return true;
+}
+
+bool ConfigNode::read(const std::string& k, bool& out) const {
+  if (!has(k)) return false;
+  out = at(k).asBool();
+  return true;
+}
+
+bool ConfigNode::read(const std::string& k, std::string& out) const {
+  if (!has(k)) return false;
+  out = at(k).asText();
+  return true;
+}
+
+std::string ConfigNode::text(const std::string& k, const std::string& what_for, bool non_empty) const {
+  if (!has(k)) throw error(k, "missing" + (what_for.empty() ? std::string() : " (" + what_for + ")"));
+  std::string s;
+  read(k, s);
+  if (non_empty && s.empty()) throw error(k, "must be a non-empty text");
+  return s;
+}
+
+int ConfigNode::readChoice(const std::string& k, std::string& out, const std::vector<std::string>& choices) const {
+  if (!has(k)) return -1;
+  const YAML::Node v = node_->n[k];
+  if (v.IsScalar())
+    for (std::size_t i = 0; i < choices.size(); ++i)
+      if (v.Scalar() == choices[i]) {
+        out = choices[i];
+        return static_cast<int>(i);
+      }
+  throw error(k, "must be one of " + joinNames(choices) + ", got " + got(v));
+}
+
+bool ConfigNode::read(const std::string& k, Eigen::Vector3d& out, const limits::Range& each) const {
+  std::vector<double> v;
+  if (!read(k, v, each, 3, 3)) return false;
+  out = Eigen::Vector3d(v[0], v[1], v[2]);
+  return true;
+}
+
+bool ConfigNode::read(const std::string& k, std::vector<double>& out, const limits::Range& each, std::size_t min,
+                      std::size_t max) const {
+  if (!has(k)) return false;
+  std::string what = "a list of ";
+  if (min == max) what += std::to_string(min) + " numbers";
+  else if (max != SIZE_MAX) what += std::to_string(min) + " to " + std::to_string(max) + " numbers";
+  else what += "numbers";
+  what += " in " + rangeText(each);
+  std::vector<double> xs;
+  for (const auto& item : list(k, min, max, what)) xs.push_back(item.asNumber(each));
+  out = xs;
+  return true;
+}
+
+bool ConfigNode::read(const std::string& k, std::vector<std::string>& out, std::size_t min, std::size_t max) const {
+  if (!has(k)) return false;
+  std::vector<std::string> xs;
+  for (const auto& item : list(k, min, max)) xs.push_back(item.asText());
+  out = xs;
+  return true;
+}
+
+std::string ConfigNode::resolve(const std::string& p) const {
+  if (p.empty() || fs::path(p).is_absolute() || doc_->dir.empty()) return p;
+  return (doc_->dir / p).lexically_normal().string();
+}
+
+std::string ConfigNode::filePath(const std::string& k) const {
+  std::string p;
+  read(k, p);
+  return resolve(p);
+}
+
+std::string ConfigNode::modelRef(const std::string& k) const {
+  std::string spec;
+  read(k, spec);
+  if (spec.empty()) return spec;
+  const auto colon = spec.rfind(':');
+  if (colon == std::string::npos || colon == 0) return resolve(spec);
+  const std::string name = spec.substr(colon + 1);
+  if (name.find('/') != std::string::npos) return resolve(spec);
+  return resolve(spec.substr(0, colon)) + ":" + name;
+}
+
+double ConfigNode::asNumber(const limits::Range& r) const {
+  return numberOf(node_->n, r, doc_->file, path_);
+}
+
+bool ConfigNode::asBool() const {
+  const YAML::Node& v = node_->n;
+  try {
+    if (!v.IsScalar()) throw YAML::Exception(YAML::Mark(), "not a scalar");
+    return v.as<bool>();
+  } catch (const YAML::Exception&) {
+    throw error("must be true or false, got " + got(v));
+  }
+}
+
+std::string ConfigNode::asText() const {
+  const YAML::Node& v = node_->n;
+  if (!v.IsScalar()) throw error("must be a text, got " + got(v));
+  return v.Scalar();
+}
+
+}  // namespace navimpact

@@ -1,0 +1,173 @@
+// The one configuration reader: every failure names the file and the dotted
+// key in one format; unknown and duplicate keys are errors; values are checked
+// for type, unit (the range names it) and range.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "navimpact/core/config.hpp"
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/limits.hpp"
+#include "test_support.hpp"
+
+using navimpact::ConfigNode;
+using navimpact::Error;
+namespace limits = navimpact::limits;
+
+namespace {
+
+template <class F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+ConfigNode doc(const std::string& text) { return ConfigNode::parse(text, "cfg.yaml"); }
+
+}  // namespace
+
+TEST(Config, ReadsTypedValuesAndKeepsDefaultsWhenAbsent) {
+  const ConfigNode c = doc(
+      "rate_hz: 200\nname: uav\nflag: yes\nseed: 18446744073709551615\n"
+      "filter: {propagate_every: 10}\nlever_arm_B_m: [0.5, -0.25, 1]\ntimes_s: [1, 10]\n"
+      "labels: [a, b]\nlist: [{x: 1}, {x: 2}]\n");
+  double rate = 1, absent = 7;
+  EXPECT_TRUE(c.read("rate_hz", rate, limits::kImuRateHz));
+  EXPECT_FALSE(c.read("absent_hz", absent, limits::kImuRateHz));
+  EXPECT_EQ(rate, 200.0);
+  EXPECT_EQ(absent, 7.0);
+  EXPECT_EQ(c.text("name"), "uav");
+  bool flag = false;
+  c.read("flag", flag);
+  EXPECT_TRUE(flag);
+  std::uint64_t seed = 0;
+  c.readSeed("seed", seed);
+  EXPECT_EQ(seed, 18446744073709551615ull);
+  int k = 1;
+  c.map("filter").read("propagate_every", k, 1, 1000);
+  EXPECT_EQ(k, 10);
+  Eigen::Vector3d l = Eigen::Vector3d::Zero();
+  c.read("lever_arm_B_m", l, limits::kLeverArmM);
+  EXPECT_EQ(l, Eigen::Vector3d(0.5, -0.25, 1));
+  std::vector<double> ts;
+  c.read("times_s", ts, limits::kDurationS);
+  EXPECT_EQ(ts, (std::vector<double>{1, 10}));
+  std::vector<std::string> labels;
+  c.read("labels", labels);
+  EXPECT_EQ(labels, (std::vector<std::string>{"a", "b"}));
+  const auto items = c.list("list");
+  ASSERT_EQ(items.size(), 2u);
+  EXPECT_EQ(items[1].path(), "list[1]");
+  EXPECT_EQ(items[1].number("x", limits::kDurationS), 2.0);
+  EXPECT_EQ(c.keys(), (std::vector<std::string>{"rate_hz", "name", "flag", "seed", "filter", "lever_arm_B_m",
+                                                "times_s", "labels", "list"}));
+}
+
+TEST(Config, UnknownKeyNamesTheFileTheDottedKeyAndTheAcceptedKeys) {
+  const ConfigNode c = doc("gnss: {rate_hz: 1, seeed: 4}\nimu: {rate_hz: 200}\n");
+  EXPECT_NO_THROW(c.allowKeys({"imu", "gnss"}));
+  EXPECT_EQ(errorOf([&] { c.map("gnss").allowKeys({"seed", "rate_hz"}); }),
+            "cfg.yaml: key 'gnss.seeed': unknown key (accepted: rate_hz, seed)");
+  EXPECT_EQ(errorOf([&] { c.allowKeys({"gnss"}); }), "cfg.yaml: key 'imu': unknown key (accepted: gnss)");
+  // nested deeper, inside a list
+  const ConfigNode d = doc("sweep:\n  gnss:\n    - {name: a, rate: 1}\n");
+  EXPECT_EQ(errorOf([&] { d.map("sweep").list("gnss")[0].allowKeys({"name", "rate_hz"}); }),
+            "cfg.yaml: key 'sweep.gnss[0].rate': unknown key (accepted: name, rate_hz)");
+}
+
+TEST(Config, DuplicateKeysAreErrorsEvenWhereNothingReadsThem) {
+  // yaml-cpp alone would keep one of the two values silently.
+  EXPECT_EQ(errorOf([] { doc("gnss: {rate_hz: 1}\nbaro: {}\ngnss: {rate_hz: 5}\n"); }),
+            "cfg.yaml: key 'gnss': duplicate key (line 3; first at line 1)");
+  EXPECT_EQ(errorOf([] { doc("a:\n  b:\n    - {c: 1, c: 2}\n"); }),
+            "cfg.yaml: key 'a.b[0].c': duplicate key (line 3; first at line 3)");
+  EXPECT_EQ(errorOf([] { doc("filter:\n  propagate_every: 10\n  propagate_every: 20\n"); }),
+            "cfg.yaml: key 'filter.propagate_every': duplicate key (line 3; first at line 2)");
+  const std::string complex = errorOf([] { doc("? [1, 2]\n: 3\n"); });
+  EXPECT_NE(complex.find("cfg.yaml:1:3: key '?': a key must be a plain name"), std::string::npos) << complex;
+}
+
+TEST(Config, WrongTypeSaysWhatWasExpectedAndWhatCame) {
+  const ConfigNode c = doc("flag: perhaps\nn: [1, 2]\nseed: -5\nv: [1, 2]\nmode: fast\nk: 2.5\n"
+                           "text: {a: 1}\nsigma_m: two\nlong: " + std::string(300, 'x') + "\n");
+  bool b = false;
+  EXPECT_EQ(errorOf([&] { c.read("flag", b); }), "cfg.yaml: key 'flag': must be true or false, got 'perhaps'");
+  double x = 0;
+  EXPECT_EQ(errorOf([&] { c.read("n", x, limits::kDurationS); }),
+            "cfg.yaml: key 'n': must be a number in (0, 604800] s, got a list");
+  EXPECT_EQ(errorOf([&] { c.read("sigma_m", x, limits::kPositionSigmaM); }),
+            "cfg.yaml: key 'sigma_m': must be a number in (0, 10000] m, got 'two'");
+  std::uint64_t s = 0;
+  EXPECT_EQ(errorOf([&] { c.readSeed("seed", s); }),
+            "cfg.yaml: key 'seed': must be an integer seed in 0..18446744073709551615, got '-5'");
+  Eigen::Vector3d v;
+  EXPECT_EQ(errorOf([&] { c.read("v", v, limits::kLeverArmM); }),
+            "cfg.yaml: key 'v': must be a list of 3 numbers in [-100, 100] m, got 2 items");
+  std::string m;
+  EXPECT_EQ(errorOf([&] { c.readChoice("mode", m, {"series", "vanloan"}); }),
+            "cfg.yaml: key 'mode': must be one of series, vanloan, got 'fast'");
+  int k = 0;
+  EXPECT_EQ(errorOf([&] { c.read("k", k, 1, 10); }), "cfg.yaml: key 'k': must be an integer in 1..10, got '2.5'");
+  EXPECT_EQ(errorOf([&] { c.read("text", m); }), "cfg.yaml: key 'text': must be a text, got a map");
+  EXPECT_EQ(errorOf([&] { c.map("flag"); }), "cfg.yaml: key 'flag': must be a map of keys, got 'perhaps'");
+  // a long value is echoed bounded
+  const std::string e = errorOf([&] { c.read("long", k, 1, 10); });
+  EXPECT_LT(e.size(), 120u) << e;
+  EXPECT_NE(e.find("...(300 bytes)"), std::string::npos) << e;
+}
+
+// The range states the unit of the key; both ends are enforced, an open end
+// excluded, non-finite values refused.
+TEST(Config, RangeAndUnitOfEveryNumber) {
+  const ConfigNode c = doc(
+      "rate_hz: 0.5\nhigh_hz: 10000\nsigma_m: 0\ntiny_m: 1e-300\nnan_m: .nan\ninf_m: .inf\n"
+      "lever: [0, 100.5, 0]\nruns: 1000001\n");
+  double x = 0;
+  EXPECT_EQ(errorOf([&] { c.read("rate_hz", x, limits::kImuRateHz); }),
+            "cfg.yaml: key 'rate_hz': must be in [1, 10000] Hz, got 0.5");
+  EXPECT_NO_THROW(c.read("high_hz", x, limits::kImuRateHz));
+  EXPECT_EQ(x, 1e4);
+  EXPECT_EQ(errorOf([&] { c.read("sigma_m", x, limits::kPositionSigmaM); }),
+            "cfg.yaml: key 'sigma_m': must be in (0, 10000] m, got 0");
+  EXPECT_NO_THROW(c.read("tiny_m", x, limits::kPositionSigmaM));
+  EXPECT_NE(errorOf([&] { c.read("nan_m", x, limits::kPositionSigmaM); }).find("key 'nan_m': must be in (0, 10000] m"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { c.read("inf_m", x, limits::kPositionSigmaM); }).find("key 'inf_m': must be in (0, 10000] m"),
+            std::string::npos);
+  Eigen::Vector3d v;
+  EXPECT_EQ(errorOf([&] { c.read("lever", v, limits::kLeverArmM); }),
+            "cfg.yaml: key 'lever[1]': must be in [-100, 100] m, got 100.5");
+  long long runs = 0;
+  EXPECT_EQ(errorOf([&] { c.read("runs", runs, 1, limits::kMaxMonteCarloRuns); }),
+            "cfg.yaml: key 'runs': must be an integer in 1..1000000, got 1000001");
+  EXPECT_EQ(errorOf([&] { c.number("absent_s", limits::kDurationS, "the outage"); }),
+            "cfg.yaml: key 'absent_s': missing (a number in (0, 604800] s: the outage)");
+}
+
+TEST(Config, FilesAreNamedInEveryMessageAndPathsAreRelativeToTheirFolder) {
+  const auto dir = navimpact::test::tempDir();
+  const auto f = (dir / "c.yaml").string();
+  std::ofstream(f) << "data: ../x.csv\nabs: /tmp/y.csv\nmodel: m.yaml:ref\nfilter: {propagate_every: 0}\n";
+  const ConfigNode c = ConfigNode::load(f);
+  EXPECT_EQ(c.filePath("data"), (dir.parent_path() / "x.csv").string());
+  EXPECT_EQ(c.filePath("abs"), "/tmp/y.csv");
+  EXPECT_EQ(c.filePath("none"), "");
+  EXPECT_EQ(c.modelRef("model"), (dir / "m.yaml").string() + ":ref");
+  int k = 1;
+  EXPECT_EQ(errorOf([&] { c.map("filter").read("propagate_every", k, 1, 1000); }),
+            f + ": key 'filter.propagate_every': must be an integer in 1..1000, got 0");
+  EXPECT_EQ(errorOf([] { ConfigNode::load("/nonexistent/c.yaml"); }), "/nonexistent/c.yaml: cannot open (no such file)");
+  const auto bad = (dir / "bad.yaml").string();
+  std::ofstream(bad) << "a: 1\nb: [unclosed\n";
+  EXPECT_NE(errorOf([&] { ConfigNode::load(bad); }).find(bad + ":3:1: YAML syntax error: "), std::string::npos)
+      << errorOf([&] { ConfigNode::load(bad); });
+  const auto lst = (dir / "list.yaml").string();
+  std::ofstream(lst) << "- 1\n- 2\n";
+  EXPECT_EQ(errorOf([&] { ConfigNode::load(lst); }), lst + ": expected a map of keys at the top level, got a list");
+  EXPECT_TRUE(ConfigNode::parse("", "empty.yaml").keys().empty());
+}
