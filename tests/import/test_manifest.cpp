@@ -331,5 +331,27 @@ TEST(ImportManifest, IncrementsAreDividedByTheirOwnInterval) {
   EXPECT_NEAR(d.imu[0].w_IB_B[0], 0.01 / 0.02, 1e-12);
 }
 
+TEST(ImportManifest, ALongRecordIsStreamedNotReadWhole) {
+  // 1.1e6 rows at 200 Hz (1.5 h), ~68 MB of text: more than a whole-file read
+  // would hold (64 MiB); the rows come back in order with their values.
+  const std::size_t n = 1100000;
+  const fs::path dir = test::tempDir();
+  {
+    std::FILE* f = std::fopen((dir / "imu.csv").c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs("t_s,gx,gy,gz,ax,ay,az\n", f);
+    for (std::size_t k = 0; k < n; ++k)
+      std::fprintf(f, "%.3f,%.9f,-0.000012345,0.000023456,0.012345678,-0.023456789,9.806650000\n", k * 0.005,
+                   1e-3 * static_cast<double>(k % 1000));
+    std::fclose(f);
+  }
+  ASSERT_GT(fs::file_size(dir / "imu.csv"), std::uintmax_t(64) << 20);
+  writeFile(dir / "m.yaml", std::string(kManifest).substr(0, std::string(kManifest).find("gnss:")));
+  const Recording d = import::importManifest((dir / "m.yaml").string());
+  ASSERT_EQ(d.imu.size(), n);
+  EXPECT_NEAR(d.imu[n - 1].t - d.imu[0].t, (n - 1) * 0.005, 1e-6);
+  EXPECT_NEAR(std::abs(d.imu[n - 1].w_IB_B.cwiseAbs().maxCoeff()), 0.999, 1e-9);
+}
+
 }  // namespace
 }  // namespace navimpact

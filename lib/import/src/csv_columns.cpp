@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/gz_input.hpp"
 #include "navimpact/core/text_io.hpp"
 
 namespace navimpact::import {
@@ -22,18 +23,13 @@ std::string_view cleanName(std::string_view n) {
 
 ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest>& req, char delimiter) {
   InputScope scope(path);
-  const std::string text = readFileMaybeGz(path);
-  const char* p = text.data();
-  const char* end = text.data() + text.size();
+  // Streamed (lines of at most 1 MiB, plain or gzip): memory is the columns
+  // kept, not the file's text (a 10^6-row IMU file is ~70 MB of text).
+  LineReader reader(path);
   std::size_t lineNo = 0;
   auto nextLine = [&](std::string_view& line) {
-    if (p >= end) return false;
-    const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
-    if (!eol) eol = end;
-    line = std::string_view(p, static_cast<std::size_t>(eol - p));
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    p = eol + 1;
-    ++lineNo;
+    if (!reader.next(line)) return false;
+    lineNo = reader.lineNo();
     return true;
   };
 
@@ -41,7 +37,6 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
   std::string_view header;
   bool found = false;
   while (nextLine(header)) {
-    if (lineNo == 1 && header.size() >= 3 && header.substr(0, 3) == "\xEF\xBB\xBF") header.remove_prefix(3);  // BOM
     const auto t = trim(header);
     if (t.empty() || t.front() == '#') continue;
     found = true;
@@ -49,6 +44,8 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
   }
   if (!found) throw fileError(path, 0, "file is empty (expected a header line naming the columns)");
   const std::size_t headerLine = lineNo;
+  const std::string headerText(header);  // the reader's buffer moves on
+  header = headerText;
   const auto names = splitView(header, delimiter);
   const std::size_t ncol = names.size();
   std::vector<int> slot(ncol, -1);
@@ -84,10 +81,14 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
   // --- rows -----------------------------------------------------------------
   ColumnTable t;
   std::vector<std::vector<double>> byCol(ncol);
-  const std::size_t approx = static_cast<std::size_t>(std::count(p, end, '\n')) + 1;
-  for (std::size_t c = 0; c < ncol; ++c)
-    if (slot[c] >= 0) byCol[c].reserve(approx);
-  t.line.reserve(approx);
+  {  // reserve from the stated decompressed size and the header's line length
+    const std::size_t approx =
+        static_cast<std::size_t>(std::min<std::uint64_t>(reader.input().statedSize() / (header.size() + 1) + 16,
+                                                         std::uint64_t(1) << 20));
+    for (std::size_t c = 0; c < ncol; ++c)
+      if (slot[c] >= 0) byCol[c].reserve(approx);
+    t.line.reserve(approx);
+  }
   std::string_view line;
   while (nextLine(line)) {
     if (trim(line).empty()) continue;
