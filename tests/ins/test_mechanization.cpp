@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <random>
 
 #include "navimpact/ins/mechanization.hpp"
 #include "navimpact/core/error.hpp"
@@ -121,4 +122,53 @@ TEST(NavState, OfAReferenceRecord) {
   ReferenceRecord noVel = r;
   noVel.v_N.reset();
   EXPECT_THROW(ins::navStateOf(noVel, o), Error);
+}
+
+// Mechanization::step carries the latitude terms (trigonometry, radii) of the
+// end of one step into the next: the states must be bit for bit those of the
+// free function, which computes everything from the latitude, also across
+// setState() (a filter update) and at latitude -0 / +0. Random rates and forces
+// (seed printed).
+TEST(Mechanization, CarriedLatitudeTermsGiveTheSameBits) {
+  const std::uint64_t seed = std::random_device{}();
+  std::cout << "seed " << seed << "\n";
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const double lat0 : {46.57 * kDeg, -0.0, 0.0, -71.3 * kDeg}) {
+    ins::NavState x0 = restState();
+    x0.lat = lat0;
+    x0.v_N = Vector3d(40.0 * u(rng), 40.0 * u(rng), 2.0 * u(rng));
+    const double dt = 1.0 / 200.0;
+    ins::Mechanization mech(x0);
+    ins::NavState ref = x0;
+    ins::ImuSample last, last2;
+    earth::LocalGravity gravity;  // the same sequence of gravity calls as inside mech
+    for (int k = 1; k <= 2000; ++k) {
+      const Vector3d w(0.3 * u(rng), 0.3 * u(rng), 0.5 * u(rng)), f(2.0 * u(rng), 2.0 * u(rng), -9.8 + u(rng));
+      const ins::ImuSample s = ins::ImuSample::fromRates(k * dt, dt, w, f);
+      mech.step(s);
+      ref = ins::mechanize(ref, s, k > 1 ? &last : nullptr, k > 2 ? &last2 : nullptr, {}, &gravity);
+      last2 = last;
+      last = s;
+      if (k % 97 == 0) {  // an update moves the state
+        ins::NavState x = mech.state();
+        x.lat += 1e-7 * u(rng);
+        x.v_N.x() += 0.01 * u(rng);
+        mech.setState(x);
+        ref = x;
+      }
+      const ins::NavState& a = mech.state();
+      ASSERT_TRUE(a.lat == ref.lat && a.lon == ref.lon && a.h == ref.h && a.v_N == ref.v_N &&
+                  a.q_BtoN.coeffs() == ref.q_BtoN.coeffs())
+          << "step " << k << " from latitude " << lat0;
+    }
+  }
+  for (const double lat : {0.0, -0.0, 0.3, -1.2, 1.5}) {
+    const earth::LatitudeTerms l(lat);
+    const earth::Radii r = earth::radii(lat);
+    EXPECT_TRUE(l.r.R_N == r.R_N && l.r.R_E == r.R_E && l.r.dR_N_dlat == r.dR_N_dlat && l.r.dR_E_dlat == r.dR_E_dlat);
+    const Vector3d v(12.0, -7.0, 1.0);
+    EXPECT_TRUE(earth::w_IE_N(l) == earth::w_IE_N(lat));
+    EXPECT_TRUE(earth::w_EN_N(l, 300.0, v) == earth::w_EN_N(lat, 300.0, v));
+  }
 }

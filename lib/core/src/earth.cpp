@@ -13,8 +13,8 @@ constexpr double kRad2Deg = 180.0 / 3.14159265358979323846;
 constexpr double kDeg2Rad = 3.14159265358979323846 / 180.0;
 }  // namespace
 
-Radii radii(double lat) {
-  const double s = std::sin(lat), c = std::cos(lat);
+namespace {
+Radii radiiOf(double s, double c) {
   const double w2 = 1.0 - kE2 * s * s;
   const double w = std::sqrt(w2);
   Radii r;
@@ -25,6 +25,13 @@ Radii radii(double lat) {
   r.dR_E_dlat = r.R_E * kE2 * s * c / w2;
   return r;
 }
+}  // namespace
+
+Radii radii(double lat) { return radiiOf(std::sin(lat), std::cos(lat)); }
+
+LatitudeTerms::LatitudeTerms(double latitude)
+    : lat(latitude), sin_lat(std::sin(latitude)), cos_lat(std::cos(latitude)), tan_lat(std::tan(latitude)),
+      r(radiiOf(sin_lat, cos_lat)) {}
 
 Eigen::Vector3d gravity_N(double lat, double h) {
   static const GeographicLib::NormalGravity& ng = GeographicLib::NormalGravity::WGS84();
@@ -67,14 +74,24 @@ void gravityGradient(double lat, double h, double& dgD_dlat, double& dgD_dh) {
   dgD_dh = -2.0 * gamma0 / kA * (1.0 + kF + m - 2.0 * kF * s2) + 6.0 * gamma0 * h / (kA * kA);
 }
 
-Eigen::Vector3d w_IE_N(double lat) {
-  return Eigen::Vector3d(kOmegaIE * std::cos(lat), 0.0, -kOmegaIE * std::sin(lat));  // Groves 5.41
+namespace {
+Eigen::Vector3d w_IE_Nof(double s, double c) {
+  return Eigen::Vector3d(kOmegaIE * c, 0.0, -kOmegaIE * s);  // Groves 5.41
 }
+Eigen::Vector3d w_EN_Nof(const Radii& r, double t, double h, const Eigen::Vector3d& v_N) {
+  return Eigen::Vector3d(v_N.y() / (r.R_E + h), -v_N.x() / (r.R_N + h),
+                         -v_N.y() * t / (r.R_E + h));  // Groves 5.44
+}
+}  // namespace
+
+Eigen::Vector3d w_IE_N(double lat) { return w_IE_Nof(std::sin(lat), std::cos(lat)); }
+Eigen::Vector3d w_IE_N(const LatitudeTerms& l) { return w_IE_Nof(l.sin_lat, l.cos_lat); }
 
 Eigen::Vector3d w_EN_N(double lat, double h, const Eigen::Vector3d& v_N) {
-  const Radii r = radii(lat);
-  return Eigen::Vector3d(v_N.y() / (r.R_E + h), -v_N.x() / (r.R_N + h),
-                         -v_N.y() * std::tan(lat) / (r.R_E + h));  // Groves 5.44
+  return w_EN_Nof(radii(lat), std::tan(lat), h, v_N);
+}
+Eigen::Vector3d w_EN_N(const LatitudeTerms& l, double h, const Eigen::Vector3d& v_N) {
+  return w_EN_Nof(l.r, l.tan_lat, h, v_N);
 }
 
 Eigen::Matrix3d C_EtoN(double lat, double lon) {

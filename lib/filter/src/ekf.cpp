@@ -11,6 +11,7 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "nine_row_product.hpp"
 
 namespace navimpact::filter {
 
@@ -18,6 +19,7 @@ using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 using ins::skew;
+using detail::nineRowProduct;
 
 Discretization parseDiscretization(const std::string& s) {
   if (s == "series") return Discretization::Series;
@@ -240,11 +242,13 @@ void ErrorStateEkf::buildTransition(const Lin& L, double dt, Transition& T) cons
     }
   }
   const double dt2 = dt * dt, dt3 = dt2 * dt;
-  const Matrix9d Fnn2 = Fnn * Fnn;
+  // the products below skip the zeros of F_ni, Q_nn (nine_row_product.hpp)
+  Matrix9d Fnn2;
+  nineRowProduct(Fnn2, Fnn, Fnn, true);
   T.A = Matrix9d::Identity() + Fnn * dt + Fnn2 * (0.5 * dt2);
   // B = Fni dt + (Fnn Fni + Fni Fii) dt^2/2
   T.B.resize(9, m);
-  T.B.noalias() = Fnn * Fni;
+  nineRowProduct(T.B, Fnn, Fni, true);
   T.B += FniFii;
   T.B *= 0.5 * dt2;
   T.B += Fni * dt;
@@ -253,16 +257,17 @@ void ErrorStateEkf::buildTransition(const Lin& L, double dt, Transition& T) cons
   Qnn.block<3, 3>(kAtt, kAtt) = L.Qa;
   // Qd = Q dt + (FQ + QF') dt^2/2 + (F^2 Q + 2 F Q F' + Q F^2') dt^3/6 + O(dt^4),
   // with Q = blockdiag(Qnn, Qii) and F = [Fnn Fni; 0 Fii]:
-  const Matrix9d FQ = Fnn * Qnn;
-  const Matrix9d F2Q = Fnn2 * Qnn;
-  Matrix9d FQFt = FQ * Fnn.transpose();
-  FQFt.noalias() += FniQii * Fni.transpose();
+  Matrix9d FQ, F2Q, FQFt;
+  nineRowProduct(FQ, Fnn, Qnn, true);
+  nineRowProduct(F2Q, Fnn2, Qnn, true);
+  nineRowProduct(FQFt, FQ, Fnn.transpose(), true);
+  nineRowProduct(FQFt, FniQii, Fni.transpose(), false);
   T.Q.topLeftCorner<9, 9>() = Qnn * dt + (FQ + FQ.transpose()) * (0.5 * dt2) +
                               (F2Q + F2Q.transpose() + 2.0 * FQFt) * (dt3 / 6.0);
   // Qni = Fni Qii dt^2/2 + (Fnn Fni Qii + Fni Fii Qii + 2 Fni Qii Fii') dt^3/6
   MatrixXd& Qni = c.Qni;
   Qni.resize(9, m);
-  Qni.noalias() = Fnn * FniQii;
+  nineRowProduct(Qni, Fnn, FniQii, true);
   Qni += FniFiiQii + 2.0 * FniQiiFii;
   Qni *= dt3 / 6.0;
   Qni += FniQii * (0.5 * dt2);
@@ -387,13 +392,16 @@ void ErrorStateEkf::propagate(const Matrix9d& A_acc_, const MatrixXd& B_acc_, co
   const Matrix9d Pnn = P_.topLeftCorner<9, 9>();
   const auto Pni = P_.topRightCorner(9, m);
   auto Pii = P_.bottomRightCorner(m, m);
+  // (products skipping the zeros of B and the IMU blocks: nine_row_product.hpp)
   MatrixXd& Mni = cache_->Mni;
-  Matrix9d Mnn = A_acc_ * Pnn;
-  Mnn.noalias() += B_acc_ * Pni.transpose();
-  Mni.noalias() = A_acc_ * Pni;
-  Mni.noalias() += B_acc_ * Pii;
-  Matrix9d Pnn1 = Mnn * A_acc_.transpose();
-  Pnn1.noalias() += Mni * B_acc_.transpose();
+  Mni.resize(9, m);
+  Matrix9d Mnn, Pnn1;
+  nineRowProduct(Mnn, A_acc_, Pnn, true);
+  nineRowProduct(Mnn, B_acc_, Pni.transpose(), false);
+  nineRowProduct(Mni, A_acc_, Pni, true);
+  nineRowProduct(Mni, B_acc_, Pii, false);
+  nineRowProduct(Pnn1, Mnn, A_acc_.transpose(), true);
+  nineRowProduct(Pnn1, Mni, B_acc_.transpose(), false);
   rightMulDt(Mni, D_acc_, blocks);
   leftMulD(Pii, D_acc_, blocks);   // in place on P
   rightMulDt(Pii, D_acc_, blocks);

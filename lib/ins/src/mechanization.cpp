@@ -2,6 +2,7 @@
 #include "navimpact/ins/mechanization.hpp"
 
 #include <cmath>
+#include <cstring>
 
 namespace navimpact::ins {
 
@@ -15,6 +16,13 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
 NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
                    const ImuSample* last2, const MechanizationOptions& opt,
                    earth::LocalGravity* gravity) {
+  return mechanize(prev, cur, last, last2, opt, gravity, earth::LatitudeTerms(prev.lat), nullptr);
+}
+
+NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
+                   const ImuSample* last2, const MechanizationOptions& opt,
+                   earth::LocalGravity* gravity, const earth::LatitudeTerms& L0,
+                   std::optional<earth::LatitudeTerms>* L1_out) {
   const double tau = cur.dt;
   const Vector3d& a = cur.dtheta_B;  // alpha_IB_B
   const Vector3d& u = cur.dv_B;      // upsilon_IB_B
@@ -61,9 +69,10 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
   const Vector3d axu = a.cross(u);
   const Vector3d u_c = u + c1 * axu + c2 * a.cross(axu) + scul;
 
-  const earth::Radii r0 = earth::radii(prev.lat);
-  const Vector3d w_ie0 = earth::w_IE_N(prev.lat);
-  const Vector3d w_en0 = earth::w_EN_N(prev.lat, prev.h, prev.v_N);
+  // trigonometry and radii once per latitude (L0: prev.lat, given by the caller)
+  const earth::Radii& r0 = L0.r;
+  const Vector3d w_ie0 = earth::w_IE_N(L0);
+  const Vector3d w_en0 = earth::w_EN_N(L0, prev.h, prev.v_N);
   const Eigen::Matrix3d C0 = prev.C_BtoN();
 
   // Specific-force frame transformation with the mean N-frame rotation (Groves 5.86).
@@ -78,8 +87,9 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
     const double h_mid = prev.h - 0.5 * tau * v_mid.z();
     const double lat_mid = prev.lat + 0.5 * tau * v_mid.x() / (r0.R_N + h_mid);
     const Vector3d g_mid = gravity ? (*gravity)(lat_mid, h_mid) : earth::gravity_N(lat_mid, h_mid);
-    const Vector3d w_ie_mid = earth::w_IE_N(lat_mid);
-    const Vector3d w_en_mid = earth::w_EN_N(lat_mid, h_mid, v_mid);
+    const earth::LatitudeTerms Lmid(lat_mid);
+    const Vector3d w_ie_mid = earth::w_IE_N(Lmid);
+    const Vector3d w_en_mid = earth::w_EN_N(Lmid, h_mid, v_mid);
     v1 = prev.v_N + dv_f_N + (g_mid - (2.0 * w_ie_mid + w_en_mid).cross(v_mid)) * tau;
   }
 
@@ -88,22 +98,29 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
   x.t = cur.t;
   x.h = prev.h - 0.5 * tau * (prev.v_N.z() + v1.z());
   x.lat = prev.lat + 0.5 * tau * (prev.v_N.x() / (r0.R_N + prev.h) + v1.x() / (r0.R_N + x.h));
-  const earth::Radii r1 = earth::radii(x.lat);
-  x.lon = prev.lon + 0.5 * tau * (prev.v_N.y() / ((r0.R_E + prev.h) * std::cos(prev.lat)) +
-                                  v1.y() / ((r1.R_E + x.h) * std::cos(x.lat)));
+  const earth::LatitudeTerms L1(x.lat);
+  const earth::Radii& r1 = L1.r;
+  x.lon = prev.lon + 0.5 * tau * (prev.v_N.y() / ((r0.R_E + prev.h) * L0.cos_lat) +
+                                  v1.y() / ((r1.R_E + x.h) * L1.cos_lat));
   x.v_N = v1;
 
   // Attitude update: body rotation (corrected increment) and N-frame rotation
   // over the interval with the mean omega_IN (Groves 5.73 in quaternion form).
   const double lat_m = 0.5 * (prev.lat + x.lat), h_m = 0.5 * (prev.h + x.h);
-  const Vector3d w_in_mid =
-      earth::w_IE_N(lat_m) + earth::w_EN_N(lat_m, h_m, 0.5 * (prev.v_N + v1));
+  const earth::LatitudeTerms Lm(lat_m);
+  const Vector3d w_in_mid = earth::w_IE_N(Lm) + earth::w_EN_N(Lm, h_m, 0.5 * (prev.v_N + v1));
   x.q_BtoN = (quatFromRotVec(-w_in_mid * tau) * prev.q_BtoN * quatFromRotVec(a_c)).normalized();
+  if (L1_out) L1_out->emplace(L1);
   return x;
 }
 
 void Mechanization::step(const ImuSample& s) {
-  x_ = mechanize(x_, s, has_last_ ? &last_ : nullptr, has_last2_ ? &last2_ : nullptr, opt_, &gravity_);
+  // the latitude terms of the end of the last step serve this one unless the
+  // state was changed in between (a filter update, setState)
+  // (compared bit for bit: sin(-0) is -0)
+  if (!lat_terms_ || std::memcmp(&lat_terms_->lat, &x_.lat, sizeof(double)) != 0) lat_terms_.emplace(x_.lat);
+  x_ = mechanize(x_, s, has_last_ ? &last_ : nullptr, has_last2_ ? &last2_ : nullptr, opt_, &gravity_,
+                 *lat_terms_, &lat_terms_);
   if (has_last_) {
     last2_ = last_;
     has_last2_ = true;

@@ -123,6 +123,22 @@ Eigen::Vector3d w_IE_N(double lat);
 Eigen::Vector3d w_EN_N(double lat, double h, const Eigen::Vector3d& v_N);
 
 /**
+ * The trigonometry of one latitude and its radii, computed once for the
+ * functions above (the mechanization meets each latitude several times per
+ * step). Every value is the same as from the function of the latitude:
+ * radii(l) == radii(l.lat), w_IE_N(l) == w_IE_N(l.lat),
+ * w_EN_N(l, h, v) == w_EN_N(l.lat, h, v), bit for bit.
+ */
+struct LatitudeTerms {
+  explicit LatitudeTerms(double lat);
+  double lat;     ///< [rad]
+  double sin_lat, cos_lat, tan_lat;
+  Radii r;
+};
+Eigen::Vector3d w_IE_N(const LatitudeTerms& l);
+Eigen::Vector3d w_EN_N(const LatitudeTerms& l, double h, const Eigen::Vector3d& v_N);
+
+/**
  * Rotation matrix from ECEF to NED at (lat, lon) (Groves 2.150 transposed).
  * @param[in] lat, lon  geodetic latitude and longitude [rad].
  */

@@ -15,6 +15,8 @@
  */
 #pragma once
 
+#include <optional>
+
 #include "navimpact/core/earth.hpp"
 #include "navimpact/ins/nav_state.hpp"
 
@@ -58,6 +60,16 @@ NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* 
                    const ImuSample* last2, const MechanizationOptions& opt = {},
                    earth::LocalGravity* gravity = nullptr);
 
+/**
+ * The same step with the latitude terms of prev.lat given (@p L0, equal to
+ * earth::LatitudeTerms(prev.lat)); the terms of the new latitude are stored in
+ * @p L1_out when it is not null (the next step's L0). Same result, bit for bit.
+ */
+NavState mechanize(const NavState& prev, const ImuSample& cur, const ImuSample* last,
+                   const ImuSample* last2, const MechanizationOptions& opt,
+                   earth::LocalGravity* gravity, const earth::LatitudeTerms& L0,
+                   std::optional<earth::LatitudeTerms>* L1_out);
+
 /// Stateful wrapper: keeps the current state and the previous increments.
 class Mechanization {
  public:
@@ -86,7 +98,8 @@ class Mechanization {
  private:
   NavState x_;
   MechanizationOptions opt_;
-  earth::LocalGravity gravity_;  ///< GeographicLib normal gravity, linearised per 10 m / 640 m box
+  earth::LocalGravity gravity_;
+  std::optional<earth::LatitudeTerms> lat_terms_;  ///< of x_.lat when it was computed  ///< GeographicLib normal gravity, linearised per 10 m / 640 m box
   ImuSample last_, last2_;
   bool has_last_ = false, has_last2_ = false;
 };
