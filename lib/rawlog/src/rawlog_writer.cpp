@@ -2,7 +2,6 @@
 #include "navimpact/rawlog/writer.hpp"
 
 #include <mrpt/io/CFileGZInputStream.h>
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationGPS.h>
 #include <mrpt/obs/CObservationIMU.h>
@@ -22,6 +21,7 @@
 
 #include "entry_reader.hpp"
 #include "foreign_reader.hpp"
+#include "gz_member_sink.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
@@ -69,9 +69,8 @@ Eigen::Matrix4f cov4(const Eigen::Matrix3d& c) {
 }  // namespace
 
 void writeRawlog(const std::string& path, const Recording& d, const RawlogWriteOptions& opt) {
-  mrpt::io::CFileGZOutputStream out;
-  if (!out.open(path, opt.gzip ? std::clamp(opt.gzip_level, 1, 9) : 0))
-    throw Error(path + ": cannot open the rawlog for writing");
+  // gzip members compressed on worker threads (see gz_member_sink.hpp)
+  detail::GzMemberSink out(path, opt.gzip ? std::clamp(opt.gzip_level, 1, 9) : 0);
   auto arch = mrpt::serialization::archiveFrom(out);
   const long long su = d.start_unix_s;
   auto rel = [&](double t) { return t - d.t_start_s; };
