@@ -26,13 +26,13 @@ navimpact_cli_fail(cli_error_cli_conversion EXIT 2 ARGS wv --input x.csv --eff a
 navimpact_cli_fail(cli_error_cli_unknown_command EXIT 2 ARGS frobnicate
   REGEX "^navimpact: unknown command 'frobnicate' \\(commands: covariance, diagnose, .*\\)$")
 
-# yaml-cpp conversion errors: the file, line and column.
+# A value of the wrong type: the file and the dotted key, what is accepted and what came.
 file(READ ${CMAKE_SOURCE_DIR}/config/replay/default.yaml _rc)
 string(REPLACE "rawlog: ../../" "rawlog: ${CMAKE_SOURCE_DIR}/" _rc "${_rc}")
 string(REPLACE "use_gnss_velocity: true " "use_gnss_velocity: perhaps" _rc "${_rc}")
 file(WRITE ${_erd}/perhaps.yaml "${_rc}")
 navimpact_cli_fail(cli_error_yaml_bad_conversion EXIT 1 ARGS replay --config ${_erd}/perhaps.yaml --out ${_erd}/o4
-  REGEX "^navimpact: [^ ]*perhaps.yaml:12:22: bad conversion")
+  REGEX "^navimpact: [^ ]*perhaps.yaml: key 'filter.use_gnss_velocity': must be true or false, got 'perhaps'$")
 file(WRITE ${_erd}/complex_key.yaml "rawlog: x.rawlog\n? [a, b]\n: 1\n")
 navimpact_cli_fail(cli_error_yaml_complex_key EXIT 1 ARGS replay --config ${_erd}/complex_key.yaml --out ${_erd}/o5
   REGEX "complex_key.yaml:2:[0-9]+: ")

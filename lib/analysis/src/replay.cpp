@@ -16,6 +16,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/text_io.hpp"
@@ -32,220 +33,137 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-std::string resolve(const fs::path& dir, const std::string& p) {
-  if (p.empty() || fs::path(p).is_absolute() || dir.empty()) return p;
-  return (dir / p).lexically_normal().string();
-}
+/// Angles given in degrees (attitude, heading) [deg].
+constexpr limits::Range kAngleDeg{-360.0, 360.0, false, "deg"};
+/// Angle sigmas [deg].
+constexpr limits::Range kAngleSigmaDeg{0.0, 180.0, true, "deg"};
+/// Start of an outage from time zero [s].
+constexpr limits::Range kOutageStartS{0.0, limits::kDurationS.hi, false, "s"};
+/// The reference's own sigmas (0: exact) [m].
+constexpr limits::Range kReferenceSigmaM{0.0, limits::kPositionSigmaM.hi, false, "m"};
+/// Sigmas of the at-rest detector: gyroscope [rad/s], accelerometer [m/s^2].
+constexpr limits::Range kGyroSigmaRadS{0.0, 1000.0, true, "rad/s"};
+constexpr limits::Range kAccSigmaMps2{0.0, 1.0e5, true, "m/s^2"};
+/// A speed (0 allowed) [m/s].
+constexpr limits::Range kSpeedMps{0.0, 1.0e3, false, "m/s"};
 
-std::string resolveModel(const fs::path& dir, const std::string& spec) {
-  const auto colon = spec.rfind(':');
-  if (colon != std::string::npos && colon > 1) return resolve(dir, spec.substr(0, colon)) + spec.substr(colon);
-  return resolve(dir, spec);
+/// A sigma given for all three axes (one number) or per axis ([x, y, z]).
+Eigen::Vector3d sigma3(const ConfigNode& n, const std::string& k, const limits::Range& r) {
+  if (n.child(k).isList()) {
+    Eigen::Vector3d v;
+    n.read(k, v, r);
+    return v;
+  }
+  return Eigen::Vector3d::Constant(n.number(k, r));
 }
 
 }  // namespace
 
-static ReplayConfig loadReplayConfigImpl(const std::string& path) {
+ReplayConfig loadReplayConfig(const std::string& path) {
   InputScope scope(path);
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw Error(path + ": cannot open the replay configuration");
-  } catch (const YAML::Exception& e) {
-    throw fileError(path, e.mark.line + 1, std::string("YAML syntax: ") + printable(e.msg, 120));
-  }
   ReplayConfig c;
   c.config_file = path;
-  const fs::path dir = fs::path(path).parent_path();
-  if (!root.IsMap()) throw keyError(path, "(root)", "expected a map");
-  const std::set<std::string> allowed = {"rawlog", "model", "outages", "filter", "initial_sigma", "noise",
-                                         "gnss_lever_arm_B_m", "initial_attitude_deg", "record_interval_s",
-                                         "outages_every", "reference_sigma", "reference_lever_arm_B_m", "alignment",
-                                         "imu_at_rest", "aids"};
-  for (const auto& kv : root)
-    if (!allowed.count(kv.first.as<std::string>()))
-      throw keyError(path, kv.first.as<std::string>(),
-                     "unknown key (expected rawlog, model, outages, filter, initial_sigma, noise, gnss_lever_arm_B_m, "
-                     "initial_attitude_deg, record_interval_s, outages_every, reference_sigma, reference_lever_arm_B_m, "
-                     "alignment, imu_at_rest, aids)");
-  auto num = [&](const YAML::Node& n, const std::string& key) {
-    try {
-      return n.as<double>();
-    } catch (const YAML::Exception&) {
-      throw keyError(path, key, "expected a number");
-    }
-  };
-  auto pos = [&](const YAML::Node& n, const std::string& key) {
-    const double v = num(n, key);
-    if (!(v > 0.0)) throw keyError(path, key, "must be > 0");
-    return v;
-  };
-  auto subKeys = [&](const YAML::Node& n, const std::string& name, const std::set<std::string>& ok) {
-    if (!n.IsMap()) throw keyError(path, name, "expected a map");
-    for (const auto& kv : n)
-      if (!ok.count(kv.first.as<std::string>()))
-        throw keyError(path, name + "." + kv.first.as<std::string>(), "unknown key");
-  };
-  if (root["rawlog"]) c.rawlog = resolve(dir, root["rawlog"].as<std::string>());
-  if (root["model"]) c.model_spec = resolveModel(dir, root["model"].as<std::string>());
-  if (const auto o = root["outages"]) {
-    if (!o.IsSequence()) throw keyError(path, "outages", "expected a list of {start_s, duration_s}");
-    for (std::size_t i = 0; i < o.size(); ++i) {
-      const std::string k = "outages[" + std::to_string(i) + "]";
-      subKeys(o[i], k, {"start_s", "duration_s"});
-      if (!o[i]["start_s"] || !o[i]["duration_s"]) throw keyError(path, k, "needs start_s and duration_s [s]");
-      const Outage w = Outage::fromStartDuration(num(o[i]["start_s"], k + ".start_s"), pos(o[i]["duration_s"], k + ".duration_s"));
-      if (!(w.start_s >= 0.0)) throw keyError(path, k + ".start_s", "must be >= 0");
-      c.outages.push_back(w);
-    }
-  }
-  if (const auto f = root["filter"]) {
-    subKeys(f, "filter", {"propagate_every", "use_gnss_velocity", "gate_probability", "gate_readmit_after",
-                           "max_imu_gap_s"});
-    if (f["max_imu_gap_s"]) {
-      c.max_imu_gap_s = limits::check(path, "filter.max_imu_gap_s", num(f["max_imu_gap_s"], "filter.max_imu_gap_s"),
-                                      limits::Range{0.0, kMaxImuGapS, false, "s"});
-    }
-    if (f["propagate_every"]) {
-      c.propagate_every = f["propagate_every"].as<int>();
-      if (c.propagate_every < 1) throw keyError(path, "filter.propagate_every", "must be >= 1");
-    }
-    if (f["use_gnss_velocity"]) c.use_gnss_velocity = f["use_gnss_velocity"].as<bool>();
-    if (f["gate_probability"]) c.gate_probability = num(f["gate_probability"], "filter.gate_probability");
-    if (f["gate_readmit_after"]) {
-      const double v = limits::check(path, "filter.gate_readmit_after",
-                                     num(f["gate_readmit_after"], "filter.gate_readmit_after"),
-                                     limits::Range{0.0, 1000.0, false, ""});
-      if (v != std::floor(v)) throw keyError(path, "filter.gate_readmit_after", "must be an integer in 0..1000");
-      c.gate_readmit_after = static_cast<int>(v);
-    }
-  }
-  if (const auto p = root["initial_sigma"]) {
-    subKeys(p, "initial_sigma", {"pos_h_m", "pos_v_m", "vel_mps", "roll_pitch_deg", "yaw_deg"});
-    if (p["pos_h_m"]) c.p0_pos_h_m = pos(p["pos_h_m"], "initial_sigma.pos_h_m");
-    if (p["pos_v_m"]) c.p0_pos_v_m = pos(p["pos_v_m"], "initial_sigma.pos_v_m");
-    if (p["vel_mps"]) c.p0_vel_mps = pos(p["vel_mps"], "initial_sigma.vel_mps");
-    if (p["roll_pitch_deg"]) c.p0_roll_pitch_deg = pos(p["roll_pitch_deg"], "initial_sigma.roll_pitch_deg");
-    if (p["yaw_deg"]) c.p0_yaw_deg = pos(p["yaw_deg"], "initial_sigma.yaw_deg");
-  }
-  if (const auto n = root["noise"]) {
-    subKeys(n, "noise", {"sigma_pos_h_m", "sigma_pos_v_m", "sigma_vel_h_mps", "sigma_vel_v_mps", "sigma_baro_m"});
-    auto ranged = [&](const char* k, const limits::Range& range) {
-      return limits::check(path, std::string("noise.") + k, num(n[k], std::string("noise.") + k), range);
-    };
-    if (n["sigma_pos_h_m"]) c.sigma_pos_h_m = ranged("sigma_pos_h_m", limits::kPositionSigmaM);
-    if (n["sigma_pos_v_m"]) c.sigma_pos_v_m = ranged("sigma_pos_v_m", limits::kPositionSigmaM);
-    if (n["sigma_vel_h_mps"]) c.sigma_vel_h_mps = ranged("sigma_vel_h_mps", limits::kVelocitySigmaMps);
-    if (n["sigma_vel_v_mps"]) c.sigma_vel_v_mps = ranged("sigma_vel_v_mps", limits::kVelocitySigmaMps);
-    if (n["sigma_baro_m"]) c.sigma_baro_m = ranged("sigma_baro_m", limits::kPositionSigmaM);
-  }
-  if (const auto l = root["gnss_lever_arm_B_m"]) {
-    if (!l.IsSequence() || l.size() != 3) throw keyError(path, "gnss_lever_arm_B_m", "expected [x, y, z] in metres");
-    Eigen::Vector3d v;
-    for (int k = 0; k < 3; ++k) {
-      const std::string key = "gnss_lever_arm_B_m[" + std::to_string(k) + "]";
-      v[k] = limits::check(path, key, num(l[k], key), limits::kLeverArmM);
-    }
-    c.lever_arm_B = v;
-  }
-  if (const auto a = root["initial_attitude_deg"]) {
-    if (!a.IsSequence() || a.size() != 3)
-      throw keyError(path, "initial_attitude_deg", "expected [roll, pitch, yaw] in degrees");
-    c.initial_attitude_deg = Eigen::Vector3d(num(a[0], "initial_attitude_deg"), num(a[1], "initial_attitude_deg"),
-                                             num(a[2], "initial_attitude_deg"));
-  }
-  if (root["record_interval_s"]) c.record_interval_s = pos(root["record_interval_s"], "record_interval_s");
-  auto nonneg = [&](const YAML::Node& n, const std::string& key) {
-    const double v = num(n, key);
-    if (!(v >= 0.0) || !std::isfinite(v)) throw keyError(path, key, "must be >= 0");
-    return v;
-  };
-  auto vec3 = [&](const YAML::Node& n, const std::string& key) {
-    if (!n.IsSequence() || n.size() != 3) throw keyError(path, key, "expected [x, y, z]");
-    return Eigen::Vector3d(num(n[0], key), num(n[1], key), num(n[2], key));
-  };
-  auto sigma3 = [&](const YAML::Node& n, const std::string& key) {
-    if (n.IsSequence()) {
-      const Eigen::Vector3d v = vec3(n, key);
-      if (!(v.array() > 0.0).all()) throw keyError(path, key, "must be > 0");
-      return v;
-    }
-    return Eigen::Vector3d::Constant(pos(n, key)).eval();
-  };
-  if (const auto o = root["outages_every"]) {
-    subKeys(o, "outages_every", {"period_s", "duration_s"});
-    if (!o["period_s"] || !o["duration_s"]) throw keyError(path, "outages_every", "needs period_s and duration_s [s]");
-    OutagePattern p{pos(o["period_s"], "outages_every.period_s"), pos(o["duration_s"], "outages_every.duration_s")};
-    if (!(p.period_s > p.duration_s))
-      throw keyError(path, "outages_every.period_s", "must exceed duration_s (GNSS time to reconverge)");
-    c.outages_every = p;
-  }
-  if (const auto r = root["reference_sigma"]) {
-    subKeys(r, "reference_sigma", {"horizontal_m", "vertical_m"});
-    if (r["horizontal_m"]) c.reference_sigma_h_m = nonneg(r["horizontal_m"], "reference_sigma.horizontal_m");
-    if (r["vertical_m"]) c.reference_sigma_v_m = nonneg(r["vertical_m"], "reference_sigma.vertical_m");
-  }
-  if (root["reference_lever_arm_B_m"]) c.reference_lever_arm_B = vec3(root["reference_lever_arm_B_m"], "reference_lever_arm_B_m");
-  if (const auto a = root["alignment"]) {
-    subKeys(a, "alignment", {"yaw_deg", "yaw_sigma_deg", "max_align_s", "max_course_sigma_deg", "min_static_s",
-                             "max_level_s", "sideslip_sigma_deg"});
-    if (a["yaw_deg"]) {
-      c.alignment.yaw_rad = num(a["yaw_deg"], "alignment.yaw_deg") * kDeg;
-      c.alignment.yaw_source = "configuration";
-    }
-    if (a["yaw_sigma_deg"]) c.alignment.yaw_sigma_rad = pos(a["yaw_sigma_deg"], "alignment.yaw_sigma_deg") * kDeg;
-    if (a["max_align_s"]) c.alignment.max_align_s = pos(a["max_align_s"], "alignment.max_align_s");
-    if (a["max_course_sigma_deg"])
-      c.alignment.max_course_sigma_rad = pos(a["max_course_sigma_deg"], "alignment.max_course_sigma_deg") * kDeg;
-    if (a["sideslip_sigma_deg"])
-      c.alignment.sideslip_sigma_rad = pos(a["sideslip_sigma_deg"], "alignment.sideslip_sigma_deg") * kDeg;
-    if (a["min_static_s"]) c.alignment.min_static_s = pos(a["min_static_s"], "alignment.min_static_s");
-    if (a["max_level_s"]) c.alignment.max_level_s = pos(a["max_level_s"], "alignment.max_level_s");
-  }
-  if (const auto r = root["imu_at_rest"]) {
-    subKeys(r, "imu_at_rest", {"gyro_sigma_rad_s", "acc_sigma_mps2", "window_s", "false_alarm", "max_mean_rate_rad_s"});
-    auto& d = c.alignment.detector;
-    if (r["gyro_sigma_rad_s"]) d.gyro_sigma_rad_s = sigma3(r["gyro_sigma_rad_s"], "imu_at_rest.gyro_sigma_rad_s");
-    if (r["acc_sigma_mps2"]) d.acc_sigma_mps2 = sigma3(r["acc_sigma_mps2"], "imu_at_rest.acc_sigma_mps2");
-    if (r["window_s"]) d.window_s = pos(r["window_s"], "imu_at_rest.window_s");
-    if (r["false_alarm"]) {
-      d.false_alarm = num(r["false_alarm"], "imu_at_rest.false_alarm");
-      if (!(d.false_alarm > 0.0 && d.false_alarm < 0.5)) throw keyError(path, "imu_at_rest.false_alarm", "must be in (0, 0.5)");
-    }
-    if (r["max_mean_rate_rad_s"]) d.max_mean_rate_rad_s = pos(r["max_mean_rate_rad_s"], "imu_at_rest.max_mean_rate_rad_s");
-  }
-  c.aids.zupt_detector = c.alignment.detector;
-  if (const auto a = root["aids"]) {
-    subKeys(a, "aids", {"zupt", "nhc"});
-    if (const auto z = a["zupt"]) {
-      subKeys(z, "aids.zupt", {"sigma_mps", "interval_s"});
-      c.aids.zupt = true;
-      if (z["sigma_mps"]) c.aids.zupt_sigma_mps = pos(z["sigma_mps"], "aids.zupt.sigma_mps");
-      if (z["interval_s"]) c.aids.zupt_interval_s = pos(z["interval_s"], "aids.zupt.interval_s");
-    }
-    if (const auto n = a["nhc"]) {
-      subKeys(n, "aids.nhc", {"sigma_lateral_mps", "sigma_vertical_mps", "interval_s", "min_speed_mps", "point_B_m"});
-      c.aids.nhc = true;
-      if (n["sigma_lateral_mps"]) c.aids.nhc_sigma_lateral_mps = pos(n["sigma_lateral_mps"], "aids.nhc.sigma_lateral_mps");
-      if (n["sigma_vertical_mps"])
-        c.aids.nhc_sigma_vertical_mps = pos(n["sigma_vertical_mps"], "aids.nhc.sigma_vertical_mps");
-      if (n["interval_s"]) c.aids.nhc_interval_s = pos(n["interval_s"], "aids.nhc.interval_s");
-      if (n["min_speed_mps"]) c.aids.nhc_min_speed_mps = nonneg(n["min_speed_mps"], "aids.nhc.min_speed_mps");
-      if (n["point_B_m"]) c.aids.nhc_point_B = vec3(n["point_B_m"], "aids.nhc.point_B_m");
-    }
-  }
+  c.loadFrom(ConfigNode::load(path));
   return c;
 }
 
-// A value of the wrong type (yaml-cpp's conversion errors, a list or map used
-// as a key) is an error naming the file and line, never an internal error.
-ReplayConfig loadReplayConfig(const std::string& path) {
-  try {
-    return loadReplayConfigImpl(path);
-  } catch (const YAML::Exception& e) {
-    throw Error(path + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) : "") +
-                ": " + printable(e.msg, 120) + " (a value or key of the wrong type)");
+void ReplayConfig::loadFrom(const ConfigNode& root) {
+  ReplayConfig& c = *this;
+  root.allowKeys({"rawlog", "model", "outages", "filter", "initial_sigma", "noise", "gnss_lever_arm_B_m",
+                  "initial_attitude_deg", "record_interval_s", "outages_every", "reference_sigma",
+                  "reference_lever_arm_B_m", "alignment", "imu_at_rest", "aids"});
+  if (root.has("rawlog")) c.rawlog = root.filePath("rawlog");
+  if (root.has("model")) c.model_spec = root.modelRef("model");
+  for (const ConfigNode& o : root.list("outages", 0, SIZE_MAX, "a list of {start_s, duration_s}")) {
+    o.allowKeys({"start_s", "duration_s"});
+    const double st = o.number("start_s", kOutageStartS, "seconds from time zero");
+    c.outages.push_back(Outage::fromStartDuration(st, o.number("duration_s", limits::kDurationS)));
+  }
+  if (const auto f = root.optMap("filter")) {
+    f->allowKeys({"propagate_every", "use_gnss_velocity", "gate_probability", "gate_readmit_after", "max_imu_gap_s"});
+    f->read("max_imu_gap_s", c.max_imu_gap_s, limits::Range{0.0, kMaxImuGapS, false, "s"});
+    f->read("propagate_every", c.propagate_every, 1, limits::kMaxPropagateEvery);
+    f->read("use_gnss_velocity", c.use_gnss_velocity);
+    f->read("gate_probability", c.gate_probability, limits::Range{0.0, 1.0, false, "(probability; 0 = gate off)"});
+    f->read("gate_readmit_after", c.gate_readmit_after, 0, 1000);
+  }
+  if (const auto p = root.optMap("initial_sigma")) {
+    p->allowKeys({"pos_h_m", "pos_v_m", "vel_mps", "roll_pitch_deg", "yaw_deg"});
+    p->read("pos_h_m", c.p0_pos_h_m, limits::kPositionSigmaM);
+    p->read("pos_v_m", c.p0_pos_v_m, limits::kPositionSigmaM);
+    p->read("vel_mps", c.p0_vel_mps, limits::kVelocitySigmaMps);
+    p->read("roll_pitch_deg", c.p0_roll_pitch_deg, kAngleSigmaDeg);
+    p->read("yaw_deg", c.p0_yaw_deg, kAngleSigmaDeg);
+  }
+  if (const auto n = root.optMap("noise")) {
+    n->allowKeys({"sigma_pos_h_m", "sigma_pos_v_m", "sigma_vel_h_mps", "sigma_vel_v_mps", "sigma_baro_m"});
+    n->read("sigma_pos_h_m", c.sigma_pos_h_m, limits::kPositionSigmaM);
+    n->read("sigma_pos_v_m", c.sigma_pos_v_m, limits::kPositionSigmaM);
+    n->read("sigma_vel_h_mps", c.sigma_vel_h_mps, limits::kVelocitySigmaMps);
+    n->read("sigma_vel_v_mps", c.sigma_vel_v_mps, limits::kVelocitySigmaMps);
+    n->read("sigma_baro_m", c.sigma_baro_m, limits::kPositionSigmaM);
+  }
+  Eigen::Vector3d v;
+  if (root.read("gnss_lever_arm_B_m", v, limits::kLeverArmM)) c.lever_arm_B = v;
+  if (root.read("initial_attitude_deg", v, kAngleDeg)) c.initial_attitude_deg = v;
+  root.read("record_interval_s", c.record_interval_s, limits::kDurationS);
+  if (const auto o = root.optMap("outages_every")) {
+    o->allowKeys({"period_s", "duration_s"});
+    OutagePattern p{o->number("period_s", limits::kDurationS), o->number("duration_s", limits::kDurationS)};
+    if (!(p.period_s > p.duration_s))
+      throw o->error("period_s", "must exceed duration_s (GNSS time to reconverge)");
+    c.outages_every = p;
+  }
+  if (const auto r = root.optMap("reference_sigma")) {
+    r->allowKeys({"horizontal_m", "vertical_m"});
+    r->read("horizontal_m", c.reference_sigma_h_m, kReferenceSigmaM);
+    r->read("vertical_m", c.reference_sigma_v_m, kReferenceSigmaM);
+  }
+  root.read("reference_lever_arm_B_m", c.reference_lever_arm_B, limits::kLeverArmM);
+  if (const auto a = root.optMap("alignment")) {
+    a->allowKeys({"yaw_deg", "yaw_sigma_deg", "max_align_s", "max_course_sigma_deg", "min_static_s", "max_level_s",
+                  "sideslip_sigma_deg"});
+    double x = 0.0;
+    if (a->read("yaw_deg", x, kAngleDeg)) {
+      c.alignment.yaw_rad = x * kDeg;
+      c.alignment.yaw_source = "configuration";
+    }
+    if (a->read("yaw_sigma_deg", x, kAngleSigmaDeg)) c.alignment.yaw_sigma_rad = x * kDeg;
+    a->read("max_align_s", c.alignment.max_align_s, limits::kDurationS);
+    if (a->read("max_course_sigma_deg", x, kAngleSigmaDeg)) c.alignment.max_course_sigma_rad = x * kDeg;
+    if (a->read("sideslip_sigma_deg", x, kAngleSigmaDeg)) c.alignment.sideslip_sigma_rad = x * kDeg;
+    a->read("min_static_s", c.alignment.min_static_s, limits::kDurationS);
+    a->read("max_level_s", c.alignment.max_level_s, limits::kDurationS);
+  }
+  if (const auto r = root.optMap("imu_at_rest")) {
+    r->allowKeys({"gyro_sigma_rad_s", "acc_sigma_mps2", "window_s", "false_alarm", "max_mean_rate_rad_s"});
+    auto& d = c.alignment.detector;
+    if (r->has("gyro_sigma_rad_s")) d.gyro_sigma_rad_s = sigma3(*r, "gyro_sigma_rad_s", kGyroSigmaRadS);
+    if (r->has("acc_sigma_mps2")) d.acc_sigma_mps2 = sigma3(*r, "acc_sigma_mps2", kAccSigmaMps2);
+    r->read("window_s", d.window_s, limits::kDurationS);
+    if (r->read("false_alarm", d.false_alarm, limits::Range{0.0, 0.5, true, "(probability)"}) &&
+        !(d.false_alarm < 0.5))
+      throw r->error("false_alarm", "must be in (0, 0.5)");
+    r->read("max_mean_rate_rad_s", d.max_mean_rate_rad_s, kGyroSigmaRadS);
+  }
+  c.aids.zupt_detector = c.alignment.detector;
+  if (const auto a = root.optMap("aids")) {
+    a->allowKeys({"zupt", "nhc"});
+    if (const auto z = a->optMap("zupt")) {
+      z->allowKeys({"sigma_mps", "interval_s"});
+      c.aids.zupt = true;
+      z->read("sigma_mps", c.aids.zupt_sigma_mps, limits::kVelocitySigmaMps);
+      z->read("interval_s", c.aids.zupt_interval_s, limits::kDurationS);
+    }
+    if (const auto n = a->optMap("nhc")) {
+      n->allowKeys({"sigma_lateral_mps", "sigma_vertical_mps", "interval_s", "min_speed_mps", "point_B_m"});
+      c.aids.nhc = true;
+      n->read("sigma_lateral_mps", c.aids.nhc_sigma_lateral_mps, limits::kVelocitySigmaMps);
+      n->read("sigma_vertical_mps", c.aids.nhc_sigma_vertical_mps, limits::kVelocitySigmaMps);
+      n->read("interval_s", c.aids.nhc_interval_s, limits::kDurationS);
+      n->read("min_speed_mps", c.aids.nhc_min_speed_mps, kSpeedMps);
+      n->read("point_B_m", c.aids.nhc_point_B, limits::kLeverArmM);
+    }
   }
 }
 
@@ -272,15 +190,8 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
     model = stochastic::loadImuModel(cfg.model_spec);
     r.model_source = model.source;
   } else if (scen && scen["imu_model_yaml"]) {
-    const fs::path tmp = fs::temp_directory_path() / ("navimpact_replay_model_" + std::to_string(::getpid()) + ".yaml");
-    std::ofstream(tmp) << scen["imu_model_yaml"].as<std::string>();
-    try {
-      model = stochastic::loadImuModel(tmp.string());
-    } catch (...) {
-      fs::remove(tmp);
-      throw;
-    }
-    fs::remove(tmp);
+    model = stochastic::parseImuModel(scen["imu_model_yaml"].as<std::string>(),
+                                      cfg.rawlog + " (scenario imu_model_yaml)");
     const std::string src = scen["imu"] && scen["imu"]["model"] ? scen["imu"]["model"].as<std::string>() : "";
     model.source = "rawlog scenario model (" + src + ")";
     r.model_source = model.source;

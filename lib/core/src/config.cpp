@@ -192,6 +192,15 @@ std::vector<ConfigNode> ConfigNode::items() const {
   return out;
 }
 
+ConfigNode ConfigNode::operator[](const std::string& k) const {
+  if (!isMap()) return ConfigNode(doc_, std::make_shared<const Node>(Node{YAML::Node(YAML::NodeType::Undefined)}), keyPath(k));
+  return at(k);
+}
+
+ConfigNode::operator bool() const { return node_->n.IsDefined(); }
+
+std::string ConfigNode::scalar() const { return isScalar() ? node_->n.Scalar() : std::string(); }
+
 std::vector<ConfigNode> ConfigNode::list(const std::string& k, std::size_t min, std::size_t max,
                                          const std::string& what) const {
   if (!has(k)) {

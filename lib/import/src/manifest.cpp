@@ -10,7 +10,9 @@
 #include <set>
 #include <sstream>
 
+#include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/import/csv_columns.hpp"
@@ -29,71 +31,43 @@ using units::kDeg;
 
 struct Keys {
   std::string file;
-  fs::path dir;
 
-  static std::string join(const std::string& path, const std::string& key) {
-    return path.empty() ? key : path + "." + key;
-  }
   Error err(const std::string& key, const std::string& what) const { return keyError(file, key, what); }
 
-  /// @p n must be a map whose keys are in @p allowed, each once, with every key of @p required.
-  void map(const YAML::Node& n, const std::string& path, std::initializer_list<const char*> allowed,
+  /// @p n must be a map whose keys are in @p allowed, with every key of @p required
+  /// (duplicate keys are refused when the manifest is parsed).
+  void map(const ConfigNode& n, const std::string& /*path: n.path()*/, std::initializer_list<const char*> allowed,
            std::initializer_list<const char*> required = {}) const {
-    std::string list;
-    for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-    if (!n || !n.IsMap()) throw err(path.empty() ? "(top level)" : path, "expected a map with keys " + list);
-    std::set<std::string> seen;
-    for (const auto& kv : n) {
-      const std::string k = kv.first.IsScalar() ? kv.first.Scalar() : std::string("(not a name)");
-      if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }) == allowed.end())
-        throw err(join(path, k), "unknown key (expected one of: " + list + ")");
-      if (!seen.insert(k).second) throw err(join(path, k), "appears twice");
-    }
-    for (const char* r : required)
-      if (!n[r]) throw err(join(path, r), "missing (required)");
+    n.allowKeys(allowed);
+    n.requireKeys(required);
   }
-  double number(const YAML::Node& n, const std::string& key) const {
-    double v;
-    if (!n.IsScalar() || !parseDouble(n.Scalar(), v) || !std::isfinite(v))
-      throw err(key, "expected a finite number, found '" + printable(n.IsScalar() ? n.Scalar() : "(not a scalar)") + "'");
-    return v;
+  double number(const ConfigNode& n, const std::string& /*key*/, double lo, double hi, const char* unit) const {
+    return n.asNumber(limits::Range{lo, hi, false, unit});
   }
-  double number(const YAML::Node& n, const std::string& key, double lo, double hi, const char* unit) const {
-    const double v = number(n, key);
-    if (v < lo || v > hi)
-      throw err(key, printable(n.Scalar()) + " is out of range [" + formatRange(lo) + ", " + formatRange(hi) + "] " + unit);
-    return v;
+  double positive(const ConfigNode& n, const std::string& /*key*/, double hi, const char* unit) const {
+    return n.asNumber(limits::Range{0.0, hi, true, unit});
   }
-  double positive(const YAML::Node& n, const std::string& key, double hi, const char* unit) const {
-    const double v = number(n, key);
-    if (!(v > 0.0) || v > hi)
-      throw err(key, printable(n.Scalar()) + " must be > 0 and at most " + formatRange(hi) + " " + unit);
-    return v;
+  std::string text(const ConfigNode& n, const std::string& /*key*/) const {
+    const std::string s = n.asText();
+    if (s.empty()) throw n.error("must be a non-empty text");
+    return s;
   }
-  std::string text(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar() || n.Scalar().empty()) throw err(key, "expected a non-empty text");
-    return n.Scalar();
-  }
-  std::vector<std::string> texts(const YAML::Node& n, const std::string& key, std::size_t lo, std::size_t hi) const {
-    if (!n.IsSequence() || n.size() < lo || n.size() > hi)
-      throw err(key, lo == hi ? "expected a list of " + std::to_string(lo) + " names"
-                              : "expected a list of " + std::to_string(lo) + " to " + std::to_string(hi) + " names");
+  std::vector<std::string> texts(const ConfigNode& n, const std::string& key, std::size_t lo, std::size_t hi) const {
+    if (!n.isList() || n.items().size() < lo || n.items().size() > hi)
+      throw err(key, lo == hi ? "must be a list of " + std::to_string(lo) + " names"
+                              : "must be a list of " + std::to_string(lo) + " to " + std::to_string(hi) + " names");
     std::vector<std::string> out;
-    for (std::size_t i = 0; i < n.size(); ++i) out.push_back(text(n[i], key + "[" + std::to_string(i) + "]"));
+    for (const ConfigNode& item : n.items()) out.push_back(text(item, item.path()));
     return out;
   }
   /// A unit from a list; returns its index.
-  std::size_t oneOf(const YAML::Node& n, const std::string& key, const std::vector<std::string>& names) const {
-    const std::string s = n.IsScalar() ? n.Scalar() : std::string("(not a name)");
+  std::size_t oneOf(const ConfigNode& n, const std::string& key, const std::vector<std::string>& names) const {
+    const std::string s = n.scalar();
     for (std::size_t i = 0; i < names.size(); ++i)
-      if (s == names[i]) return i;
+      if (n.isScalar() && s == names[i]) return i;
     std::string list;
     for (const auto& a : names) list += (list.empty() ? "" : ", ") + a;
-    throw err(key, "'" + printable(s) + "' is not accepted (expected one of: " + list + ")");
-  }
-  std::string resolve(const std::string& p) const {
-    if (p.empty() || fs::path(p).is_absolute() || dir.empty()) return p;
-    return (dir / p).lexically_normal().string();
+    throw err(key, "must be one of " + list + ", got " + (n.isScalar() ? "'" + printable(s) + "'" : std::string("a list or a map")));
   }
   static std::string formatRange(double v) {
     std::ostringstream o;
@@ -120,21 +94,21 @@ struct StreamSpec {
   double max_gap_s = 0.0;    // 0: no limit
 };
 
-StreamSpec streamSpec(const Keys& k, const YAML::Node& n, const std::string& name) {
+StreamSpec streamSpec(const Keys& k, const ConfigNode& n, const std::string& name) {
   StreamSpec s;
   s.name = name;
-  s.file = k.resolve(k.text(n["file"], name + ".file"));
+  s.file = n.resolve(k.text(n["file"], name + ".file"));
   if (n["delimiter"]) {
     const std::size_t i = k.oneOf(n["delimiter"], name + ".delimiter", {",", ";", "tab"});
     s.delimiter = i == 0 ? ',' : i == 1 ? ';' : '\t';
   }
   const std::string tk = name + ".time";
-  const YAML::Node t = n["time"];
-  if (t && t.IsMap() && t["rate_hz"]) {
+  const ConfigNode t = n["time"];
+  if (t && t.isMap() && t["rate_hz"]) {
     if (name != "imu") throw k.err(tk + ".rate_hz", "only the IMU stream may be given by a rate (others need a time column)");
     k.map(t, tk, {"rate_hz", "start_s"}, {"rate_hz"});
     s.rate_hz = k.positive(t["rate_hz"], tk + ".rate_hz", 1e5, "Hz");
-    if (t["start_s"]) s.start_s = k.number(t["start_s"], tk + ".start_s");
+    if (t["start_s"]) s.start_s = t["start_s"].asNumber(limits::kFileTimeS);
   } else {
     k.map(t, tk, {"column", "unit"}, {"column", "unit"});
     s.time_column = true;
@@ -187,15 +161,18 @@ std::size_t addTime(Requests& r, const StreamSpec& s) {
 }
 
 /// Axes: body FRD axis i = sign_i * file axis src_i (a proper signed permutation), or a rotation matrix.
-Eigen::Matrix3d axesMatrix(const Keys& k, const YAML::Node& n, const std::string& key) {
+Eigen::Matrix3d axesMatrix(const Keys& k, const ConfigNode& n, const std::string& key) {
   const char* accepted = " (expected the body forward, right, down axes written in the file's axes as a proper signed "
                          "permutation such as [-y, x, z], or a 3x3 rotation matrix [[..], [..], [..]] from file to body axes)";
-  if (!n.IsSequence() || n.size() != 3) throw k.err(key, std::string("expected a list of three axes") + accepted);
+  if (!n.isList() || n.items().size() != 3) throw k.err(key, std::string("expected a list of three axes") + accepted);
+  const std::vector<ConfigNode> rows = n.items();
   Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
-  if (n[0].IsSequence()) {
+  if (rows[0].isList()) {
     for (int i = 0; i < 3; ++i) {
-      if (!n[i].IsSequence() || n[i].size() != 3) throw k.err(key, std::string("a rotation matrix needs 3 rows of 3 numbers") + accepted);
-      for (int j = 0; j < 3; ++j) C(i, j) = k.number(n[i][j], key + "[" + std::to_string(i) + "][" + std::to_string(j) + "]");
+      if (!rows[i].isList() || rows[i].items().size() != 3)
+        throw k.err(key, std::string("a rotation matrix needs 3 rows of 3 numbers") + accepted);
+      const std::vector<ConfigNode> row = rows[i].items();
+      for (int j = 0; j < 3; ++j) C(i, j) = row[j].asNumber(limits::Range{-2.0, 2.0, false, ""});
     }
     if ((C * C.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || C.determinant() < 0.0)
       throw k.err(key, "is not a rotation matrix (orthonormal to 1e-6 with determinant +1)");
@@ -203,7 +180,7 @@ Eigen::Matrix3d axesMatrix(const Keys& k, const YAML::Node& n, const std::string
   }
   bool used[3] = {false, false, false};
   for (int i = 0; i < 3; ++i) {
-    const std::string s = n[i].IsScalar() ? n[i].Scalar() : std::string("(not an axis)");
+    const std::string s = rows[i].isScalar() ? rows[i].scalar() : std::string("(not an axis)");
     std::string_view p = trim(s);
     double sign = 1.0;
     if (!p.empty() && (p.front() == '-' || p.front() == '+')) {
@@ -223,8 +200,8 @@ Eigen::Matrix3d axesMatrix(const Keys& k, const YAML::Node& n, const std::string
 }
 
 /// height_datum: "ellipsoid" or {geoid_undulation_m: N}; returns N [m] (added to the heights).
-double heightDatum(const Keys& k, const YAML::Node& n, const std::string& key) {
-  if (n.IsScalar()) {
+double heightDatum(const Keys& k, const ConfigNode& n, const std::string& key) {
+  if (n.isScalar()) {
     k.oneOf(n, key, {"ellipsoid"});
     return 0.0;
   }
@@ -238,7 +215,7 @@ struct PositionSpec {
   double angle = kDeg;
 };
 
-PositionSpec positionSpec(const Keys& k, const YAML::Node& n, const std::string& key, Requests& r) {
+PositionSpec positionSpec(const Keys& k, const ConfigNode& n, const std::string& key, Requests& r) {
   k.map(n, key, {"lat", "lon", "height", "angle_unit", "height_unit"}, {"lat", "lon", "height", "angle_unit"});
   PositionSpec p;
   p.lat = r.add(k.text(n["lat"], key + ".lat"), key + ".lat");
@@ -273,12 +250,12 @@ struct SigmaSpec {
   std::vector<std::size_t> cols;
 };
 
-SigmaSpec sigmaSpec(const Keys& k, const YAML::Node& n, const std::string& key, Requests& r, const char* unitName,
+SigmaSpec sigmaSpec(const Keys& k, const ConfigNode& n, const std::string& key, Requests& r, const char* unitName,
                     const char* hKey, const char* vKey) {
   SigmaSpec s;
   if (!n) return s;
   s.present = true;
-  if (n.IsMap() && n["columns"]) {
+  if (n.isMap() && n["columns"]) {
     k.map(n, key, {"columns", "unit"}, {"columns", "unit"});
     k.oneOf(n["unit"], key + ".unit", {unitName});
     const auto names = k.texts(n["columns"], key + ".columns", 2, 3);
@@ -315,7 +292,7 @@ struct VelocitySpec {
   SigmaSpec sigma;
 };
 
-VelocitySpec velocitySpec(const Keys& k, const YAML::Node& n, const std::string& key, Requests& r) {
+VelocitySpec velocitySpec(const Keys& k, const ConfigNode& n, const std::string& key, Requests& r) {
   VelocitySpec v;
   if (!n) return v;
   v.present = true;
@@ -375,19 +352,13 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     manifestText = ss.str();
   }
   if (manifestText.size() > (1u << 20)) throw Error(manifestPath + ": manifest larger than 1 MiB");
-  YAML::Node root;
-  try {
-    root = YAML::Load(manifestText);
-  } catch (const YAML::Exception& e) {
-    throw Error(manifestPath + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                ": YAML syntax: " + e.msg);
-  }
-  const Keys k{manifestPath, fs::path(manifestPath).parent_path()};
+  const ConfigNode root = ConfigNode::parse(manifestText, manifestPath);
+  const Keys k{manifestPath};
   k.map(root, "", {"imu", "gnss", "baro", "reference", "time_offset_s", "time_zero_unix_s", "origin"}, {"imu"});
 
   double offset[4] = {0, 0, 0, 0};  // imu, gnss, baro, reference
   if (root["time_offset_s"]) {
-    const YAML::Node o = root["time_offset_s"];
+    const ConfigNode o = root["time_offset_s"];
     k.map(o, "time_offset_s", {"imu", "gnss", "baro", "reference"});
     const char* names[] = {"imu", "gnss", "baro", "reference"};
     for (int i = 0; i < 4; ++i)
@@ -399,7 +370,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
   Recording d;
   d.source = manifestPath;
   std::optional<earth::Geodetic> origin;
-  if (const YAML::Node o = root["origin"]) {
+  if (const ConfigNode o = root["origin"]) {
     k.map(o, "origin", {"lat_deg", "lon_deg", "height_m"}, {"lat_deg", "lon_deg", "height_m"});
     origin = earth::Geodetic{k.number(o["lat_deg"], "origin.lat_deg", -90.0, 90.0, "deg") * kDeg,
                              k.number(o["lon_deg"], "origin.lon_deg", -180.0, 360.0, "deg") * kDeg,
@@ -409,7 +380,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
 
   // --- IMU ------------------------------------------------------------------
   {
-    const YAML::Node n = root["imu"];
+    const ConfigNode n = root["imu"];
     k.map(n, "imu", {"file", "delimiter", "time", "gyro", "acc", "axes", "max_gap_s"}, {"file", "time", "gyro", "acc", "axes"});
     StreamSpec s = streamSpec(k, n, "imu");
     s.offset_s = offset[0];
@@ -421,7 +392,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     const char* sensor[2] = {"gyro", "acc"};
     for (int q = 0; q < 2; ++q) {
       const std::string key = std::string("imu.") + sensor[q];
-      const YAML::Node g = n[sensor[q]];
+      const ConfigNode g = n[sensor[q]];
       k.map(g, key, {"columns", "unit", "increments"}, {"columns"});
       const auto names = k.texts(g["columns"], key + ".columns", 3, 3);
       for (int i = 0; i < 3; ++i) sc[q][i] = r.add(names[i], key + ".columns[" + std::to_string(i) + "]");
@@ -484,7 +455,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
 
   // --- GNSS -----------------------------------------------------------------
   std::optional<double> gnssUndulation;
-  if (const YAML::Node n = root["gnss"]) {
+  if (const ConfigNode n = root["gnss"]) {
     k.map(n, "gnss", {"file", "delimiter", "time", "position", "height_datum", "velocity", "sigma", "lever_arm_m", "max_gap_s"},
           {"file", "time", "position", "height_datum"});
     StreamSpec s = streamSpec(k, n, "gnss");
@@ -496,10 +467,8 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     const VelocitySpec vs = velocitySpec(k, n["velocity"], "gnss.velocity", r);
     const SigmaSpec ss = sigmaSpec(k, n["sigma"], "gnss.sigma", r, "m", "horizontal_m", "vertical_m");
     if (n["lever_arm_m"]) {
-      const YAML::Node l = n["lever_arm_m"];
-      if (!l.IsSequence() || l.size() != 3) throw k.err("gnss.lever_arm_m", "expected [forward, right, down] in metres (body FRD, from the IMU to the antenna)");
       Eigen::Vector3d la;
-      for (int i = 0; i < 3; ++i) la[i] = k.number(l[i], "gnss.lever_arm_m[" + std::to_string(i) + "]", -100.0, 100.0, "m");
+      n.read("lever_arm_m", la, limits::kLeverArmM);  // [forward, right, down], body FRD, IMU to antenna
       d.lever_arm_B = la;
     }
     const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
@@ -517,7 +486,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
   }
 
   // --- barometer ------------------------------------------------------------
-  if (const YAML::Node n = root["baro"]) {
+  if (const ConfigNode n = root["baro"]) {
     k.map(n, "baro", {"file", "delimiter", "time", "height", "height_datum", "sigma_m", "max_gap_s"}, {"file", "time", "height"});
     StreamSpec s = streamSpec(k, n, "baro");
     s.offset_s = offset[2];
@@ -540,7 +509,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
   }
 
   // --- reference ------------------------------------------------------------
-  if (const YAML::Node n = root["reference"]) {
+  if (const ConfigNode n = root["reference"]) {
     k.map(n, "reference", {"file", "delimiter", "time", "position", "height_datum", "attitude", "velocity", "sigma", "max_gap_s"},
           {"file", "time", "position"});
     StreamSpec s = streamSpec(k, n, "reference");
@@ -555,7 +524,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     bool att = false;
     std::size_t ac[3] = {0, 0, 0};
     double aunit = kDeg;
-    if (const YAML::Node a = n["attitude"]) {
+    if (const ConfigNode a = n["attitude"]) {
       k.map(a, "reference.attitude", {"roll", "pitch", "yaw", "unit"}, {"roll", "pitch", "yaw", "unit"});
       const char* names[] = {"roll", "pitch", "yaw"};
       for (int i = 0; i < 3; ++i)

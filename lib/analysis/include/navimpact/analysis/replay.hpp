@@ -62,6 +62,7 @@
 
 #include "navimpact/analysis/nav_run.hpp"
 #include "navimpact/analysis/scoring.hpp"
+#include "navimpact/core/config.hpp"
 #include "navimpact/core/recording.hpp"
 #include "navimpact/filter/alignment.hpp"
 
@@ -100,6 +101,10 @@ struct ReplayConfig {
   /// one (aligning phase, estimate recorded every record_interval_s); used to
   /// get the GNSS-aided solution densely when the reference is sparse.
   bool use_reference = true;
+
+  /// Read the keys of a replay configuration (see the file comment), with the
+  /// ranges of core/limits.hpp; paths relative to the configuration's folder.
+  void loadFrom(const ConfigNode& root);
 };
 
 /// Read a replay configuration. @throws navimpact::Error naming file and key.

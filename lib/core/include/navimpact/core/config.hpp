@@ -94,6 +94,13 @@ class ConfigNode {
                                const std::string& what = "") const;
   /// The items of this node, which must be a list.
   std::vector<ConfigNode> items() const;
+  /// The node under key @p k, which may be absent (then `!node`): for readers
+  /// that decide by what is present.
+  ConfigNode operator[](const std::string& k) const;
+  /// True when this node is present in the file (a `key:` without value counts).
+  explicit operator bool() const;
+  /// The text of a scalar ("" for a list, a map or an absent node).
+  std::string scalar() const;
 
   // ---- values of keys of this map ---------------------------------------
   // The optional forms leave @p out unchanged when the key is absent and

@@ -43,6 +43,13 @@ struct ImuModel {
  */
 ImuModel loadImuModel(const std::string& spec);
 
+/**
+ * The model @p name ("" = the only one) of a model file's YAML @p text, e.g. the
+ * model a rawlog's scenario records; @p source names it in messages and
+ * becomes ImuModel::source. Same keys and errors as loadImuModel().
+ */
+ImuModel parseImuModel(const std::string& text, const std::string& source, const std::string& name = "");
+
 /// Names of the models in a file (empty for a single-model file).
 std::vector<std::string> listModels(const std::string& file);
 
