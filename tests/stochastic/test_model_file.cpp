@@ -184,3 +184,18 @@ TEST(ModelFile, ConvertImuModel) {
   EXPECT_NEAR(c.axis[0].terms[0].sigma, 9.788e-4 * std::sqrt(0.5), 1e-18);
   EXPECT_NEAR(c.axis[3].terms[4].omega, 2 * 9.302e-10, 1e-24);
 }
+
+// A model given as text (a rawlog scenario records its model this way) reads as
+// the same file would, named by its source in errors; no file is written.
+TEST(ModelFile, ParsedFromTextAsFromItsFile) {
+  const ImuModel ref = loadImuModel(table1() + ":ref");
+  const std::string y = toYaml(ref, "scenario model");
+  const ImuModel m = parseImuModel(y, "run.rawlog (scenario imu_model_yaml)");
+  EXPECT_EQ(m.rate_hz, ref.rate_hz);
+  EXPECT_EQ(m.source, "run.rawlog (scenario imu_model_yaml)");
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(m.axis[i].terms, ref.axis[i].terms);
+  const std::string e = errorOf([] { parseImuModel("rate_hz: 200\ngyroscope: none\ngyroscope: none\n", "run.rawlog"); });
+  EXPECT_NE(e.find("run.rawlog: key 'gyroscope': duplicate key (line 3; first at line 2)"), std::string::npos) << e;
+  const std::string n = errorOf([] { parseImuModel("rate_hz: 200\nmodels: {a: {gyroscope: none}}\n", "t", "b"); });
+  EXPECT_NE(n.find("t: no model named 'b' (available: a)"), std::string::npos) << n;
+}
