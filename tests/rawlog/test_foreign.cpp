@@ -10,6 +10,7 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 #include "navimpact/core/error.hpp"
@@ -24,6 +25,7 @@ constexpr double kDeg = M_PI / 180.0;
 
 struct Truth {
   std::vector<Eigen::Vector3d> w_B, f_B;  // body FRD
+  std::vector<Eigen::Vector3d> v_N;       // GNSS velocity of each fix (kinds 3, 4: Novatel BESTVEL)
   Eigen::Matrix3d C_StoFRD;               // sensor axes -> body FRD
 };
 
@@ -86,7 +88,36 @@ Truth writeForeign(const std::string& path, std::uint64_t seed, bool sensoryFram
         rmc.fields.speed_knots = 10.0;
         rmc.fields.direction_degrees = 30.0;
         g->setMsg(rmc);
-      } else if (gnssKind == 1) {
+      } else if (gnssKind == 1 || gnssKind == 3 || gnssKind == 4) {
+        if (gnssKind != 1) {  // BESTVEL as MRPT's driver records it: a generic OEM6 frame, log 99
+          std::uniform_real_distribution<double> Ur(0.0, 1.0);
+          const double hor = 30.0 * Ur(rng), trk = 360.0 * Ur(rng), vert = 4.0 * (Ur(rng) - 0.5);
+          t.v_N.push_back(Eigen::Vector3d(hor * std::cos(trk * kDeg), hor * std::sin(trk * kDeg), -vert));
+          gnss::Message_NV_OEM6_GENERIC_FRAME v;
+          v.header.msg_id = 99;
+          v.header.hdr_len = 28;  // as a receiver fills it (MRPT sizes the body from msg_len)
+          v.header.msg_len = 44;
+          v.msg_body.assign(44, 0);
+          const std::uint32_t status = 0, type = 8;  // SOL_COMPUTED, DOPPLER_VELOCITY
+          const float latency = 0.0f, age = 0.5f;
+          std::memcpy(v.msg_body.data(), &status, 4);
+          std::memcpy(v.msg_body.data() + 4, &type, 4);
+          std::memcpy(v.msg_body.data() + 8, &latency, 4);
+          std::memcpy(v.msg_body.data() + 12, &age, 4);
+          std::memcpy(v.msg_body.data() + 16, &hor, 8);
+          std::memcpy(v.msg_body.data() + 24, &trk, 8);
+          std::memcpy(v.msg_body.data() + 32, &vert, 8);
+          // (setMsg needs a msg_type the generic frame lacks: into the map as the driver does)
+          if (gnssKind == 3) {
+            g->messages[gnss::NV_OEM6_GENERIC_FRAME].set(new gnss::Message_NV_OEM6_GENERIC_FRAME(v));
+          } else {  // a GNSS entry of its own at the same time
+            auto g2 = std::make_shared<mrpt::obs::CObservationGPS>();
+            g2->sensorLabel = "GPS";
+            g2->timestamp = ts;
+            g2->messages[gnss::NV_OEM6_GENERIC_FRAME].set(new gnss::Message_NV_OEM6_GENERIC_FRAME(v));
+            obs.push_back(g2);
+          }
+        }
         gnss::Message_NV_OEM6_BESTPOS b;
         b.fields.solution_stat = gnss::nv_oem6_solution_status::SOL_COMPUTED;
         b.fields.lat = lat;
@@ -164,6 +195,22 @@ TEST(ForeignRawlog, ImuInSensorAxesWithItsMountingComesBackInBodyFrd) {
         EXPECT_FALSE(f.v_N);
       }
     }
+}
+
+// Novatel BESTVEL has no MRPT 2.5 class: MRPT's driver stores it as a generic
+// OEM6 frame, whose deserialisation reads 4 bytes of the body instead of its
+// length (libs/obs/src/gnss_messages_novatel.cpp, internal_readFromStream), so
+// MRPT cannot read such an entry back. The reader refuses it in one line naming
+// the entry, whether the frame shares the BESTPOS entry or has its own.
+TEST(ForeignRawlog, NovatelGenericFramesAreRefusedNamingTheEntry) {
+  for (int kind : {3, 4}) {
+    const auto p = (navimpact::test::tempDir() / ("bv" + std::to_string(kind) + ".rawlog")).string();
+    writeForeign(p, 4400 + kind, false, {"XSENS"}, kind);
+    const std::string e = errorOf(p, {});
+    EXPECT_NE(e.find("bv" + std::to_string(kind) + ".rawlog: entry "), std::string::npos) << e;
+    EXPECT_NE(e.find("CObservationGPS"), std::string::npos) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
 }
 
 TEST(ForeignRawlog, SeveralImuLabelsNeedAChoiceListingThem) {
