@@ -7,6 +7,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
@@ -130,6 +131,56 @@ Eigen::Matrix<double, 6, 1> ErrorStateEkf::sensorErrors() const {
   return e;
 }
 
+void ErrorStateEkf::setImuStates(const VectorXd& x) {
+  if (x.size() != layout_.imuSize() || !x.allFinite())
+    throw Error("IMU states: expected " + std::to_string(layout_.imuSize()) + " finite values, got " +
+                std::to_string(x.size()));
+  x_imu_ = x;
+  cache_->nominal_valid = false;
+}
+
+double ErrorStateEkf::extra(Extra g, int i) const {
+  const int k = layout_.extraIndex(g);
+  return k < 0 ? 0.0 : x_imu_(k - kNav + i);
+}
+
+namespace {
+SensorParams paramsFrom(const StateLayout& L, const std::function<double(int)>& v) {
+  SensorParams p;
+  auto get3 = [&](Extra g, Eigen::Vector3d& out) {
+    const int k = L.extraIndex(g);
+    if (k >= 0) out = Vector3d(v(k), v(k + 1), v(k + 2));
+  };
+  get3(Extra::GyroScale, p.gyro_scale);
+  get3(Extra::AccScale, p.acc_scale);
+  get3(Extra::GyroMisalignment, p.gyro_misalignment_rad);
+  get3(Extra::AccMisalignment, p.acc_misalignment_rad);
+  get3(Extra::LeverArm, p.lever_arm_error_B_m);
+  const int k = L.extraIndex(Extra::TimeOffset);
+  if (k >= 0) p.time_offset_s = v(k);
+  return p;
+}
+}  // namespace
+
+SensorParams ErrorStateEkf::extraEstimates() const {
+  return paramsFrom(layout_, [&](int k) { return x_imu_(k - kNav); });
+}
+
+SensorParams ErrorStateEkf::extraSigmas() const {
+  return paramsFrom(layout_, [&](int k) { return std::sqrt(std::max(P_(k, k), 0.0)); });
+}
+
+void ErrorStateEkf::addExtraCouplings(const Lin& L, Eigen::Ref<MatrixXd> X, int col0) const {
+  // corrected - true = -diag(true) ds + [true x] dm (state_layout.hpp), entering
+  // d(psi)/dt and d(dv)/dt through C_BtoN (Groves 14.64-14.65)
+  const int gs = layout_.extraIndex(Extra::GyroScale), as = layout_.extraIndex(Extra::AccScale);
+  const int gm = layout_.extraIndex(Extra::GyroMisalignment), am = layout_.extraIndex(Extra::AccMisalignment);
+  if (gs >= 0) X.block<3, 3>(kAtt, gs - col0) = -L.CDw;
+  if (gm >= 0) X.block<3, 3>(kAtt, gm - col0) = L.CSw;
+  if (as >= 0) X.block<3, 3>(kVel, as - col0) = -L.CDf;
+  if (am >= 0) X.block<3, 3>(kVel, am - col0) = L.CSf;
+}
+
 ErrorStateEkf::Lin ErrorStateEkf::currentLin() const {
   Lin L;
   L.Fnn = navErrorDynamics(state(), f_B_);
@@ -138,6 +189,12 @@ ErrorStateEkf::Lin ErrorStateEkf::currentLin() const {
   const Vector3d pg(psd[0], psd[1], psd[2]), pa(psd[3], psd[4], psd[5]);
   L.Qv = L.C * pa.asDiagonal() * L.C.transpose();
   L.Qa = L.C * pg.asDiagonal() * L.C.transpose();
+  if (layout_.hasExtra()) {
+    L.CDw = L.C * w_IB_B_.asDiagonal();
+    L.CSw = L.C * skew(w_IB_B_);
+    L.CDf = L.C * f_B_.asDiagonal();
+    L.CSf = L.C * skew(f_B_);
+  }
   return L;
 }
 
@@ -151,6 +208,7 @@ MatrixXd ErrorStateEkf::assembleF(const Lin& L) const {
     F.block(row, b.offset, 3, b.ss.n) = -L.C.col(b.channel % 3) * b.ss.H;
     F.block(b.offset, b.offset, b.ss.n, b.ss.n) = b.ss.F;
   }
+  if (layout_.hasExtra()) addExtraCouplings(L, F, 0);
   return F;
 }
 
@@ -241,6 +299,8 @@ void ErrorStateEkf::buildTransition(const Lin& L, double dt, Transition& T) cons
       FniFiiQii.block<3, 1>(row, o + j) = col * hFQ;
     }
   }
+  // extra states: random constants (Fii = 0, Qii = 0), only their Fni columns
+  if (layout_.hasExtra()) addExtraCouplings(L, Fni, kNav);
   const double dt2 = dt * dt, dt3 = dt2 * dt;
   // the products below skip the zeros of F_ni, Q_nn (nine_row_product.hpp)
   Matrix9d Fnn2;
@@ -424,6 +484,16 @@ void ErrorStateEkf::applyInterval() {
   L.C = iv_C_ * inv;
   L.Qv = iv_Qv_ * inv;
   L.Qa = iv_Qa_ * inv;
+  if (layout_.hasExtra()) {
+    L.CDw = iv_CDw_ * inv;
+    L.CSw = iv_CSw_ * inv;
+    L.CDf = iv_CDf_ * inv;
+    L.CSf = iv_CSf_ * inv;
+    iv_CDw_.setZero();
+    iv_CSw_.setZero();
+    iv_CDf_.setZero();
+    iv_CSf_.setZero();
+  }
   Transition& Tr = cache_->tmp;
   buildTransition(L, T, Tr);
   propagate(Tr.A, Tr.B, Tr.D, Tr.Q);
@@ -460,6 +530,19 @@ void ErrorStateEkf::predict(const ins::ImuSample& raw) {
   ins::ImuSample s = raw;
   s.dtheta_B -= e.head<3>() * raw.dt;
   s.dv_B -= e.tail<3>() * raw.dt;
+  if (layout_.hasExtra()) {
+    // corrected = M_est^-1 (raw - b_est), M_est = I + diag(s_est) + [m_est x] (state_layout.hpp)
+    if (layout_.extraIndex(Extra::GyroScale) >= 0 || layout_.extraIndex(Extra::GyroMisalignment) >= 0) {
+      const Eigen::Matrix3d M = Eigen::Matrix3d::Identity() + Eigen::Matrix3d(extra3(Extra::GyroScale).asDiagonal()) +
+                                skew(extra3(Extra::GyroMisalignment));
+      s.dtheta_B = M.inverse() * s.dtheta_B;
+    }
+    if (layout_.extraIndex(Extra::AccScale) >= 0 || layout_.extraIndex(Extra::AccMisalignment) >= 0) {
+      const Eigen::Matrix3d M = Eigen::Matrix3d::Identity() + Eigen::Matrix3d(extra3(Extra::AccScale).asDiagonal()) +
+                                skew(extra3(Extra::AccMisalignment));
+      s.dv_B = M.inverse() * s.dv_B;
+    }
+  }
   w_IB_B_ = s.w_IB_B();
   f_B_ = s.f_B();
   mech_.step(s);
@@ -518,6 +601,12 @@ void ErrorStateEkf::predict(const ins::ImuSample& raw) {
   };
   addPsd(iv_Qv_, psd[3], psd[4], psd[5]);
   addPsd(iv_Qa_, psd[0], psd[1], psd[2]);
+  if (layout_.hasExtra()) {
+    iv_CDw_.noalias() += C * (w_IB_B_ * raw.dt).asDiagonal();
+    iv_CSw_.noalias() += C * skew(w_IB_B_ * raw.dt);
+    iv_CDf_.noalias() += C * (f_B_ * raw.dt).asDiagonal();
+    iv_CSf_.noalias() += C * skew(f_B_ * raw.dt);
+  }
   if (++iv_n_ >= cfg_.propagate_every) applyInterval();
 }
 
@@ -544,16 +633,37 @@ void ErrorStateEkf::predictCovariance(const ins::NavState& nominal, const Vector
 }
 
 MatrixXd ErrorStateEkf::H_gnssPosition(const Vector3d& lever_B, double dt_meas) const {
+  const Vector3d l = lever_B - extra3(Extra::LeverArm);
+  const double tau = dt_meas + extra(Extra::TimeOffset);
   MatrixXd H = MatrixXd::Zero(3, size());
   H.block<3, 3>(0, kPos).setIdentity();
   // p_ant = p + C l: d(C l) = psi x (C l) = -[(C l) x] psi (Groves 14.110 with our signs)
-  H.block<3, 3>(0, kAtt) = -skew(state().C_BtoN() * lever_B);
-  // carried to the measurement epoch: p_ant + v_ant dt_meas
-  if (dt_meas != 0.0) H += dt_meas * H_gnssVelocity(lever_B);
+  H.block<3, 3>(0, kAtt) = -skew(state().C_BtoN() * l);
+  // lever-arm error e = told - true: l_used - l_true = -de
+  if (const int k = layout_.extraIndex(Extra::LeverArm); k >= 0) H.block<3, 3>(0, k) = -state().C_BtoN();
+  // carried to the measurement epoch: p_ant + v_ant tau
+  if (tau != 0.0) H += tau * H_antennaVelocity(l);
+  // time offset: d(p_ant + v_ant tau)/d(d_est) = v_ant
+  if (const int k = layout_.extraIndex(Extra::TimeOffset); k >= 0) H.col(k) = antennaVelocity(l);
   return H;
 }
 
-MatrixXd ErrorStateEkf::H_gnssVelocity(const Vector3d& lever_B, double dt_meas) const {
+Vector3d ErrorStateEkf::antennaVelocity(const Vector3d& l) const {
+  const ins::NavState& x = state();
+  const Eigen::Matrix3d C = x.C_BtoN();
+  const Vector3d w_ie = earth::w_IE_N(x.lat);
+  return x.v_N + C * w_IB_B_.cross(l) - w_ie.cross(C * l);
+}
+
+Vector3d ErrorStateEkf::accelerationN() const {
+  // dv/dt = C f_B + g_N - (2 w_IE_N + w_EN_N) x v_N (Groves 5.54)
+  const ins::NavState& x = state();
+  const Vector3d w_ie = earth::w_IE_N(x.lat);
+  return x.C_BtoN() * f_B_ + earth::gravity_N(x.lat, x.h) -
+         (2.0 * w_ie + earth::w_EN_N(x.lat, x.h, x.v_N)).cross(x.v_N);
+}
+
+MatrixXd ErrorStateEkf::H_antennaVelocity(const Vector3d& lever_B) const {
   MatrixXd H = MatrixXd::Zero(3, size());
   const Eigen::Matrix3d C = state().C_BtoN();
   const Vector3d w_ie = earth::w_IE_N(state().lat);
@@ -566,9 +676,28 @@ MatrixXd ErrorStateEkf::H_gnssVelocity(const Vector3d& lever_B, double dt_meas) 
     for (int c = 0; c < 3; ++c) Hg.row(c) = layout_.sensorRow(c);
     H.rightCols(layout_.imuSize()) = C * skew(lever_B) * Hg;
   }
+  if (layout_.hasExtra()) {
+    // dw = -diag(w) ds_g + [w x] dm_g enters as C (dw x l) = -C [l x] dw
+    if (const int k = layout_.extraIndex(Extra::GyroScale); k >= 0)
+      H.block<3, 3>(0, k) = C * skew(lever_B) * w_IB_B_.asDiagonal();
+    if (const int k = layout_.extraIndex(Extra::GyroMisalignment); k >= 0)
+      H.block<3, 3>(0, k) = -C * skew(lever_B) * skew(w_IB_B_);
+    // lever-arm error: l_used - l_true = -de, d v_ant / d l = C [w x] - [w_IE x] C
+    if (const int k = layout_.extraIndex(Extra::LeverArm); k >= 0)
+      H.block<3, 3>(0, k) = -(C * skew(w_IB_B_) - skew(w_ie) * C);
+  }
+  return H;
+}
+
+MatrixXd ErrorStateEkf::H_gnssVelocity(const Vector3d& lever_B, double dt_meas) const {
+  const Vector3d l = lever_B - extra3(Extra::LeverArm);
+  const double tau = dt_meas + extra(Extra::TimeOffset);
+  MatrixXd H = H_antennaVelocity(l);
   // carried to the measurement epoch with dv/dt, whose linearisation is the
   // velocity rows of F (Groves 14.65-14.69 and the accelerometer coupling)
-  if (dt_meas != 0.0) H += dt_meas * F().middleRows(kVel, 3);
+  if (tau != 0.0) H += tau * F().middleRows(kVel, 3);
+  // time offset: d(v_ant + a_N tau)/d(d_est) = a_N
+  if (const int k = layout_.extraIndex(Extra::TimeOffset); k >= 0) H.col(k) = accelerationN();
   return H;
 }
 
@@ -592,6 +721,11 @@ MatrixXd ErrorStateEkf::H_nonHolonomic(const Vector3d& point_B) const {
     MatrixXd Hg(3, layout_.imuSize());
     for (int c = 0; c < 3; ++c) Hg.row(c) = layout_.sensorRow(c);
     H3.rightCols(layout_.imuSize()) = skew(point_B) * Hg;
+    // extra gyro states: dw = -diag(w) ds_g + [w x] dm_g enters as dw x l = -[l x] dw
+    if (const int k = layout_.extraIndex(Extra::GyroScale); k >= 0)
+      H3.block<3, 3>(0, k) = skew(point_B) * w_IB_B_.asDiagonal();
+    if (const int k = layout_.extraIndex(Extra::GyroMisalignment); k >= 0)
+      H3.block<3, 3>(0, k) = -skew(point_B) * skew(w_IB_B_);
   }
   return H3.bottomRows(2);
 }
@@ -681,13 +815,15 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
 
 VectorXd ErrorStateEkf::residualGnssPosition(const earth::Geodetic& z, const Vector3d& lever_B,
                                              double dt_meas) const {
+  const Vector3d l = lever_B - extra3(Extra::LeverArm);
+  const double tau = dt_meas + extra(Extra::TimeOffset);
   const ins::NavState& x = state();
   const earth::Radii r = earth::radii(x.lat);
-  const Vector3d l_N = x.C_BtoN() * lever_B;
+  const Vector3d l_N = x.C_BtoN() * l;
   const earth::Geodetic ant{x.lat + l_N.x() / (r.R_N + x.h),
                             x.lon + l_N.y() / ((r.R_E + x.h) * std::cos(x.lat)), x.h - l_N.z()};
   VectorXd dz = earth::curvilinearDiffNed(ant, z);
-  if (dt_meas != 0.0) dz += dt_meas * residualGnssVelocity(Vector3d::Zero(), lever_B);
+  if (tau != 0.0) dz += tau * antennaVelocity(l);
   return dz;
 }
 
@@ -703,16 +839,10 @@ UpdateResult ErrorStateEkf::updateGnssPosition(const earth::Geodetic& z, const V
 
 VectorXd ErrorStateEkf::residualGnssVelocity(const Vector3d& z_N, const Vector3d& lever_B,
                                              double dt_meas) const {
-  const ins::NavState& x = state();
-  const Eigen::Matrix3d C = x.C_BtoN();
-  const Vector3d w_ie = earth::w_IE_N(x.lat);
-  Vector3d v_ant = x.v_N + C * w_IB_B_.cross(lever_B) - w_ie.cross(C * lever_B);
-  if (dt_meas != 0.0) {
-    // dv/dt = C f_B + g_N - (2 w_IE_N + w_EN_N) x v_N (Groves 5.54)
-    const Vector3d a_N = C * f_B_ + earth::gravity_N(x.lat, x.h) -
-                         (2.0 * w_ie + earth::w_EN_N(x.lat, x.h, x.v_N)).cross(x.v_N);
-    v_ant += a_N * dt_meas;
-  }
+  const Vector3d l = lever_B - extra3(Extra::LeverArm);
+  const double tau = dt_meas + extra(Extra::TimeOffset);
+  Vector3d v_ant = antennaVelocity(l);
+  if (tau != 0.0) v_ant += accelerationN() * tau;
   return v_ant - z_N;
 }
 

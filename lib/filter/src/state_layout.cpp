@@ -94,6 +94,41 @@ StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuError
                     std::to_string(m.terms.size()) + " terms), more than the filter accepts per axis");
     }
   }
+  // Extra states: random constants (F = 0, Qc = 0) with a zero sensor row;
+  // ErrorStateEkf adds their couplings (state_layout.hpp).
+  const ExtraStates& x = opt.extra;
+  const double sig[kExtraGroups] = {x.gyro_scale_sigma,           x.acc_scale_sigma,
+                                    x.gyro_misalignment_sigma_rad, x.acc_misalignment_sigma_rad,
+                                    x.lever_arm_sigma_m,           x.time_offset_sigma_s};
+  const char* key[kExtraGroups] = {"gyro_scale_sigma",           "acc_scale_sigma",
+                                   "gyro_misalignment_sigma_rad", "acc_misalignment_sigma_rad",
+                                   "lever_arm_sigma_m",           "time_offset_sigma_s"};
+  const char* base[kExtraGroups] = {"gyro.scale_",         "acc.scale_",         "gyro.misalignment_",
+                                    "acc.misalignment_",   "gnss.lever_arm_error_", "gnss.time_offset"};
+  const char* unit[kExtraGroups] = {"", "", " rad", " rad", " m", " s"};
+  for (int g = 0; g < kExtraGroups; ++g) {
+    if (!(std::isfinite(sig[g]) && sig[g] >= 0.0))
+      throw Error("extra state " + std::string(key[g]) + " must be finite and >= 0 (0 = off), got " +
+                  formatNumber(sig[g], 4));
+    if (sig[g] == 0.0) continue;
+    L.extra_[g] = static_cast<int>(L.names_.size());
+    L.has_extra_ = true;
+    const int n = g == static_cast<int>(Extra::TimeOffset) ? 1 : 3;
+    for (int i = 0; i < n; ++i) {
+      ProcessBlock b;
+      b.channel = 0;  // unused: the sensor row is zero
+      b.offset = static_cast<int>(L.names_.size());
+      b.ss.n = 1;
+      b.ss.F = Eigen::MatrixXd::Zero(1, 1);
+      b.ss.Qc = Eigen::MatrixXd::Zero(1, 1);
+      b.ss.H = Eigen::RowVectorXd::Zero(1);
+      b.ss.P0 = Eigen::MatrixXd::Constant(1, 1, sig[g] * sig[g]);
+      b.ss.names = {"random constant"};
+      L.names_.push_back(std::string(base[g]) + (n == 3 ? std::string(1, "xyz"[i]) : std::string()) +
+                         "(sigma=" + formatNumber(sig[g], 4) + unit[g] + ")");
+      L.blocks_.push_back(b);
+    }
+  }
   const int m = L.imuSize();
   for (int c = 0; c < 6; ++c) L.h_[c] = Eigen::RowVectorXd::Zero(m);
   for (const ProcessBlock& b : L.blocks_)

@@ -18,7 +18,7 @@
  *  - sensor effects of an emulation and the extra filter states that model
  *    them (emulation::SensorEffects): scale factors [-0.05, 0.05] (ratio,
  *    +-50 000 ppm), misalignment and non-orthogonality angles [-0.05, 0.05] rad,
- *    IMU-GNSS time offset [-1, 1] s, lever-arm error components [-10, 10] m,
+ *    IMU-GNSS time offset [-0.1, 0.1] s, lever-arm error components [-10, 10] m,
  *    in-motion white-noise factor [1, 100], motion thresholds
  *    [1e-3, 10] rad/s and [0.05, 100] m/s^2.
  * README ("Ranges and budgets") lists them with the budgets.
@@ -61,7 +61,7 @@ inline constexpr int kMaxPropagateEvery = 1000;
 // stop agreeing to second order, so the ranges stop there.
 inline constexpr Range kScaleFactor{-0.05, 0.05, false, "(ratio)"};
 inline constexpr Range kMisalignmentRad{-0.05, 0.05, false, "rad"};
-inline constexpr Range kTimeOffsetS{-1.0, 1.0, false, "s"};
+inline constexpr Range kTimeOffsetS{-0.1, 0.1, false, "s"};
 inline constexpr Range kLeverArmErrorM{-10.0, 10.0, false, "m"};
 inline constexpr Range kMotionNoiseFactor{1.0, 100.0, false, "(factor)"};
 inline constexpr Range kMotionRateThresholdRadS{1.0e-3, 10.0, false, "rad/s"};

@@ -79,7 +79,7 @@ struct SensorEffects {
   Eigen::Vector3d acc_misalignment_rad = Eigen::Vector3d::Zero();   ///< accelerometer triad small angles [rad], each in [-0.05, 0.05]
   Eigen::Vector3d gyro_nonorthogonality_rad = Eigen::Vector3d::Zero();  ///< optional, [rad], each in [-0.05, 0.05]
   Eigen::Vector3d acc_nonorthogonality_rad = Eigen::Vector3d::Zero();   ///< optional, [rad], each in [-0.05, 0.05]
-  double time_offset_s = 0.0;  ///< t_IMU - t_true [s], in [-1, 1]
+  double time_offset_s = 0.0;  ///< t_IMU - t_true [s], in [-0.1, 0.1]
   /// White-noise factor k while moving (1 = off), per sensor, in [1, 100].
   double gyro_motion_noise_factor = 1.0;
   double acc_motion_noise_factor = 1.0;  ///< as gyro_motion_noise_factor, for the accelerometers

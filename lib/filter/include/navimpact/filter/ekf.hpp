@@ -86,6 +86,19 @@ struct EkfConfig {
  */
 ImuErrorOptions effectiveImuOptions(const stochastic::ImuModel& model, const EkfConfig& cfg);
 
+/**
+ * Values of the extra states (state_layout.hpp, ExtraStates), the quantities of
+ * emulation::SensorEffects of the same names, SI; zero for a group that is off.
+ */
+struct SensorParams {
+  Eigen::Vector3d gyro_scale = Eigen::Vector3d::Zero();             ///< [ratio]
+  Eigen::Vector3d acc_scale = Eigen::Vector3d::Zero();              ///< [ratio]
+  Eigen::Vector3d gyro_misalignment_rad = Eigen::Vector3d::Zero();  ///< [rad]
+  Eigen::Vector3d acc_misalignment_rad = Eigen::Vector3d::Zero();   ///< [rad]
+  Eigen::Vector3d lever_arm_error_B_m = Eigen::Vector3d::Zero();    ///< told - true antenna, body FRD [m]
+  double time_offset_s = 0.0;                                       ///< t_IMU - t_true [s]
+};
+
 /// Result of one measurement update.
 struct UpdateResult {
   bool accepted = true;         ///< false when rejected by the chi-square gate
@@ -140,8 +153,10 @@ class ErrorStateEkf {
    * GNSS position of the antenna (Groves 14.? loosely coupled, lever arm 14.110).
    * @param[in] z          measured antenna position (geodetic).
    * @param[in] sigma_NED  1-sigma noise along N, E, D [m], > 0.
-   * @param[in] lever_B    antenna position w.r.t. the IMU in body axes [m].
-   * @param[in] dt_meas    measurement epoch minus filter time state().t [s]: a fix
+   * @param[in] lever_B    antenna position w.r.t. the IMU in body axes [m] (as told; with
+   *                       the lever-arm state on, lever_B - e_est is used).
+   * @param[in] dt_meas    measurement epoch minus filter time state().t [s] (with the
+   *                       time-offset state on, dt_meas + d_est is used): a fix
    *                       between IMU samples is compared with the predicted antenna
    *                       position carried to its epoch with the antenna velocity,
    *                       p_ant + v_ant dt_meas (first order; |dt_meas| is at most
@@ -231,11 +246,18 @@ class ErrorStateEkf {
   const Eigen::VectorXd& imuStates() const { return x_imu_; }
   /// Estimated sensor errors now, gyro_x..acc_z [rad/s, m/s^2].
   Eigen::Matrix<double, 6, 1> sensorErrors() const;
+  /// Estimates of the extra states (zero for groups that are off).
+  SensorParams extraEstimates() const;
+  /// Their 1-sigma from P (zero for groups that are off).
+  SensorParams extraSigmas() const;
   const StateLayout& layout() const { return layout_; }
   int size() const { return layout_.size(); }
   const UpdateResult& lastUpdate() const { return last_; }
   int rejections() const { return rejections_; }
   const EkfConfig& config() const { return cfg_; }
+  /// Overwrite the IMU-error and extra-state estimates (size imuSize(); tests, warm
+  /// starts); P is unchanged. @throws navimpact::Error on a size mismatch or a non-finite value.
+  void setImuStates(const Eigen::VectorXd& x);
   /// Overwrite the navigation state (e.g. alignment); P is unchanged.
   void setState(const ins::NavState& x) { mech_.setState(x); }
   /// Last corrected angular rate and specific force [rad/s, m/s^2].
@@ -251,7 +273,21 @@ class ErrorStateEkf {
   struct Lin {
     Matrix9d Fnn;
     Eigen::Matrix3d C, Qv, Qa;
+    // extra states only: C diag(w_IB_B), C [w_IB_B x], C diag(f_B), C [f_B x]
+    Eigen::Matrix3d CDw, CSw, CDf, CSf;
   };
+  /// Couplings of the extra sensor states into F (rows psi and dv), written
+  /// into X at column (full-state index - col0).
+  void addExtraCouplings(const Lin& L, Eigen::Ref<Eigen::MatrixXd> X, int col0) const;
+  /// Value of an extra state (component i of the group; 0 when the group is off).
+  double extra(Extra g, int i = 0) const;
+  Eigen::Vector3d extra3(Extra g) const { return {extra(g, 0), extra(g, 1), extra(g, 2)}; }
+  /// Jacobian (3 x size()) of the antenna velocity v_ant for the lever arm @p l used.
+  Eigen::MatrixXd H_antennaVelocity(const Eigen::Vector3d& l) const;
+  /// Antenna velocity v + C (w x l) - w_IE x (C l) (Groves 14.111) and the
+  /// acceleration a_N (Groves 5.54) at the current state.
+  Eigen::Vector3d antennaVelocity(const Eigen::Vector3d& l) const;
+  Eigen::Vector3d accelerationN() const;
   Lin currentLin() const;
   Eigen::MatrixXd assembleF(const Lin& L) const;
   Eigen::MatrixXd assembleQc(const Lin& L) const;
@@ -279,6 +315,9 @@ class ErrorStateEkf {
   Eigen::Vector3d iv_fN_ = Eigen::Vector3d::Zero();  // sum C f_B dt [m/s]
   Eigen::Matrix3d iv_C_ = Eigen::Matrix3d::Zero();   // sum C dt [s]
   Eigen::Matrix3d iv_Qv_ = Eigen::Matrix3d::Zero(), iv_Qa_ = Eigen::Matrix3d::Zero();  // sum C diag(psd) C' dt
+  // extra states only: sums of C diag(w) dt, C [w x] dt, C diag(f) dt, C [f x] dt
+  Eigen::Matrix3d iv_CDw_ = Eigen::Matrix3d::Zero(), iv_CSw_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d iv_CDf_ = Eigen::Matrix3d::Zero(), iv_CSf_ = Eigen::Matrix3d::Zero();
   UpdateResult last_;
   int rejections_ = 0;
   int consecutive_rejections_ = 0;  ///< gated rejections since the last applied update

@@ -11,8 +11,44 @@
  *            optional turn-on bias first, then one block per process of the
  *            axis model in model order: GM 1 state, RW 1, DR 2 (bias, rate),
  *            SIN 2 (oscillator); WN and QN have no state (process noise only).
+ *  -  then the optional extra states (ExtraStates; each group present only
+ *            when its prior sigma is > 0), in this order: gyro scale factors
+ *            x,y,z; accelerometer scale factors x,y,z; gyro misalignment
+ *            angles x,y,z; accelerometer misalignment angles x,y,z; antenna
+ *            lever-arm error x,y,z (body FRD); IMU-GNSS time offset.
  * The IMU error states are estimate minus truth as well: the filter's
  * corrected sensor output is raw - H x_imu_est.
+ *
+ * Extra states (random constants: no process noise; prior sigma as given).
+ * Each state holds the filter's estimate of the quantity of the sensor model
+ * below, the same quantity emulation::SensorEffects sets, so an estimate is
+ * compared with the hidden value directly; its error is estimate minus truth.
+ *  - Sensor model per triad (gyro with w_IB_B, accelerometer with f_B):
+ *      raw = M true + b + noise,  M = I + diag(s) + [m x]
+ *    s: scale factors [ratio] (2000 ppm = 0.002); m: misalignment angles [rad]
+ *    ([m x] v = m x v: the triad's axes are the body axes rotated by -m).
+ *  - Corrected output (ErrorStateEkf::predict): corrected = M_est^-1 (raw - b_est)
+ *    with M_est = I + diag(s_est) + [m_est x]; to first order
+ *    (I - [m_est x] - diag(s_est)) (raw - b_est). Hence, with ds = s_est - s and
+ *    dm = m_est - m, corrected - true = -diag(true) ds + [true x] dm - db, and
+ *    (Groves 2013 eqs. 14.64-14.65 with the sensor-error inputs expanded):
+ *      d(psi)/dt += -C_BtoN diag(w_IB_B) ds_g + C_BtoN [w_IB_B x] dm_g
+ *      d(dv)/dt  += -C_BtoN diag(f_B) ds_a   + C_BtoN [f_B x] dm_a
+ *  - Lever-arm error e [m, body FRD] = told - true: the filter uses the antenna
+ *    at l = lever_B - e_est (lever_B as passed to the GNSS updates). With
+ *    de = e_est - e, l_used - l_true = -de, so the GNSS position rows get
+ *    -C_BtoN and the velocity rows -(C_BtoN [w_IB_B x] - [w_IE_N x] C_BtoN)
+ *    (Groves 2013 eqs. 14.110-14.111 differentiated w.r.t. the lever arm).
+ *  - Time offset d [s] = t_IMU - t_true: the filter state at IMU time t is the
+ *    truth at t - d, so a GNSS fix (stamped in GNSS = true time) is compared
+ *    with the prediction carried forward by d_est: position p_ant + v_ant d_est,
+ *    velocity v_ant + a_N d_est (a_N = C_BtoN f_B + g_N - (2 w_IE_N + w_EN_N) x v_N,
+ *    Groves 2013 eq. 5.54); H column v_ant resp. a_N. v_ant carries the rate of
+ *    the attitude through the lever arm, C_BtoN (w_IB_B x l) (Groves 2013
+ *    eq. 14.111). First order in d: the error of a measurement taken d late is
+ *    its rate times d; the neglected a d^2 / 2 and (da/dt) d^2 / 2 bias the
+ *    estimate by a few percent at d = 0.3 s on a manoeuvring flight
+ *    (tests/filter/test_extra_states.cpp), hence the range +-0.1 s (limits.hpp).
  */
 #pragma once
 
@@ -39,6 +75,29 @@ struct ProcessBlock {
   stochastic::StateSpaceBlock ss;  ///< continuous model (n = ss.n states)
 };
 
+/**
+ * Optional extra error states (see the file comment for the model and the
+ * convention), each group off by default and on when its prior sigma is > 0.
+ * All are random constants. Prior sigmas in SI, finite, >= 0.
+ */
+struct ExtraStates {
+  double gyro_scale_sigma = 0.0;             ///< gyro scale factors x,y,z [ratio]
+  double acc_scale_sigma = 0.0;              ///< accelerometer scale factors x,y,z [ratio]
+  double gyro_misalignment_sigma_rad = 0.0;  ///< gyro misalignment angles x,y,z [rad]
+  double acc_misalignment_sigma_rad = 0.0;   ///< accelerometer misalignment angles x,y,z [rad]
+  double lever_arm_sigma_m = 0.0;            ///< antenna lever-arm error x,y,z, body FRD [m]
+  double time_offset_sigma_s = 0.0;          ///< IMU-GNSS time offset [s]
+  /// True when any group is on.
+  bool any() const {
+    return gyro_scale_sigma > 0 || acc_scale_sigma > 0 || gyro_misalignment_sigma_rad > 0 ||
+           acc_misalignment_sigma_rad > 0 || lever_arm_sigma_m > 0 || time_offset_sigma_s > 0;
+  }
+};
+
+/// The groups of extra states (ExtraStates), in their order in the state vector.
+enum class Extra { GyroScale, AccScale, GyroMisalignment, AccMisalignment, LeverArm, TimeOffset };
+constexpr int kExtraGroups = 6;
+
 /// Options for the IMU-error part of the state.
 struct ImuErrorOptions {
   /// Add a random-constant turn-on bias state per axis (prior sigma below).
@@ -56,6 +115,8 @@ struct ImuErrorOptions {
   /// into GMs with T = 3-6 ms). ErrorStateEkf raises it to its propagation
   /// interval; 0 = keep every GM as a state. Reported by StateLayout::notes().
   double white_gm_below_s = 0.0;
+  /// Optional extra states (scale factor, misalignment, lever arm, time offset); all off by default.
+  ExtraStates extra;
 };
 
 /// Names and positions of all error states.
@@ -66,7 +127,7 @@ class StateLayout {
    * Build the layout from a six-axis model (axes with an empty model have no
    * states and no noise: a perfect sensor).
    * @throws navimpact::Error if a turn-on sigma is not finite and positive
-   *         while turn_on_bias is set.
+   *         while turn_on_bias is set, or an extra-state sigma is not finite and >= 0.
    */
   static StateLayout build(const stochastic::ImuModel& model, const ImuErrorOptions& opt = {});
 
@@ -85,6 +146,11 @@ class StateLayout {
   const stochastic::ImuModel& model() const { return model_; }
   /// What build() changed in the model (GMs entered as white noise), one line each.
   const std::vector<std::string>& notes() const { return notes_; }
+  /// Full-state index of the first state of an extra group (3 states, 1 for
+  /// TimeOffset), or -1 when the group is off.
+  int extraIndex(Extra g) const { return extra_[static_cast<int>(g)]; }
+  /// True when any extra state is on.
+  bool hasExtra() const { return has_extra_; }
 
  private:
   std::vector<std::string> names_;
@@ -93,6 +159,8 @@ class StateLayout {
   std::array<Eigen::RowVectorXd, 6> h_;
   stochastic::ImuModel model_;
   std::vector<std::string> notes_;
+  std::array<int, kExtraGroups> extra_{{-1, -1, -1, -1, -1, -1}};
+  bool has_extra_ = false;
 };
 
 }  // namespace navimpact::filter
