@@ -13,6 +13,7 @@
 #include "cli_common.hpp"
 #include "navimpact/analysis/diagnose_power.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/report/power_report.hpp"
 
@@ -93,9 +94,11 @@ int run(const Opts& o) {
      << o.runs << " runs per cause, " << o.null_runs << " null records; SNR = effect size / detection limit "
      << "(see README \"Detection power\"); rate " << o.rate << " Hz, "
      << (o.duration_h.empty() ? "samples " + o.samples : "duration " + o.duration_h + " h") << ".\n\n"
-     << table << "\nCost: " << r.cpu_s << " s CPU, " << r.wall_s << " s wall.\n";
+     << table;
   out.writeText("power.md", md.str());
   out.writeText("power.json", navimpact::report::powerJson(r));
+  out.writeText("timing.json", "{\n \"cpu_s\": " + navimpact::formatExact(r.cpu_s) + ",\n \"wall_s\": " +
+                                   navimpact::formatExact(r.wall_s) + "\n}\n");  // apart from the results
   out.commit();
   std::cout << table << "cost: " << r.cpu_s << " s CPU, " << r.wall_s << " s wall\n"
             << "wrote " << (std::filesystem::path(o.out) / "power.md").string() << " and power.json\n";

@@ -57,8 +57,6 @@ std::string powerJson(const PowerResult& r) {
     runs.push_back({{"cause", causeName(x.cause)}, {"snr", x.snr}, {"rate_hz", x.rate_hz},
                     {"duration_s", x.duration_s}, {"detected", x.detected}, {"right", x.right}, {"why", x.why}});
   j["runs"] = runs;
-  j["cpu_s"] = r.cpu_s;
-  j["wall_s"] = r.wall_s;
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
