@@ -53,6 +53,7 @@ struct Opts {
   std::vector<double> durations{10.0, 30.0, 60.0};
   double reconverge = 30.0;
   int realisations = 50;
+  int folds = 5;
 };
 
 /// `diagnose --run`: predicted against measured outage errors of a real run.
@@ -64,6 +65,7 @@ int runOnRun(const Opts& o) {
   ro.durations_s = o.durations;
   ro.reconverge_s = o.reconverge;
   ro.realisations = o.realisations;
+  ro.folds = o.folds;
   ro.seed = o.seed;
   ro.alpha = o.alpha;
   ro.threads = o.threads;
@@ -83,14 +85,14 @@ int runOnRun(const Opts& o) {
   bar.finish();
   nlohmann::json in = {{"run", o.run_rawlog},       {"model", o.model},         {"config", o.replay_config},
                        {"static", o.static_file},   {"durations_s", o.durations}, {"reconverge_s", o.reconverge},
-                       {"realisations", o.realisations}, {"seed", o.seed},     {"alpha", o.alpha}};
+                       {"realisations", o.realisations}, {"folds", o.folds}, {"seed", o.seed},     {"alpha", o.alpha}};
   const std::size_t figs = navimpact::report::writeRunDiagnosisOutputs(
       d, in.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), out);
   out.commit();
   for (const auto& n : d.notices) std::cerr << "navimpact: notice: " << n << "\n";
   std::cout << navimpact::report::runDiagnosisSummary(d);
-  std::cout << "wrote " << (std::filesystem::path(o.out) / "run_diagnosis.json").string() << ", report.md and "
-            << figs << " figure(s)\n";
+  std::cout << "wrote " << (std::filesystem::path(o.out) / "run_diagnosis.json").string() << ", report.md, "
+            << (d.best >= 0 ? "model_extended.yaml, filter_extended.yaml, " : "") << figs << " figure(s)\n";
   return 0;
 }
 
@@ -230,6 +232,8 @@ navimpact::cli::Registrar reg(
            ->capture_default_str();
        app.add_option("--reconverge", o->reconverge, "--run: GNSS time before each outage [s]")->capture_default_str();
        app.add_option("--realisations", o->realisations, "--run: simulated realisations (seeded by --seed)")
+           ->capture_default_str();
+       app.add_option("--folds", o->folds, "--run: cross-validation folds (time blocks of the run) for the causes")
            ->capture_default_str();
        app.add_option("--model", o->model,
                       "model simulated today: FILE[:NAME], or fit:SPEC (e.g. fit:WN+GM) to fit "

@@ -102,7 +102,7 @@ navimpact_cli_check(cli_diagnose_run CHECK run_json
   DEFINES OUT=${_dg_out}/run JSON_FILE=run_diagnosis.json
   JSON "verdict=^(adequate|inadequate)$" "comparisons/0/quantity=^horizontal_position$" "comparisons/0/duration_s=^20"
        "comparisons/0/ratio_interval/1=^[0-9]" "durations/1/duration_s=^40" "simulation/realisations=^4$"
-       "gain/significant=^(false|OFF)$"
+       "gain/significant=^(true|false|ON|OFF)$" "gain/outage_error_before_m=^[0-9]"
   FILES report.md predicted_vs_measured.png)
 navimpact_cli_fail(cli_diagnose_run_fit_model EXIT 1 NOOUT ${_dg_out}/bad11
   ARGS diagnose --run ${_dg_rawlog} --model fit:WN --out ${_dg_out}/bad11

@@ -79,7 +79,10 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       // the fix's own epoch relative to the filter time (0 when on a sample)
       const double dt_meas = std::abs(f.t - t_now) > 1e-9 ? f.t - t_now : 0.0;
       const Eigen::Vector3d sp = f.cov_pos_N->diagonal().cwiseSqrt();
-      bool used = check(ekf.updateGnssPosition(f.pos, sp, opt.lever_arm_B, dt_meas), "gnss_position");
+      const filter::UpdateResult up = ekf.updateGnssPosition(f.pos, sp, opt.lever_arm_B, dt_meas);
+      if (up.innovation.size() == 3 && up.S.rows() == 3)
+        res.gnss_innovations.push_back({f.t, up.innovation, up.S.diagonal(), sp.cwiseAbs2(), up.accepted});
+      bool used = check(up, "gnss_position");
       if (opt.use_gnss_velocity && f.v_N) {
         if (!f.cov_vel_N) throw Error("navigation run: GNSS fix at " + formatNumber(f.t, 10) + " s has no velocity covariance");
         const Eigen::Vector3d sv = f.cov_vel_N->diagonal().cwiseSqrt();

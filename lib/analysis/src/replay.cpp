@@ -186,7 +186,10 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   }
   // IMU model of the filter.
   stochastic::ImuModel model;
-  if (!cfg.model_spec.empty()) {
+  if (cfg.model) {
+    model = *cfg.model;
+    r.model_source = model.source.empty() ? cfg.model_spec : model.source;
+  } else if (!cfg.model_spec.empty()) {
     model = stochastic::loadImuModel(cfg.model_spec);
     r.model_source = model.source;
   } else if (scen && scen["imu_model_yaml"]) {

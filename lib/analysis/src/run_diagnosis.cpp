@@ -7,15 +7,20 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <random>
 #include <thread>
 
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/fisher_f.hpp>
+#include <boost/math/distributions/students_t.hpp>
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
+#include "navimpact/emulation/sensor_effects.hpp"
 #include "navimpact/emulation/sensors.hpp"
+#include "navimpact/core/imu_series.hpp"
+#include "navimpact/rawlog/writer.hpp"
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/simulate.hpp"
@@ -92,7 +97,548 @@ struct RealisationOut {
   std::vector<std::vector<double>> nees;           // [duration][outage]
 };
 
+
+/// Where a measured run-level statistic (log) falls among the realisations' (log):
+/// t = (x - mu) / (sd sqrt(1 + 1/R)), Student t with R - 1 dof (a prediction
+/// interval, Gaussian logs assumed); interval of x - mu at level 1 - a.
+struct LogTest {
+  double mu = 0.0, sd = 0.0, log_ratio = 0.0, lo = 0.0, hi = 0.0, p = 1.0;
+};
+LogTest logTest(double x, const std::vector<double>& logs, double a) {
+  LogTest r;
+  const double R = static_cast<double>(logs.size());
+  if (R < 2) {
+    r.p = NAN;
+    return r;
+  }
+  for (double v : logs) r.mu += v;
+  r.mu /= R;
+  for (double v : logs) r.sd += (v - r.mu) * (v - r.mu);
+  r.sd = std::sqrt(r.sd / (R - 1.0));
+  r.log_ratio = x - r.mu;
+  const double se = r.sd * std::sqrt(1.0 + 1.0 / R);
+  boost::math::students_t st(R - 1.0);
+  const double tq = boost::math::quantile(boost::math::complement(st, a / 2));
+  r.lo = r.log_ratio - tq * se;
+  r.hi = r.log_ratio + tq * se;
+  if (se > 0) r.p = std::min(1.0, 2.0 * boost::math::cdf(boost::math::complement(st, std::abs(r.log_ratio) / se)));
+  else r.p = r.log_ratio == 0.0 ? 1.0 : 0.0;
+  return r;
+}
+
+/// Run tasks 0..n-1 on up to @p threads threads; the first error is rethrown.
+void parallelFor(int n, int threads, const std::function<void(int)>& task) {
+  std::atomic<int> next{0};
+  std::mutex mu;
+  std::string first_error;
+  auto work = [&]() {
+    for (;;) {
+      const int i = next++;
+      if (i >= n) return;
+      try {
+        task(i);
+      } catch (const std::exception& e) {
+        std::lock_guard<std::mutex> lk(mu);
+        if (first_error.empty()) first_error = e.what();
+        next = n;
+      }
+    }
+  };
+  int t = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  t = std::max(1, std::min(t, n));
+  std::vector<std::thread> pool;
+  for (int k = 1; k < t; ++k) pool.emplace_back(work);
+  work();
+  for (auto& th : pool) th.join();
+  if (!first_error.empty()) throw Error(first_error);
+}
+
+/// Error and predicted sigma (nine navigation errors) at the end of each scored outage of @p r.
+std::vector<std::pair<filter::Vector9d, filter::Vector9d>> scoredEnds(const ReplayResult& r) {
+  std::vector<std::pair<filter::Vector9d, filter::Vector9d>> v;
+  for (const auto& o : r.score->outages) {
+    std::pair<filter::Vector9d, filter::Vector9d> e{filter::Vector9d::Constant(NAN), filter::Vector9d::Constant(NAN)};
+    for (const auto& ro : r.run.outages)
+      if (std::abs(ro.window.start_s - r.t_zero - o.start_s) <= 1e-6 && ro.end_epoch >= 0) {
+        const auto& ep = r.run.epochs[static_cast<std::size_t>(ro.end_epoch)];
+        e = {ep.err, ep.sigma};
+      }
+    v.push_back(e);
+  }
+  return v;
+}
+
+/// Negative log-likelihood of the velocity and attitude errors at an outage end
+/// (diagonal), for the parts the reference has.
+double navNll(const std::pair<filter::Vector9d, filter::Vector9d>& e, const ReferenceInfo& ref) {
+  double nll = 0.0;
+  for (int k = 3; k < 9; ++k) {
+    if ((k < 6 && !ref.has_velocity) || (k >= 6 && !ref.has_attitude)) continue;
+    const double v = e.second(k) * e.second(k);
+    if (!(v > 0.0) || !std::isfinite(e.first(k))) continue;
+    nll += 0.5 * (e.first(k) * e.first(k) / v + std::log(v));
+  }
+  return nll;
+}
+
+/// Position negative log-likelihood of one outage end (diagonal covariance, reference counted).
+double outageNll(const OutageScore& o, const ReferenceInfo& ref) {
+  double nll = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double r = i < 2 ? ref.sigma_h_m : ref.sigma_v_m;
+    const double v = o.sigma_N(i) * o.sigma_N(i) + r * r;
+    nll += 0.5 * (o.err_N(i) * o.err_N(i) / v + std::log(v));
+  }
+  return nll;
+}
+
+/// One-sided paired sign-flip permutation p-value of mean(d) > 0 (seeded Monte Carlo).
+double signFlipP(const std::vector<double>& d, std::uint64_t seed, int flips = 20000) {
+  if (d.empty()) return 1.0;
+  double obs = 0.0;
+  bool any = false;
+  for (double x : d) {
+    obs += x;
+    any = any || x != 0.0;
+  }
+  if (!any) return 1.0;
+  std::mt19937_64 rng(seed);
+  int count = 0;
+  for (int b = 0; b < flips; ++b) {
+    double s = 0.0;
+    for (double x : d) s += (rng() & 1u) ? x : -x;
+    if (s >= obs - 1e-12 * std::abs(obs)) ++count;
+  }
+  return (count + 1.0) / (flips + 1.0);
+}
+
+/// A time interval excluded from a fit (the held-out block).
+struct Exclusion {
+  double a = 0.0, b = -1.0;  // empty when b < a
+  bool covers(double t) const { return t >= a && t <= b; }
+  bool overlaps(double s, double e) const { return b >= a && s <= b && e >= a; }
+};
+
+/// Per-channel high-frequency residual of the real IMU against the trajectory.
+struct ImuResidual {
+  std::vector<double> t;                      // sample times
+  std::vector<char> moving;                   // the trajectory moves at the sample
+  std::array<std::vector<double>, 6> r;       // residual rates [rad/s, m/s^2]
+};
+
+/// White-noise sigma^2 batches from second differences over samples k-2..k all
+/// selected (moving == want_moving) and outside @p ex; 20 batch means.
+std::vector<double> wnBatches(const ImuResidual& res, int ch, bool want_moving, const Exclusion& ex) {
+  std::vector<double> d2;
+  for (std::size_t k = 2; k < res.t.size(); ++k) {
+    bool ok = true;
+    for (std::size_t j = k - 2; j <= k && ok; ++j)
+      ok = (res.moving[j] != 0) == want_moving && !ex.covers(res.t[j]);
+    if (!ok) continue;
+    const double v = res.r[ch][k] - 2 * res.r[ch][k - 1] + res.r[ch][k - 2];
+    d2.push_back(v * v / 6.0);
+  }
+  std::vector<double> b;
+  const std::size_t B = 20;
+  if (d2.size() < 10 * B) return b;
+  for (std::size_t i = 0; i < B; ++i) {
+    const std::size_t lo = i * d2.size() / B, hi = (i + 1) * d2.size() / B;
+    double s = 0.0;
+    for (std::size_t k = lo; k < hi; ++k) s += d2[k];
+    b.push_back(s / double(hi - lo));
+  }
+  return b;
+}
+
+/// Mean and 99 % Student-t interval of batch means.
+void batchInterval(const std::vector<double>& b, double& mean, double& lo, double& hi) {
+  const double n = static_cast<double>(b.size());
+  mean = 0.0;
+  for (double x : b) mean += x;
+  mean /= n;
+  double v = 0.0;
+  for (double x : b) v += (x - mean) * (x - mean);
+  v /= (n - 1.0);
+  boost::math::students_t st(n - 1.0);
+  const double h = boost::math::quantile(boost::math::complement(st, 0.005)) * std::sqrt(v / n);
+  lo = std::max(0.0, mean - h);
+  hi = mean + h;
+}
+
+/// Scale every WN term of channel @p ch by @p k (or add WN(sigma_imu) converted to the model rate).
+void inflateWhite(stochastic::ImuModel& m, int ch, double k, double sigma_imu, double imu_rate) {
+  bool has = false;
+  for (auto& p : m.axis[ch].terms)
+    if (p.kind == stochastic::ProcessKind::WN) {
+      p.sigma *= k;
+      has = true;
+    }
+  if (!has && sigma_imu > 0.0) {
+    const double r = m.axis[ch].rate_hz > 0 ? m.axis[ch].rate_hz : m.rate_hz;
+    m.axis[ch].terms.push_back(stochastic::Process::wn(sigma_imu * std::sqrt(r / imu_rate)));
+  }
+}
+
+/// Add an RW of continuous density q [(unit)^2/s] to channel @p ch (merged with an existing RW).
+void addRandomWalk(stochastic::ImuModel& m, int ch, double q) {
+  if (!(q > 0.0)) return;
+  const double r = m.axis[ch].rate_hz > 0 ? m.axis[ch].rate_hz : m.rate_hz;
+  for (auto& p : m.axis[ch].terms)
+    if (p.kind == stochastic::ProcessKind::RW) {
+      p.gamma = std::sqrt(p.gamma * p.gamma + q / r);
+      return;
+    }
+  m.axis[ch].terms.push_back(stochastic::Process::rw(std::sqrt(q / r)));
+}
+
 }  // namespace
+
+/// The causes: fitted per fold outside the held-out block, scored on the held-out outages.
+template <class SimOutages, class Progress>
+void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std::vector<ReplayResult>& measured,
+                    const SimOutages& simOut, const std::vector<RealisationOut>& sims,
+                    const emulation::SmoothTrajectory& tr, double t0, double t1, const stochastic::ImuModel& model,
+                    const Progress& progress) {
+  if (opt.folds < 2) throw Error("diagnose --run: --folds must be >= 2");
+  const std::size_t D = measured.size();
+  const int K = opt.folds;
+  out.folds = K;
+  const ReferenceInfo& ref = out.reference;
+  const double rate = out.imu_rate_hz;
+  const double L = (t1 - t0) / K;
+
+  // Outages: (duration, index into simOut), their fold and window (absolute).
+  struct Item {
+    std::size_t i, j;
+    int fold;
+    double a, b;     // window
+    double T;        // coasting time at the scored end [s]
+    double pred_h2, pred_v2;  // simulated mean squares at this outage end
+  };
+  std::vector<Item> items;
+  for (std::size_t i = 0; i < D; ++i) {
+    const auto& sc = *measured[i].score;
+    const double tz = measured[i].t_zero;
+    for (std::size_t j = 0; j < simOut[i].size(); ++j) {
+      const auto& o = sc.outages[simOut[i][j].score_index];
+      Item it{i, j, 0, o.start_s + tz, o.start_s + tz + o.duration_s, o.end_s - o.start_s, 0.0, 0.0};
+      const double mid = 0.5 * (it.a + it.b);
+      it.fold = std::min(K - 1, std::max(0, static_cast<int>(std::floor((mid - t0) / L))));
+      double h2 = 0.0, v2 = 0.0;
+      for (const auto& s : sims) {
+        const auto& e = s.err[i][j];
+        h2 += e(0) * e(0) + e(1) * e(1);
+        v2 += e(2) * e(2);
+      }
+      it.pred_h2 = h2 / double(sims.size());
+      it.pred_v2 = v2 / double(sims.size());
+      items.push_back(it);
+    }
+  }
+  std::vector<Exclusion> excl(K);
+  std::vector<int> heldCount(K, 0);
+  for (int f = 0; f < K; ++f) {
+    excl[f] = {t0 + f * L, t0 + (f + 1) * L};
+    for (const auto& it : items)
+      if (it.fold == f) {
+        excl[f].a = std::min(excl[f].a, it.a);
+        excl[f].b = std::max(excl[f].b, it.b);
+        ++heldCount[f];
+      }
+  }
+  const Exclusion none{};
+
+  // IMU residual against the trajectory (real IMU read again from the rawlog).
+  ImuResidual res;
+  {
+    const Recording rec = rawlog::readRawlog(opt.replay.rawlog, {opt.replay.imu_label, opt.replay.gnss_label});
+    const double dt = 1.0 / rate;
+    for (const auto& s : rec.imu) {
+      if (s.t - dt < tr.tBegin() || s.t > tr.tEnd()) continue;
+      Eigen::Vector3d dv, dth;
+      tr.increments(s.t - dt, s.t, dv, dth);
+      const emulation::TruthState x = tr.at(s.t);
+      const emulation::SensorEffects fx;  // the emulation's motion test, its default thresholds
+      const bool mv = x.w_IB_B.norm() > fx.motion_rate_threshold_rad_s ||
+                      std::abs(x.f_B.norm() - 9.80665) > fx.motion_acc_threshold_mps2;
+      res.t.push_back(s.t);
+      res.moving.push_back(mv ? 1 : 0);
+      for (int a = 0; a < 3; ++a) {
+        res.r[a].push_back(s.w_IB_B(a) - dth(a) / dt);
+        res.r[3 + a].push_back(s.f_B(a) - dv(a) / dt);
+      }
+    }
+  }
+  const std::array<double, 6> wnModel = emulation::whiteNoiseSigma(model, rate);
+  const auto& innov = measured.front().run.gnss_innovations;
+
+  // The fits; each returns the extended replay configuration and, for the whole run, findings.
+  using Fit = std::function<ReplayConfig(const Exclusion&, std::vector<RunFinding>*, CauseResult*)>;
+  auto fitMotion = [&](const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
+    stochastic::ImuModel m = model;
+    for (int c = 0; c < 6; ++c) {
+      const auto b = wnBatches(res, c, true, ex);
+      if (b.empty()) continue;
+      double mean, lo, hi;
+      batchInterval(b, mean, lo, hi);
+      const double sig = std::sqrt(mean);
+      const double k = wnModel[c] > 0 ? sig / wnModel[c] : NAN;
+      inflateWhite(m, c, std::isfinite(k) ? k : 1.0, sig, rate);
+      if (fnd) {
+        RunFinding f;
+        f.cause = "in_motion_noise";
+        f.channel = kChannelNames[c];
+        f.params = {{"factor", k}, {"white_sigma_in_motion", sig}};
+        f.interval = {{"factor", {std::sqrt(lo) / wnModel[c], std::sqrt(hi) / wnModel[c]}},
+                      {"white_sigma_in_motion", {std::sqrt(lo), std::sqrt(hi)}}};
+        const auto bs = wnBatches(res, c, false, ex);
+        if (!bs.empty()) {
+          double ms, l2, h2;
+          batchInterval(bs, ms, l2, h2);
+          f.params.push_back({"factor_at_rest", std::sqrt(ms) / wnModel[c]});
+          f.interval.push_back({"factor_at_rest", {std::sqrt(l2) / wnModel[c], std::sqrt(h2) / wnModel[c]}});
+        }
+        f.note = "second differences of the IMU residual while moving, 20 batch means, 99 % Student-t interval";
+        fnd->push_back(f);
+      }
+    }
+    m.source = model.source + " with in-motion white noise";
+    if (cr) {
+      cr->model_after = m;
+      cr->extension = "each channel's white noise multiplied by its in-motion factor";
+    }
+    ReplayConfig c = opt.replay;
+    c.model = m;
+    return c;
+  };
+  auto fitGnss = [&](const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
+    // per axis group (horizontal N, E pooled; vertical): innovations outside the block
+    std::array<std::vector<double>, 2> dz2, hph, rr;
+    std::array<double, 3> nis{0, 0, 0}, lag{0, 0, 0};
+    std::array<std::size_t, 3> nn{0, 0, 0}, nl{0, 0, 0};
+    std::vector<double> rh, rv;
+    std::array<double, 3> prevZ{NAN, NAN, NAN};
+    for (const auto& g : innov) {
+      if (!g.accepted || ex.covers(g.t)) {
+        prevZ = {NAN, NAN, NAN};
+        continue;
+      }
+      for (int a = 0; a < 3; ++a) {
+        const int grp = a < 2 ? 0 : 1;
+        dz2[grp].push_back(g.dz(a) * g.dz(a));
+        hph[grp].push_back(std::max(0.0, g.S_diag(a) - g.R_diag(a)));
+        rr[grp].push_back(g.R_diag(a));
+        const double z = g.dz(a) / std::sqrt(g.S_diag(a));
+        nis[a] += z * z;
+        ++nn[a];
+        if (std::isfinite(prevZ[a])) {
+          lag[a] += z * prevZ[a];
+          ++nl[a];
+        }
+        prevZ[a] = z;
+      }
+      rh.push_back(std::sqrt(0.5 * (g.R_diag(0) + g.R_diag(1))));
+      rv.push_back(std::sqrt(g.R_diag(2)));
+    }
+    if (dz2[0].size() < 6 || dz2[1].size() < 3)
+      throw Error("diagnose --run: too few GNSS innovations outside the held-out block");
+    // s solves mean(dz^2 / (HPH' + s^2 R)) = target (decreasing in s), by bisection on log s in [0.01, 1000]
+    auto solve = [&](int grp, double target) {
+      auto F = [&](double sc) {
+        double m = 0.0;
+        for (std::size_t k = 0; k < dz2[grp].size(); ++k) m += dz2[grp][k] / (hph[grp][k] + sc * sc * rr[grp][k]);
+        return m / double(dz2[grp].size());
+      };
+      double lo = std::log(0.01), hi = std::log(1000.0);
+      if (F(std::exp(lo)) <= target) return std::exp(lo);
+      if (F(std::exp(hi)) >= target) return std::exp(hi);
+      for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (F(std::exp(mid)) > target ? lo : hi) = mid;
+      }
+      return std::exp(0.5 * (lo + hi));
+    };
+    double scale[2], slo[2], shi[2];
+    for (int grp = 0; grp < 2; ++grp) {
+      const double N = double(dz2[grp].size());
+      boost::math::chi_squared chi(N);
+      scale[grp] = solve(grp, 1.0);
+      slo[grp] = solve(grp, boost::math::quantile(chi, 0.995) / N);
+      shi[grp] = solve(grp, boost::math::quantile(chi, 0.005) / N);
+    }
+    ReplayConfig c = opt.replay;
+    c.sigma_pos_h_m = scale[0] * percentile(rh, 0.5);
+    c.sigma_pos_v_m = scale[1] * percentile(rv, 0.5);
+    if (fnd) {
+      RunFinding f;
+      f.cause = "gnss_noise";
+      f.channel = "gnss";
+      f.params = {{"sigma_scale_h", scale[0]}, {"sigma_scale_v", scale[1]},
+                  {"sigma_pos_h_m", *c.sigma_pos_h_m}, {"sigma_pos_v_m", *c.sigma_pos_v_m}};
+      f.interval = {{"sigma_scale_h", {slo[0], shi[0]}}, {"sigma_scale_v", {slo[1], shi[1]}}};
+      const char* ax[3] = {"n", "e", "d"};
+      for (int a = 0; a < 3; ++a) {
+        const double N = double(nn[a]);
+        boost::math::chi_squared chi(N);
+        f.params.push_back({std::string("mean_nis_") + ax[a], nis[a] / N});
+        f.interval.push_back({std::string("mean_nis_") + ax[a],
+                              {boost::math::quantile(chi, 0.005) / N, boost::math::quantile(chi, 0.995) / N}});
+        const double rho = nl[a] ? (lag[a] / double(nl[a])) / (nis[a] / N) : NAN;
+        f.params.push_back({std::string("lag1_correlation_") + ax[a], rho});
+        const double zb = 2.576 / std::sqrt(std::max<double>(1.0, double(nl[a])));
+        f.interval.push_back({std::string("lag1_correlation_") + ax[a], {-zb, zb}});
+      }
+      f.note = "GNSS position innovations of the aided phases: the scale s of the fix sigmas that makes the mean NIS 1 "
+               "(horizontal, vertical; 99 % interval from chi-square on the count, innovations treated as independent); "
+               "mean NIS and lag-1 correlation intervals are the 99 % bands of a consistent filter with white GNSS errors";
+      fnd->push_back(f);
+    }
+    if (cr) {
+      cr->model_after = model;
+      cr->gnss_sigma_h_m = c.sigma_pos_h_m;
+      cr->gnss_sigma_v_m = c.sigma_pos_v_m;
+      cr->extension = "the filter's GNSS position sigmas set to the fitted scale times the median fix sigma";
+    }
+    return c;
+  };
+  auto fitBias = [&](const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
+    std::vector<const Item*> tr_items;
+    for (const auto& it : items)
+      if (!ex.overlaps(it.a, it.b)) tr_items.push_back(&it);
+    if (tr_items.empty()) throw Error("diagnose --run: no training outage outside the held-out block");
+    auto lsq = [&](const std::vector<const Item*>& v, double& qh, double& qv) {
+      double nh = 0, dh = 0, nv = 0, dv = 0;
+      for (const Item* it : v) {
+        const auto& o = measured[it->i].score->outages[simOut[it->i][it->j].score_index];
+        const double eh2 = o.err_N(0) * o.err_N(0) + o.err_N(1) * o.err_N(1), ev2 = o.err_N(2) * o.err_N(2);
+        const double xh = std::pow(it->T, 5) / 10.0, xv = std::pow(it->T, 5) / 20.0;
+        nh += (eh2 - it->pred_h2 - 2 * ref.sigma_h_m * ref.sigma_h_m) * xh;
+        dh += xh * xh;
+        nv += (ev2 - it->pred_v2 - ref.sigma_v_m * ref.sigma_v_m) * xv;
+        dv += xv * xv;
+      }
+      qh = dh > 0 ? std::max(0.0, nh / dh) : 0.0;
+      qv = dv > 0 ? std::max(0.0, nv / dv) : 0.0;
+    };
+    double qh, qv;
+    lsq(tr_items, qh, qv);
+    stochastic::ImuModel m = model;
+    addRandomWalk(m, 3, qh);
+    addRandomWalk(m, 4, qh);
+    addRandomWalk(m, 5, qv);
+    m.source = model.source + " with an accelerometer bias random walk";
+    if (fnd) {
+      // seeded bootstrap over the outages
+      std::mt19937_64 rng(stochastic::deriveSeed(opt.seed, 9001));
+      std::vector<double> bh, bv;
+      for (int b = 0; b < 999; ++b) {
+        std::vector<const Item*> v;
+        for (std::size_t k = 0; k < tr_items.size(); ++k) v.push_back(tr_items[rng() % tr_items.size()]);
+        double a1, a2;
+        lsq(v, a1, a2);
+        bh.push_back(a1);
+        bv.push_back(a2);
+      }
+      for (int c = 3; c < 6; ++c) {
+        const double q = c < 5 ? qh : qv;
+        const auto& bb = c < 5 ? bh : bv;
+        RunFinding f;
+        f.cause = "bias_instability";
+        f.channel = kChannelNames[c];
+        f.params = {{"rw_density", std::sqrt(q)}};
+        f.interval = {{"rw_density", {std::sqrt(percentile(bb, 0.005)), std::sqrt(percentile(bb, 0.995))}}};
+        f.note = std::string("accelerometer bias random walk density [m/s^2/sqrt(s)] from the ") +
+                 (c < 5 ? "horizontal" : "vertical") + " outage-end errors' excess over the simulation (q T^5/20 per axis), "
+                 "99 % interval by a seeded bootstrap over " + std::to_string(tr_items.size()) + " outages";
+        fnd->push_back(f);
+      }
+    }
+    if (cr) {
+      cr->model_after = m;
+      cr->extension = "an accelerometer bias random walk added (horizontal channels from the horizontal errors, acc_z from the vertical)";
+    }
+    ReplayConfig c = opt.replay;
+    c.model = m;
+    return c;
+  };
+  const std::vector<std::pair<std::string, Fit>> cands = {
+      {"in_motion_noise", fitMotion}, {"gnss_noise", fitGnss}, {"bias_instability", fitBias}};
+  const int C = static_cast<int>(cands.size());
+
+  // Held-out scores: task (cause, fold) replays every duration with the fold's extension.
+  std::vector<std::vector<std::vector<OutageScore>>> after(C * K);  // [task][duration] scored outages
+  std::vector<std::vector<std::vector<std::pair<filter::Vector9d, filter::Vector9d>>>> afterEnds(C * K);
+  std::vector<std::vector<std::pair<filter::Vector9d, filter::Vector9d>>> beforeEnds(D);
+  for (std::size_t i = 0; i < D; ++i) beforeEnds[i] = scoredEnds(measured[i]);
+  std::atomic<int> done{0};
+  std::mutex mu;
+  parallelFor(C * K, opt.threads, [&](int task) {
+    const int c = task / K, f = task % K;
+    if (heldCount[f] == 0) return;
+    ReplayConfig cfg = cands[c].second(excl[f], nullptr, nullptr);
+    std::vector<std::vector<OutageScore>> per(D);
+    std::vector<std::vector<std::pair<filter::Vector9d, filter::Vector9d>>> ends(D);
+    for (std::size_t i = 0; i < D; ++i) {
+      cfg.outages.clear();
+      cfg.outages_every = measured[i].cfg.outages_every;
+      const ReplayResult r = runReplay(cfg);
+      if (!r.score || r.score->outages.size() != measured[i].score->outages.size())
+        throw Error("diagnose --run: the extended replay scored other outages than today's");
+      per[i] = r.score->outages;
+      ends[i] = scoredEnds(r);
+    }
+    after[task] = std::move(per);
+    afterEnds[task] = std::move(ends);
+    const int dn = ++done;
+    std::lock_guard<std::mutex> lk(mu);
+    progress(0.80 + 0.19 * double(dn) / double(C * K), "causes");
+  });
+
+  for (int c = 0; c < C; ++c) {
+    CauseResult cr;
+    cr.cause = cands[c].first;
+    cands[c].second(Exclusion{}, &cr.findings, &cr);
+    std::vector<double> g, ge;
+    double eb = 0, ea = 0, vb = 0, va = 0, nb = 0, na = 0;
+    for (const auto& it : items) {
+      const auto& ob = measured[it.i].score->outages[simOut[it.i][it.j].score_index];
+      const auto& oa = after[c * K + it.fold][it.i][simOut[it.i][it.j].score_index];
+      const std::size_t si = simOut[it.i][it.j].score_index;
+      g.push_back(outageNll(ob, ref) + navNll(beforeEnds[it.i][si], ref) - outageNll(oa, ref) -
+                  navNll(afterEnds[c * K + it.fold][it.i][si], ref));
+      ge.push_back(ob.err_N.norm() - oa.err_N.norm());
+      eb += ob.horizontal_error_m * ob.horizontal_error_m;
+      ea += oa.horizontal_error_m * oa.horizontal_error_m;
+      vb += ob.vertical_error_m * ob.vertical_error_m;
+      va += oa.vertical_error_m * oa.vertical_error_m;
+      nb += ob.nees;
+      na += oa.nees;
+    }
+    const double n = double(items.size());
+    cr.heldout_outages = items.size();
+    cr.error_before_m = std::sqrt(eb / n);
+    cr.error_after_m = std::sqrt(ea / n);
+    cr.vertical_before_m = std::sqrt(vb / n);
+    cr.vertical_after_m = std::sqrt(va / n);
+    cr.anees_before = nb / n;
+    cr.anees_after = na / n;
+    double s = 0;
+    for (double x : g) s += x;
+    cr.gain = s / n;
+    cr.p_value = signFlipP(g, stochastic::deriveSeed(opt.seed, 7000 + c));
+    cr.error_p_value = signFlipP(ge, stochastic::deriveSeed(opt.seed, 7100 + c));
+    cr.significant = cr.gain > 0 && cr.p_value < opt.alpha / C;
+    out.causes.push_back(std::move(cr));
+  }
+  std::stable_sort(out.causes.begin(), out.causes.end(),
+                   [](const CauseResult& a, const CauseResult& b) { return a.gain > b.gain; });
+  for (std::size_t k = 0; k < out.causes.size(); ++k)
+    if (out.causes[k].significant) {
+      if (out.best < 0) out.best = static_cast<int>(k);
+      for (const auto& f : out.causes[k].findings) out.findings.push_back(f);
+    }
+  (void)none;
+}
 
 RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   const auto wall0 = std::chrono::steady_clock::now();
@@ -272,7 +818,7 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
           }
           const int dn = ++done;
           std::lock_guard<std::mutex> lk(mu);
-          progress(0.15 + 0.85 * double(dn) / double(R * D), "simulation");
+          progress(0.15 + (opt.causes ? 0.65 : 0.85) * double(dn) / double(R * D), "simulation");
         }
       } catch (const std::exception& e) {
         std::lock_guard<std::mutex> lk(mu);
@@ -311,9 +857,27 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
     for (const auto& o : dd.measured) sn += o.nees;
     dd.anees = sn / double(K);
     boost::math::chi_squared chi(3.0 * double(K));
-    dd.anees_lo = boost::math::quantile(chi, a / 2) / double(K);
-    dd.anees_hi = boost::math::quantile(chi, 1 - a / 2) / double(K);
-    dd.anees_rejects = dd.anees < dd.anees_lo || dd.anees > dd.anees_hi;
+    dd.chi2_lo = boost::math::quantile(chi, a / 2) / double(K);
+    dd.chi2_hi = boost::math::quantile(chi, 1 - a / 2) / double(K);
+    {
+      // the measured mean NEES against the same statistic of each realisation
+      std::vector<double> logs;
+      for (const auto& s : sims) {
+        double m = 0.0;
+        std::size_t n = 0;
+        for (double v : s.nees[i])
+          if (std::isfinite(v)) {
+            m += v;
+            ++n;
+          }
+        if (n > 0 && m > 0) logs.push_back(std::log(m / double(n)));
+      }
+      const LogTest lt = logTest(std::log(std::max(dd.anees, 1e-300)), logs, a);
+      dd.anees_lo = std::exp(lt.mu + (lt.lo - lt.log_ratio));
+      dd.anees_hi = std::exp(lt.mu + (lt.hi - lt.log_ratio));
+      dd.anees_p = lt.p;
+      dd.anees_rejects = lt.p < a;
+    }
     double ps = 0.0;
     std::size_t pn = 0;
     for (const auto& s : sims)
@@ -326,8 +890,8 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
     dd.simulated_outages = static_cast<std::size_t>(R) * simOut[i].size();
     if (dd.anees_rejects)
       out.reasons.push_back("measured mean NEES " + formatNumber(dd.anees, 3) + " at " + formatNumber(dd.duration_s) +
-                            " s outages outside its band [" + formatNumber(dd.anees_lo, 3) + ", " +
-                            formatNumber(dd.anees_hi, 3) + "]");
+                            " s outages outside the simulated band [" + formatNumber(dd.anees_lo, 3) + ", " +
+                            formatNumber(dd.anees_hi, 3) + "], p = " + formatNumber(dd.anees_p, 3));
 
     // measured errors: the end epoch of each run outage (velocity, attitude from the run's epochs)
     std::vector<filter::Vector9d> mErr;
@@ -353,25 +917,24 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
       for (const auto& s : sims)
         for (const auto& e : s.err[i]) c.predicted.push_back(magnitude(q, e));
       const double refVar = q == 0 ? 2 * ref.sigma_h_m * ref.sigma_h_m : q == 1 ? ref.sigma_v_m * ref.sigma_v_m : 0.0;
-      const double msM = meanSquare(c.measured), msP = meanSquare(c.predicted) + refVar;
-      c.measured_rms = std::sqrt(msM);
-      c.predicted_rms = std::sqrt(msP);
+      c.measured_rms = std::sqrt(meanSquare(c.measured));
+      // the same statistic (RMS over these outages) for each realisation
+      std::vector<double> logs;
+      for (const auto& s : sims) {
+        std::vector<double> m;
+        for (const auto& e : s.err[i]) m.push_back(magnitude(q, e));
+        logs.push_back(0.5 * std::log(meanSquare(m) + refVar));
+      }
+      const LogTest lt = logTest(std::log(c.measured_rms), logs, a);
+      c.predicted_rms = std::exp(lt.mu);
+      c.predicted_log_sd = lt.sd;
       c.predicted_p05 = percentile(c.predicted, 0.05);
       c.predicted_p50 = percentile(c.predicted, 0.50);
       c.predicted_p95 = percentile(c.predicted, 0.95);
-      c.ratio = c.measured_rms / c.predicted_rms;
-      const double d1 = double(c.dof) * double(c.measured.size()), d2 = double(c.dof) * double(c.predicted.size());
-      boost::math::fisher_f F(d1, d2);
-      const double f = msM / msP;
-      if (std::isfinite(f) && f > 0.0) {
-        const double cdf = boost::math::cdf(F, f);
-        c.p_value = std::min(1.0, 2.0 * std::min(cdf, 1.0 - cdf));
-        c.ratio_lo = std::sqrt(f / boost::math::quantile(F, 1 - a / 2));
-        c.ratio_hi = std::sqrt(f / boost::math::quantile(F, a / 2));
-      } else {
-        c.p_value = f == 0.0 ? 0.0 : 1.0;
-        c.ratio_lo = c.ratio_hi = c.ratio;
-      }
+      c.ratio = std::exp(lt.log_ratio);
+      c.ratio_lo = std::exp(lt.lo);
+      c.ratio_hi = std::exp(lt.hi);
+      c.p_value = lt.p;
       c.rejects = c.p_value < a;
       if (c.rejects)
         out.reasons.push_back(c.quantity + " at " + formatNumber(c.duration_s) + " s outages: measured/predicted RMS " +
@@ -382,6 +945,8 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
     out.durations.push_back(std::move(dd));
   }
   out.verdict = out.reasons.empty() ? "adequate" : "inadequate";
+  out.model_before = model;
+  if (opt.causes) diagnoseCauses(opt, out, measured, simOut, sims, tr, t0, t1, model, progress);
   progress(1.0, "done");
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return out;

@@ -9,6 +9,7 @@
 
 #include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
+#include "navimpact/stochastic/model_file.hpp"
 
 namespace navimpact::report {
 
@@ -31,17 +32,55 @@ std::string runDiagnosisJson(const RunDiagnosis& d, const std::string& input_jso
       {"tests", d.tests},
       {"level_per_test", d.test_level},
       {"method",
-       "Bonferroni over two-sided F tests of measured against simulated mean squared outage-end errors "
-       "(dof = components x outages) and chi-square bands of the measured mean position NEES"},
+       "Bonferroni over two-sided tests of the run-level statistics (RMS outage-end error per quantity and duration, "
+       "mean position NEES per duration) against their distribution over the simulated realisations "
+       "(ln statistic, Student t prediction interval with R - 1 dof)"},
       {"reasons", d.reasons}};
+  auto findingJson = [](const analysis::RunFinding& f) {
+    nlohmann::json p = nlohmann::json::object(), iv = nlohmann::json::object();
+    for (const auto& kv : f.params) p[kv.first] = num(kv.second);
+    for (const auto& kv : f.interval) iv[kv.first] = {num(kv.second.first), num(kv.second.second)};
+    return nlohmann::json{{"cause", f.cause}, {"channel", f.channel}, {"params", p}, {"interval", iv}, {"note", f.note}};
+  };
   j["findings"] = nlohmann::json::array();
-  // The extension and its held-out gain come with the cause analysis; none yet.
-  j["gain"] = {{"outage_error_before_m", nullptr},
-               {"outage_error_after_m", nullptr},
-               {"anees_before", nullptr},
-               {"anees_after", nullptr},
-               {"significant", false},
-               {"note", "no cause fitted: no extension to compare"}};
+  for (const auto& f : d.findings) j["findings"].push_back(findingJson(f));
+  auto gainJson = [&](const analysis::CauseResult& c) {
+    return nlohmann::json{{"cause", c.cause},
+                          {"outage_error_before_m", num(c.error_before_m)},
+                          {"outage_error_after_m", num(c.error_after_m)},
+                          {"vertical_error_before_m", num(c.vertical_before_m)},
+                          {"vertical_error_after_m", num(c.vertical_after_m)},
+                          {"anees_before", num(c.anees_before)},
+                          {"anees_after", num(c.anees_after)},
+                          {"nll_gain", num(c.gain)},
+                          {"p_value", num(c.p_value)},
+                          {"error_p_value", num(c.error_p_value)},
+                          {"heldout_outages", c.heldout_outages},
+                          {"significant", c.significant},
+                          {"extension", c.extension}};
+  };
+  if (d.best >= 0) {
+    j["gain"] = gainJson(d.causes[static_cast<std::size_t>(d.best)]);
+  } else if (!d.causes.empty()) {
+    j["gain"] = gainJson(d.causes.front());
+    j["gain"]["note"] = "no cause has a significant held-out gain: the best-ranked one is shown, no extension written";
+  } else {
+    j["gain"] = {{"outage_error_before_m", nullptr}, {"outage_error_after_m", nullptr}, {"anees_before", nullptr},
+                 {"anees_after", nullptr}, {"significant", false}, {"note", "causes not analysed"}};
+  }
+  nlohmann::json cs = nlohmann::json::array();
+  for (const auto& c : d.causes) {
+    nlohmann::json cj = gainJson(c);
+    cj["findings"] = nlohmann::json::array();
+    for (const auto& f : c.findings) cj["findings"].push_back(findingJson(f));
+    cs.push_back(cj);
+  }
+  j["causes"] = cs;
+  j["cross_validation"] = {{"folds", d.folds},
+                           {"method",
+                            "time blocks of the run; each outage held out once, the cause fitted outside its block; "
+                            "score: position negative log-likelihood at the outage end; one-sided paired sign-flip "
+                            "permutation test (20000 seeded flips) at alpha / causes"}};
   j["run"] = {{"rawlog", d.rawlog},
               {"model", d.model_source},
               {"imu_rate_hz", d.imu_rate_hz},
@@ -74,6 +113,8 @@ std::string runDiagnosisJson(const RunDiagnosis& d, const std::string& input_jso
                     {"measured_anees", num(dd.anees)},
                     {"anees_band", {num(dd.anees_lo), num(dd.anees_hi)}},
                     {"anees_outside_band", dd.anees_rejects},
+                    {"anees_p_value", num(dd.anees_p)},
+                    {"anees_chi2_band_independent_outages", {num(dd.chi2_lo), num(dd.chi2_hi)}},
                     {"predicted_anees", num(dd.predicted_anees)},
                     {"coverage", dd.distribution.coverage},
                     {"coverage_expected", dd.distribution.coverage_expected},
@@ -94,7 +135,9 @@ std::string runDiagnosisJson(const RunDiagnosis& d, const std::string& input_jso
                    {"predicted_p95", num(c.predicted_p95)},
                    {"ratio", num(c.ratio)},
                    {"ratio_interval", {num(c.ratio_lo), num(c.ratio_hi)}},
-                   {"interval_method", "F distribution, level " + formatNumber(1.0 - d.test_level, 6)},
+                   {"predicted_log_sd", num(c.predicted_log_sd)},
+                   {"interval_method", "Student t prediction interval over the realisations, level " +
+                                           formatNumber(1.0 - d.test_level, 6)},
                    {"p_value", num(c.p_value)},
                    {"rejects", c.rejects}});
   j["comparisons"] = cmp;
@@ -113,10 +156,9 @@ std::string runDiagnosisMarkdown(const RunDiagnosis& d) {
   for (const auto& r : d.reasons) s << "- " << r << "\n";
   if (!d.reasons.empty()) s << "\n";
   s << "## Measured against predicted at the outage ends\n\n";
-  s << "Ratio = measured RMS / predicted RMS; interval from the F distribution at level "
-    << formatNumber(1.0 - d.test_level, 4)
-    << " (counts: error components x outages; outages of one run counted as independent, which they are not "
-       "entirely).\n\n";
+  s << "Ratio = measured RMS over the run's outages / the same RMS predicted (geometric mean over the "
+    << d.realisations << " realisations); interval and p from the spread of that RMS over the realisations "
+    << "(Student t prediction interval on ln RMS), level " << formatNumber(1.0 - d.test_level, 4) << ".\n\n";
   s << "| duration [s] | quantity | measured outages | measured RMS | predicted RMS | predicted 5-95 % | ratio | "
        "interval | p |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : d.comparisons)
@@ -126,16 +168,52 @@ std::string runDiagnosisMarkdown(const RunDiagnosis& d) {
       << ", " << r3(c.ratio_hi) << "] | " << formatReadable(c.p_value, 2) << (c.rejects ? " (rejects)" : "")
       << " |\n";
   s << "\n## Measured NEES and coverage (the filter's own sigma)\n\n";
-  s << "| duration [s] | outages | mean position NEES | band | simulated mean NEES | coverage 1/2/3 sigma |\n"
-       "|---|---|---|---|---|---|\n";
+  s << "| duration [s] | outages | mean position NEES | simulated band | p | chi-square band (independent outages) | "
+       "simulated mean NEES | coverage 1/2/3 sigma |\n|---|---|---|---|---|---|---|---|\n";
   for (const auto& dd : d.durations)
     s << "| " << formatNumber(dd.duration_s) << " | " << dd.measured.size() << " | " << r3(dd.anees) << " | ["
       << r3(dd.anees_lo) << ", " << r3(dd.anees_hi) << "]" << (dd.anees_rejects ? " outside" : "") << " | "
+      << formatReadable(dd.anees_p, 2) << " | [" << r3(dd.chi2_lo) << ", " << r3(dd.chi2_hi) << "] | "
       << r3(dd.predicted_anees) << " | " << formatFixed(100 * dd.distribution.coverage[0], 0) << " / "
       << formatFixed(100 * dd.distribution.coverage[1], 0) << " / " << formatFixed(100 * dd.distribution.coverage[2], 0)
       << " % (expected 68 / 95 / 99.7) |\n";
   s << "\nFigure: predicted_vs_measured.png (simulated 5-95 % band and median, measured outages as points).\n";
-  s << "\n## Causes and the extension\n\nNo cause analysis in this report: no extension and no gain.\n";
+  s << "\n## Causes (fitted on training outages, scored on held-out ones)\n\n";
+  if (d.causes.empty()) {
+    s << "Not analysed.\n";
+  } else {
+    s << d.folds << "-fold cross-validation over time blocks of the run; gain = mean decrease of the position "
+      << "negative log-likelihood per held-out outage; p: one-sided paired sign-flip permutation test, significant "
+      << "below " << formatReadable(d.alpha / double(d.causes.size()), 3) << ".\n\n";
+    s << "| rank | cause | held-out outages | horizontal RMS before / after | vertical RMS before / after | "
+         "mean NEES before / after | gain | p | significant |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (std::size_t k = 0; k < d.causes.size(); ++k) {
+      const auto& c = d.causes[k];
+      s << "| " << k + 1 << " | " << c.cause << " | " << c.heldout_outages << " | " << r3(c.error_before_m) << " / "
+        << r3(c.error_after_m) << " m | " << r3(c.vertical_before_m) << " / " << r3(c.vertical_after_m) << " m | "
+        << r3(c.anees_before) << " / " << r3(c.anees_after) << " | " << r3(c.gain) << " | "
+        << formatReadable(c.p_value, 2) << " | " << (c.significant ? "yes" : "no") << " |\n";
+    }
+    s << "\n### Fitted parameters (whole run)\n\n| cause | channel | parameter | value | interval |\n|---|---|---|---|---|\n";
+    for (const auto& c : d.causes)
+      for (const auto& f : c.findings)
+        for (std::size_t k = 0; k < f.params.size(); ++k) {
+          s << "| " << f.cause << " | " << f.channel << " | " << f.params[k].first << " | " << r3(f.params[k].second)
+            << " | ";
+          for (const auto& iv : f.interval)
+            if (iv.first == f.params[k].first) s << "[" << r3(iv.second.first) << ", " << r3(iv.second.second) << "]";
+          s << " |\n";
+        }
+    if (d.best >= 0) {
+      const auto& b = d.causes[static_cast<std::size_t>(d.best)];
+      s << "\n**Cause: " << b.cause << "** (" << b.extension << "). Held-out horizontal error "
+        << r3(b.error_before_m) << " -> " << r3(b.error_after_m) << " m, mean NEES " << r3(b.anees_before) << " -> "
+        << r3(b.anees_after) << ", p = " << formatReadable(b.p_value, 2)
+        << ". The extension: model_extended.yaml and filter_extended.yaml.\n";
+    } else {
+      s << "\nNo cause has a significant held-out gain: no extension is proposed.\n";
+    }
+  }
   if (!d.notices.empty()) {
     s << "\n## Notices\n\n";
     for (const auto& n : d.notices) s << "- " << n << "\n";
@@ -153,6 +231,9 @@ std::string runDiagnosisSummary(const RunDiagnosis& d) {
   for (const auto& dd : d.durations)
     s << "  " << formatNumber(dd.duration_s) << " s mean NEES " << r3(dd.anees) << " band [" << r3(dd.anees_lo) << ", "
       << r3(dd.anees_hi) << "]" << (dd.anees_rejects ? " outside" : "") << "\n";
+  for (const auto& c : d.causes)
+    s << "  cause " << c.cause << ": held-out gain " << r3(c.gain) << ", p = " << formatReadable(c.p_value, 2)
+      << (c.significant ? " significant" : "") << "\n";
   s << "  " << formatFixed(d.wall_s, 1) << " s\n";
   return s.str();
 }
@@ -160,6 +241,22 @@ std::string runDiagnosisSummary(const RunDiagnosis& d) {
 std::size_t writeRunDiagnosisOutputs(const RunDiagnosis& d, const std::string& input_json, OutputSet& out) {
   out.writeText("run_diagnosis.json", runDiagnosisJson(d, input_json));
   out.writeText("report.md", runDiagnosisMarkdown(d));
+  if (d.best >= 0) {
+    const auto& b = d.causes[static_cast<std::size_t>(d.best)];
+    out.writeText("model_extended.yaml",
+                  stochastic::toYaml(b.model_after, "extended by navimpact diagnose --run (" + b.cause + ") from " +
+                                                        d.rawlog + ", seed " + std::to_string(d.seed)));
+    std::ostringstream f;
+    f << "# Filter of the extension found by navimpact diagnose --run (" << b.cause << ") on " << d.rawlog << ".\n"
+      << "# Use with navimpact replay --config THIS (keys as in the replay configuration).\n"
+      << "model: model_extended.yaml\n";
+    if (b.gnss_sigma_h_m || b.gnss_sigma_v_m) {
+      f << "noise:\n";
+      if (b.gnss_sigma_h_m) f << "  sigma_pos_h_m: " << formatExact(*b.gnss_sigma_h_m) << "\n";
+      if (b.gnss_sigma_v_m) f << "  sigma_pos_v_m: " << formatExact(*b.gnss_sigma_v_m) << "\n";
+    }
+    out.writeText("filter_extended.yaml", f.str());
+  }
   // One panel per (quantity, duration): x = measured outage index, the simulated
   // 5-95 % band and median across, the measured end errors as points.
   std::vector<std::string> qs;

@@ -116,6 +116,15 @@ struct RejectedUpdate {
   double inflation = 1.0;  ///< re-admitted: the factor P was scaled by (NIS / gate); rejected: 1
 };
 
+/// One GNSS position update's innovation (NED), for innovation statistics.
+struct GnssInnovation {
+  double t = 0.0;                                   ///< fix time [s]
+  Eigen::Vector3d dz = Eigen::Vector3d::Zero();     ///< innovation h(x_est) - z, N E D [m]
+  Eigen::Vector3d S_diag = Eigen::Vector3d::Zero(); ///< diagonal of its covariance H P H' + R [m^2]
+  Eigen::Vector3d R_diag = Eigen::Vector3d::Zero(); ///< diagonal of the fix's R [m^2]
+  bool accepted = true;                             ///< passed the chi-square gate
+};
+
 /// Errors, sigmas and NEES at one record epoch.
 struct NavEpoch {
   double t = 0.0;                   ///< [s]
@@ -146,6 +155,7 @@ struct NavRunResult {
   int rejections = 0;               ///< updates rejected by the chi-square gate
   std::vector<RejectedUpdate> rejected;  ///< each of them
   std::vector<RejectedUpdate> readmitted;  ///< updates applied after a lock-out, P inflated first
+  std::vector<GnssInnovation> gnss_innovations;  ///< every GNSS position update, in time order
   std::size_t zupt_updates = 0;     ///< zero-velocity updates applied
   std::size_t nhc_updates = 0;      ///< non-holonomic updates applied
   double wall_s = 0.0;              ///< wall-clock time of the run [s]

@@ -65,6 +65,7 @@
 #include "navimpact/core/config.hpp"
 #include "navimpact/core/recording.hpp"
 #include "navimpact/filter/alignment.hpp"
+#include "navimpact/stochastic/model_file.hpp"
 
 namespace navimpact::analysis {
 
@@ -101,6 +102,9 @@ struct ReplayConfig {
   /// one (aligning phase, estimate recorded every record_interval_s); used to
   /// get the GNSS-aided solution densely when the reference is sparse.
   bool use_reference = true;
+  /// A filter model given in memory (e.g. an extension under test); takes
+  /// precedence over model_spec, whose text then only names it.
+  std::optional<stochastic::ImuModel> model;
 
   /// Read the keys of a replay configuration (see the file comment), with the
   /// ranges of core/limits.hpp; paths relative to the configuration's folder.

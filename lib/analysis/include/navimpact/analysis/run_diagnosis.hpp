@@ -28,22 +28,55 @@
  * NavRunOptions: propagation, gate, aids, lever arm) over the same outages.
  *
  * Comparison per quantity (horizontal position, vertical position; velocity
- * and attitude when the reference has them) and duration, at the outage ends:
- *   ratio = sqrt(mean measured e^2 / mean predicted e^2), the predicted mean
- *   square including the reference's own variance (2 s_h^2 horizontal, s_v^2
- *   vertical). With Gaussian zero-mean errors the statistic
- *   F = (SS_m / (d K)) / (SS_p / (d M)) follows F(d K, d M) when the
- *   simulation is right (d components per outage: 2 horizontal, 1 vertical,
- *   3 velocity, 3 attitude; K measured outages, M = R x outages simulated);
- *   the two-sided p-value and the (1 - alpha/m) interval of the ratio,
- *   sqrt(F / F_{1-a/2}), sqrt(F / F_{a/2}), a = alpha / m, come from it.
- *   Caveat: outages of one run share the trajectory and the bias, so they are
- *   not independent; the interval counts them as if they were.
- * Measured NEES: mean position NEES over the K outages against the
- * chi-square(3K)/K band at the same level a.
+ * and attitude when the reference has them) and duration, at the outage ends.
+ * The outages of one run share its bias and trajectory, so they are not
+ * independent: the measured run is ONE draw of a run-level statistic, and the
+ * realisations give its distribution. Statistic: RMS over the run's outages
+ * of the error magnitude (reference variance 2 s_h^2 horizontal, s_v^2
+ * vertical added to the simulated squares). With mu, sd the mean and standard
+ * deviation of ln RMS over the R realisations (Gaussian logs assumed):
+ *   ratio = RMS_measured / exp(mu);
+ *   t = ln(ratio) / (sd sqrt(1 + 1/R)), Student t with R - 1 dof (a
+ *   prediction interval): two-sided p-value, and the ratio's interval
+ *   exp(ln(ratio) +- t_{1-a/2} sd sqrt(1 + 1/R)) at a = alpha / m.
+ * Measured NEES: the mean position NEES over the run's outages tested the
+ * same way against the realisations' mean NEES (the chi-square(3K)/K band of
+ * independent outages is reported beside it).
  * Verdict: "inadequate" when any of the m tests (all comparisons and all NEES
- * bands) rejects at level a = alpha / m (Bonferroni), so the family-wise
+ * tests) rejects at level a = alpha / m (Bonferroni), so the family-wise
  * false-alarm rate is at most alpha; else "adequate".
+ *
+ * Causes (each fitted on training data and scored on held-out outages): the
+ * run is cut into `folds` time blocks; the outages whose midpoint falls in
+ * block f are held out, the cause is fitted on everything outside block f
+ * (IMU samples, GNSS innovations, or outages that do not overlap block f),
+ * the run is replayed with that extension and the held-out outage ends
+ * scored. Every outage is held out exactly once. Score per outage: negative
+ * log-likelihood 0.5 sum_i (e_i^2 / s_i^2 + ln s_i^2) of the errors at its
+ * end, i over the position axes (s_i^2 the filter's predicted variance plus
+ * the reference's) and the velocity and attitude axes when the reference has
+ * them (diagonal of the filter's covariance); gain = its mean
+ * decrease; significance: one-sided paired sign-flip permutation test (seeded,
+ * 20000 flips) at alpha / (number of causes).
+ *  - in_motion_noise, per channel: white-noise sigma of the IMU residual (real
+ *    IMU minus the perfect IMU of the smoothed trajectory) from second
+ *    differences (var = 6 sigma^2 for white noise) over the samples where the
+ *    trajectory moves (|w_IB_B| > 0.05 rad/s or ||f_B| - g| > 0.3 m/s^2, the
+ *    emulation's SensorEffects test); factor = that sigma / the model's white
+ *    noise (emulation::whiteNoiseSigma); 99 % interval from 20 batch means
+ *    (Student t). Extension: every WN term of the channel times the factor.
+ *  - gnss_noise: GNSS position innovations of the aided phases: per axis
+ *    group (horizontal, vertical) the scale s of the fix sigma with
+ *    mean(dz^2) = mean(S - R) + s^2 mean(R); mean NIS and lag-1 correlation of
+ *    the normalised innovations. Extension: the filter's GNSS sigmas set to s
+ *    times the median fix sigma (replay noise.sigma_pos_h_m / sigma_pos_v_m).
+ *  - bias_instability: an accelerometer bias random walk of density q the
+ *    static model lacks: the measured excess of the squared outage-end error
+ *    over the simulated mean square grows as q T^5 / 20 per axis (T the
+ *    coasting time); q by least squares over the training outages (horizontal
+ *    for acc_x, acc_y; vertical for acc_z), clipped at 0; 99 % interval by a
+ *    seeded bootstrap over outages. Extension: an RW term of gamma =
+ *    sqrt(q / rate) added to those channels.
  */
 #pragma once
 
@@ -55,8 +88,36 @@
 
 #include "navimpact/analysis/replay.hpp"
 #include "navimpact/core/csv_reader.hpp"
+#include "navimpact/stochastic/model_file.hpp"
 
 namespace navimpact::analysis {
+
+/// A cause's parameter for one channel, fitted on the whole run.
+struct RunFinding {
+  std::string cause;     ///< in_motion_noise, gnss_noise, bias_instability
+  std::string channel;   ///< gyro_x .. acc_z, or gnss
+  std::vector<std::pair<std::string, double>> params;                    ///< SI, names as in the README
+  std::vector<std::pair<std::string, std::pair<double, double>>> interval;  ///< per parameter, its interval
+  std::string note;      ///< how it was estimated
+};
+
+/// One candidate explanation: fitted on training outages, scored on held-out ones.
+struct CauseResult {
+  std::string cause;
+  std::vector<RunFinding> findings;      ///< the whole-run fit, per channel
+  std::size_t heldout_outages = 0;       ///< outages scored (each held out once)
+  double error_before_m = 0.0;           ///< RMS horizontal error at the held-out outage ends, today's filter [m]
+  double error_after_m = 0.0;            ///< the same with the extension fitted without them [m]
+  double vertical_before_m = 0.0, vertical_after_m = 0.0;  ///< RMS vertical error [m]
+  double anees_before = 0.0, anees_after = 0.0;  ///< mean position NEES at those ends
+  double gain = 0.0;                     ///< mean decrease of the position negative log-likelihood per held-out outage
+  double p_value = 1.0;                  ///< one-sided paired sign-flip permutation test of gain > 0
+  double error_p_value = 1.0;            ///< the same test on the 3-D position error at the ends
+  bool significant = false;              ///< p_value < alpha / (number of causes)
+  std::string extension;                 ///< what the extension changes, in words
+  stochastic::ImuModel model_after;      ///< the extended model (whole-run fit; = today's for GNSS causes)
+  std::optional<double> gnss_sigma_h_m, gnss_sigma_v_m;  ///< the extended filter's GNSS sigmas (gnss_noise)
+};
 
 /// Options of a run diagnosis.
 struct RunDiagnosisOptions {
@@ -69,6 +130,8 @@ struct RunDiagnosisOptions {
   std::string static_file;                    ///< "" = the model's simulated errors; else a static recording (CSV)
   CsvImuOptions static_csv;                   ///< units, rate, axes of that recording
   int threads = 0;                            ///< worker threads (0 = hardware)
+  int folds = 5;                              ///< cross-validation folds (time blocks of the run), >= 2
+  bool causes = true;                         ///< fit and score the causes (false: comparison only)
   /// Progress (fraction done 0..1, stage); may be empty.
   std::function<void(double, const std::string&)> progress;
 };
@@ -82,11 +145,12 @@ struct QuantityComparison {
   std::vector<double> measured;    ///< per measured outage: error magnitude at the end [unit]
   std::vector<double> predicted;   ///< per simulated outage (all realisations): magnitude [unit]
   double measured_rms = 0.0;       ///< sqrt(mean e^2) of the measured [unit]
-  double predicted_rms = 0.0;      ///< the same of the simulated, reference variance added [unit]
+  double predicted_rms = 0.0;      ///< geometric mean over realisations of the same RMS, reference variance added [unit]
+  double predicted_log_sd = 0.0;   ///< spread (sd of ln RMS) of that RMS over realisations
   double predicted_p05 = 0.0, predicted_p50 = 0.0, predicted_p95 = 0.0;  ///< percentiles of the simulated magnitudes
   double ratio = 0.0;              ///< measured_rms / predicted_rms
-  double ratio_lo = 0.0, ratio_hi = 0.0;  ///< its (1 - alpha/m) interval (F distribution)
-  double p_value = 1.0;            ///< two-sided F test of equal variances
+  double ratio_lo = 0.0, ratio_hi = 0.0;  ///< its (1 - alpha/m) interval (see the file comment)
+  double p_value = 1.0;            ///< two-sided test of ratio = 1 against the realisations' spread
   bool rejects = false;            ///< p_value < alpha/m
 };
 
@@ -97,8 +161,10 @@ struct DurationDiagnosis {
   std::vector<OutageScore> measured;       ///< the scored outages of the real run
   OutageDistribution distribution;         ///< their distribution (coverage, NEES)
   double anees = 0.0;                      ///< measured mean position NEES
-  double anees_lo = 0.0, anees_hi = 0.0;   ///< its band chi2(3K)/K at level alpha/m
+  double anees_lo = 0.0, anees_hi = 0.0;   ///< its band from the realisations at level alpha/m
+  double anees_p = 1.0;                    ///< two-sided p of the measured mean NEES against that band
   bool anees_rejects = false;              ///< outside the band
+  double chi2_lo = 0.0, chi2_hi = 0.0;     ///< the chi2(3K)/K band of independent outages (for reference)
   double predicted_anees = 0.0;            ///< mean position NEES of the simulated outages
   std::size_t simulated_outages = 0;       ///< realisations x outages
 };
@@ -124,6 +190,11 @@ struct RunDiagnosis {
   std::string verdict;                     ///< "adequate" or "inadequate"
   std::vector<std::string> reasons;        ///< the tests that rejected, in words
   std::vector<std::string> notices;
+  int folds = 0;                           ///< cross-validation folds used
+  std::vector<CauseResult> causes;         ///< ranked by held-out gain, best first
+  int best = -1;                           ///< index of the best significant cause (-1: none)
+  std::vector<RunFinding> findings;        ///< of the significant causes, in rank order
+  stochastic::ImuModel model_before;       ///< today's model
   double wall_s = 0.0;                     ///< wall-clock time [s]
 };
 
