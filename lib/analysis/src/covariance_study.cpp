@@ -218,11 +218,15 @@ CovarianceStudyResult runAlong(const CovarianceStudyConfig& cfg, long n, const N
         run.sigma.push_back(s);
       };
       record(0.0);
-      for (long k = 1; k <= n; ++k) {
-        nominal(k, xk, w_B, f_B);
-        ekf.predictCovariance(xk, w_B, f_B, dt);
-        if (every_baro > 0 && k % every_baro == 0) ekf.update(dz0, ekf.H_baro(), Rb, /*feedback=*/false);
-        if (k % every_out == 0) record(k * dt);
+      try {
+        for (long k = 1; k <= n; ++k) {
+          nominal(k, xk, w_B, f_B);
+          ekf.predictCovariance(xk, w_B, f_B, dt);
+          if (every_baro > 0 && k % every_baro == 0) ekf.update(dz0, ekf.H_baro(), Rb, /*feedback=*/false);
+          if (k % every_out == 0) record(k * dt);
+        }
+      } catch (const Error& e) {  // say which model of which set (the filter knows neither)
+        throw Error(cfg.source + ": model set " + set.name + ", model " + name + ": " + e.what());
       }
       res.runs.push_back(std::move(run));
       if (progress) progress(++done, total);
