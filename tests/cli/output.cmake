@@ -21,3 +21,8 @@ navimpact_cli_check(cli_reproducible_diagnose CHECK reproducible
   ARGS diagnose --input ${CMAKE_SOURCE_DIR}/datasets/adis16405_static_excerpt.csv.gz --rate 100 --gyro-unit deg/s
        --acc-unit g --model fit:WN --trajectory ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz
        --outage 200:60 --nav-runs 4 --out @OUT@)
+navimpact_cli_check(cli_reproducible_diagnose_run CHECK reproducible
+  DEFINES W=${_rep}/diagnose_run
+  ARGS diagnose --run ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog
+       --model ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref --durations 20 --reconverge 30
+       --realisations 4 --folds 3 --out @OUT@)

@@ -1,7 +1,7 @@
 /**
  * @file run_diagnosis_report.hpp
  * @brief Outputs of `navimpact diagnose --run`: run_diagnosis.json, report.md
- *        and predicted_vs_measured.png (the simulation's 5-95 % band and median
+ *        timing.json (wall clock, kept apart from the results) and predicted_vs_measured.png (the simulation's 5-95 % band and median
  *        of the outage-end error against the measured outages, per duration).
  */
 #pragma once
