@@ -7,6 +7,7 @@
 
 #include "navimpact/analysis/replay.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/emulation/scenario.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/report/replay_report.hpp"
@@ -276,4 +277,49 @@ TEST(Replay, AidsAreAppliedOnlyWhenTheirConditionHolds) {
   EXPECT_EQ(r.run.zupt_updates, 0u);
   EXPECT_GE(r.run.nhc_updates, 55u);
   EXPECT_LE(r.run.nhc_updates, 60u);
+}
+
+// filter.extra_states switches the extra states on in a replay: read from the
+// configuration, estimated over the run; on emulated data without any of these
+// effects (the truth is zero) every estimate lies within 3 sigma of zero and
+// its sigma is below the prior where the flight makes it observable.
+TEST(Replay, ExtraStatesFromTheConfigurationAreEstimated) {
+  const auto dir = navimpact::test::tempDir();
+  const auto raw = (dir / "model.rawlog").string();
+  navimpact::rawlog::writeRawlog(raw, emulate60("model"));
+  const auto path = (dir / "c.yaml").string();
+  std::ofstream(path) << "rawlog: model.rawlog\n"
+                         "filter:\n"
+                         "  extra_states:\n"
+                         "    scale_factor: {gyro_sigma: 0.01}\n"
+                         "    lever_arm: {sigma_m: 1}\n"
+                         "    time_offset: {sigma_s: 0.05}\n";
+  const an::ReplayConfig c = an::loadReplayConfig(path);
+  EXPECT_EQ(c.extra_states.gyro_scale_sigma, 0.01);
+  EXPECT_EQ(c.extra_states.acc_scale_sigma, 0.0);
+  const auto r = an::runReplay(c);
+  const auto& e = r.run.extra_estimates;
+  const auto& s = r.run.extra_sigmas;
+  std::printf("gyro scale %s sigma %s; lever arm error %s sigma %s; time offset %g s sigma %g s\n",
+              navimpact::formatNumber(e.gyro_scale.norm()).c_str(), navimpact::formatNumber(s.gyro_scale.norm()).c_str(),
+              navimpact::formatNumber(e.lever_arm_error_B_m.norm()).c_str(),
+              navimpact::formatNumber(s.lever_arm_error_B_m.norm()).c_str(), e.time_offset_s, s.time_offset_s);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_GT(s.gyro_scale(a), 0.0);
+    EXPECT_LE(std::abs(e.gyro_scale(a)), 3.0 * s.gyro_scale(a)) << a;
+    EXPECT_LE(std::abs(e.lever_arm_error_B_m(a)), 3.0 * s.lever_arm_error_B_m(a)) << a;
+    EXPECT_EQ(s.acc_scale(a), 0.0);  // off
+  }
+  EXPECT_LE(std::abs(e.time_offset_s), 3.0 * s.time_offset_s);
+  EXPECT_LT(s.time_offset_s, 0.05);   // the flight's velocity changes observe it
+  EXPECT_LT(s.gyro_scale.z(), 0.01);  // the turns observe the yaw-gyro scale
+  std::ofstream(path) << "rawlog: model.rawlog\nfilter: {extra_states: {lever_arm: {sigma_m: 20}}}\n";
+  try {
+    an::loadReplayConfig(path);
+    ADD_FAILURE() << "a lever-arm sigma of 20 m was accepted";
+  } catch (const navimpact::Error& err) {
+    EXPECT_NE(std::string(err.what()).find("key 'filter.extra_states.lever_arm.sigma_m': must be in (0, 10] m"),
+              std::string::npos)
+        << err.what();
+  }
 }

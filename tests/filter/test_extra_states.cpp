@@ -12,6 +12,7 @@
 #include <random>
 
 #include "filter_test_util.hpp"
+#include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/limits.hpp"
@@ -98,6 +99,37 @@ TEST(ExtraStates, OffByDefaultAndLaidOutAfterTheModelStates) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("time_offset_sigma_s"), std::string::npos) << e.what();
   }
+}
+
+TEST(ExtraStates, ConfigKeysSwitchThemOn) {
+  const ConfigNode n = ConfigNode::parse(
+      "extra_states:\n"
+      "  scale_factor: {gyro_sigma: 0.005, acc_sigma: 0.004}\n"
+      "  misalignment: {gyro_sigma_rad: 0.003}\n"
+      "  lever_arm: {sigma_m: 0.5}\n"
+      "  time_offset: {sigma_s: 0.05}\n",
+      "f.yaml");
+  filter::ExtraStates x;
+  x.loadFrom(n.map("extra_states"));
+  EXPECT_EQ(x.gyro_scale_sigma, 0.005);
+  EXPECT_EQ(x.acc_scale_sigma, 0.004);
+  EXPECT_EQ(x.gyro_misalignment_sigma_rad, 0.003);
+  EXPECT_EQ(x.acc_misalignment_sigma_rad, 0.0);  // left out: off
+  EXPECT_EQ(x.lever_arm_sigma_m, 0.5);
+  EXPECT_EQ(x.time_offset_sigma_s, 0.05);
+  auto err = [](const std::string& text) {
+    try {
+      filter::ExtraStates y;
+      y.loadFrom(ConfigNode::parse(text, "f.yaml").map("extra_states"));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(err("extra_states: {time_offset: {sigma_s: 0.5}}"),
+            "f.yaml: key 'extra_states.time_offset.sigma_s': must be in (0, 0.1] s, got 0.5");
+  EXPECT_NE(err("extra_states: {scale: {gyro_sigma: 0.01}}").find("unknown key"), std::string::npos);
+  EXPECT_NE(err("extra_states: {lever_arm: {sigma_m: 0}}").find("(0, 10] m"), std::string::npos);
 }
 
 // F columns of the scale-factor and misalignment states: Phi from the exact

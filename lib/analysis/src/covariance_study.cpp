@@ -122,7 +122,8 @@ void CovarianceStudyConfig::loadFrom(const ConfigNode& root) {
 
   std::string disc = "series";
   if (const auto f = root.optMap("filter")) {
-    f->allowKeys({"discretization", "propagate_every"});
+    f->allowKeys({"discretization", "propagate_every", "extra_states"});
+    if (const auto x = f->optMap("extra_states")) c.filter.imu.extra.loadFrom(*x);
     f->readChoice("discretization", disc, {"series", "vanloan"});
     c.filter.discretization = filter::parseDiscretization(disc);
     c.filter.propagate_every = 1;

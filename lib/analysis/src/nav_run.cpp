@@ -187,6 +187,11 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
     }
   }
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  if (ekf.layout().hasExtra()) {
+    ekf.flushPropagation();
+    res.extra_estimates = ekf.extraEstimates();
+    res.extra_sigmas = ekf.extraSigmas();
+  }
   return res;
 }
 

@@ -80,7 +80,9 @@ void ReplayConfig::loadFrom(const ConfigNode& root) {
     c.outages.push_back(Outage::fromStartDuration(st, o.number("duration_s", limits::kDurationS)));
   }
   if (const auto f = root.optMap("filter")) {
-    f->allowKeys({"propagate_every", "use_gnss_velocity", "gate_probability", "gate_readmit_after", "max_imu_gap_s"});
+    f->allowKeys({"propagate_every", "use_gnss_velocity", "gate_probability", "gate_readmit_after", "max_imu_gap_s",
+                  "extra_states"});
+    if (const auto x = f->optMap("extra_states")) c.extra_states.loadFrom(*x);
     f->read("max_imu_gap_s", c.max_imu_gap_s, limits::Range{0.0, kMaxImuGapS, false, "s"});
     f->read("propagate_every", c.propagate_every, 1, limits::kMaxPropagateEvery);
     f->read("use_gnss_velocity", c.use_gnss_velocity);
@@ -353,6 +355,7 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   opt.ekf.propagate_every = cfg.propagate_every;
   opt.ekf.gate_probability = cfg.gate_probability;
   opt.ekf.gate_readmit_after = cfg.gate_readmit_after;
+  opt.ekf.imu.extra = cfg.extra_states;
   opt.use_gnss_velocity = cfg.use_gnss_velocity;
   opt.P0_nav.setZero();
   const double ph = cfg.p0_pos_h_m, pv = cfg.p0_pos_v_m, vv = cfg.p0_vel_mps;

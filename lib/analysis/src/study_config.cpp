@@ -151,7 +151,8 @@ void StudyConfig::loadFrom(const ConfigNode& root, const std::vector<std::string
     if (m->read("threads", t, 0, kMaxThreads)) threads = static_cast<unsigned>(t);
   }
   if (const auto f = root.optMap("filter")) {
-    f->allowKeys({"propagate_every", "discretization", "coning_sculling", "initial_sigma"});
+    f->allowKeys({"propagate_every", "discretization", "coning_sculling", "initial_sigma", "extra_states"});
+    if (const auto x = f->optMap("extra_states")) ekf.imu.extra.loadFrom(*x);
     f->read("propagate_every", ekf.propagate_every, 1, limits::kMaxPropagateEvery);
     std::string disc;
     if (f->readChoice("discretization", disc, {"series", "vanloan"}) >= 0)

@@ -44,6 +44,28 @@ stochastic::Model whiteShortGms(const stochastic::Model& in, double t_max, const
 
 }  // namespace
 
+void ExtraStates::loadFrom(const ConfigNode& n) {
+  n.allowKeys({"scale_factor", "misalignment", "lever_arm", "time_offset"});
+  if (const auto s = n.optMap("scale_factor")) {
+    s->allowKeys({"gyro_sigma", "acc_sigma"});
+    s->read("gyro_sigma", gyro_scale_sigma, limits::kScaleFactorSigma);
+    s->read("acc_sigma", acc_scale_sigma, limits::kScaleFactorSigma);
+  }
+  if (const auto m = n.optMap("misalignment")) {
+    m->allowKeys({"gyro_sigma_rad", "acc_sigma_rad"});
+    m->read("gyro_sigma_rad", gyro_misalignment_sigma_rad, limits::kMisalignmentSigmaRad);
+    m->read("acc_sigma_rad", acc_misalignment_sigma_rad, limits::kMisalignmentSigmaRad);
+  }
+  if (const auto l = n.optMap("lever_arm")) {
+    l->allowKeys({"sigma_m"});
+    l->read("sigma_m", lever_arm_sigma_m, limits::kLeverArmErrorSigmaM);
+  }
+  if (const auto t = n.optMap("time_offset")) {
+    t->allowKeys({"sigma_s"});
+    t->read("sigma_s", time_offset_sigma_s, limits::kTimeOffsetSigmaS);
+  }
+}
+
 StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuErrorOptions& opt) {
   StateLayout L;
   L.model_ = model;

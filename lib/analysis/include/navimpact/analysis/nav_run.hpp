@@ -159,6 +159,9 @@ struct NavRunResult {
   std::size_t zupt_updates = 0;     ///< zero-velocity updates applied
   std::size_t nhc_updates = 0;      ///< non-holonomic updates applied
   double wall_s = 0.0;              ///< wall-clock time of the run [s]
+  /// Estimates and 1-sigma of the filter's extra states at the end of the run
+  /// (filter::ErrorStateEkf::extraEstimates / extraSigmas; zero when off).
+  filter::SensorParams extra_estimates, extra_sigmas;
 };
 
 /**

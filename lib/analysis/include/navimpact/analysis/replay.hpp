@@ -17,7 +17,10 @@
  * model: ../models/navchip_table1.yaml:ref   # filter's IMU model; default: the rawlog's scenario model
  * outages: [{start_s: 200, duration_s: 60}]  # [s] from time zero
  * filter: {propagate_every: 10, use_gnss_velocity: true, gate_probability: 0, gate_readmit_after: 3,
- *          max_imu_gap_s: 0}
+ *          max_imu_gap_s: 0,
+ *          extra_states: {scale_factor: {gyro_sigma: 0.005, acc_sigma: 0.005},
+ *                         misalignment: {gyro_sigma_rad: 0.003, acc_sigma_rad: 0.003},
+ *                         lever_arm: {sigma_m: 0.5}, time_offset: {sigma_s: 0.05}}}
  * initial_sigma: {pos_h_m: 1, pos_v_m: 1, vel_mps: 0.1, roll_pitch_deg: 0.1, yaw_deg: 0.5}
  * noise: {sigma_pos_h_m: 2, sigma_pos_v_m: 4, sigma_vel_h_mps: 0.05, sigma_vel_v_mps: 0.1, sigma_baro_m: 0.5}
  * gnss_lever_arm_B_m: [0, 0, 0]              # default: the scenario's
@@ -85,6 +88,7 @@ struct ReplayConfig {
   bool use_gnss_velocity = true;
   double gate_probability = 0.0;
   int gate_readmit_after = 3;                   ///< filter::EkfConfig::gate_readmit_after (0..1000, 0 = never)
+  filter::ExtraStates extra_states;             ///< filter.extra_states (filter/state_layout.hpp); all off by default
   double p0_pos_h_m = 1.0, p0_pos_v_m = 1.0, p0_vel_mps = 0.1;
   double p0_roll_pitch_deg = 0.1, p0_yaw_deg = 0.5;
   std::optional<double> sigma_pos_h_m, sigma_pos_v_m, sigma_vel_h_mps, sigma_vel_v_mps, sigma_baro_m;

@@ -66,6 +66,12 @@ inline constexpr Range kLeverArmErrorM{-10.0, 10.0, false, "m"};
 inline constexpr Range kMotionNoiseFactor{1.0, 100.0, false, "(factor)"};
 inline constexpr Range kMotionRateThresholdRadS{1.0e-3, 10.0, false, "rad/s"};
 inline constexpr Range kMotionAccThresholdMps2{0.05, 100.0, false, "m/s^2"};
+// Prior sigmas of the filter's extra states (filter::ExtraStates): the same
+// bounds as the effects they estimate, open at 0 (a state is off by leaving it out).
+inline constexpr Range kScaleFactorSigma{0.0, 0.05, true, "(ratio)"};
+inline constexpr Range kMisalignmentSigmaRad{0.0, 0.05, true, "rad"};
+inline constexpr Range kLeverArmErrorSigmaM{0.0, 10.0, true, "m"};
+inline constexpr Range kTimeOffsetSigmaS{0.0, 0.1, true, "s"};
 
 /// Most Monte Carlo runs of one study (monte_carlo.runs).
 inline constexpr long long kMaxMonteCarloRuns = 1000000;

@@ -58,6 +58,7 @@
 #include <string>
 #include <vector>
 
+#include "navimpact/core/config.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/state_space.hpp"
 
@@ -87,6 +88,18 @@ struct ExtraStates {
   double acc_misalignment_sigma_rad = 0.0;   ///< accelerometer misalignment angles x,y,z [rad]
   double lever_arm_sigma_m = 0.0;            ///< antenna lever-arm error x,y,z, body FRD [m]
   double time_offset_sigma_s = 0.0;          ///< IMU-GNSS time offset [s]
+  /**
+   * Read the `extra_states` map of a filter section (every group optional):
+   * @code
+   * extra_states:
+   *   scale_factor: {gyro_sigma: 0.005, acc_sigma: 0.005}          # [ratio], (0, 0.05]
+   *   misalignment: {gyro_sigma_rad: 0.003, acc_sigma_rad: 0.003}  # [rad], (0, 0.05]
+   *   lever_arm: {sigma_m: 0.5}                                    # [m], (0, 10]
+   *   time_offset: {sigma_s: 0.05}                                 # [s], (0, 0.1]
+   * @endcode
+   * @throws navimpact::Error naming the file and dotted key (unknown key, out of range).
+   */
+  void loadFrom(const ConfigNode& n);
   /// True when any group is on.
   bool any() const {
     return gyro_scale_sigma > 0 || acc_scale_sigma > 0 || gyro_misalignment_sigma_rad > 0 ||
