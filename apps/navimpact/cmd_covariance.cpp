@@ -6,6 +6,7 @@
 
 #include "cli_common.hpp"
 #include "navimpact/analysis/covariance_study.hpp"
+#include "navimpact/filter/model_entry.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/report/covariance_report.hpp"
@@ -47,10 +48,11 @@ navimpact::cli::Registrar reg({
         if (o->print_states) {
           for (const auto& set : cfg.model_sets)
             for (const auto& m : set.models) {
-              const auto layout = navimpact::filter::StateLayout::build(
-                  navimpact::stochastic::loadImuModel(cfg.model_file + ":" + m), cfg.filter.imu);
-              std::printf("# %s / %s: %d states\n%s", set.name.c_str(), m.c_str(), layout.size(),
-                          layout.describe().c_str());
+              const auto entry = navimpact::filter::layoutFor(
+                  navimpact::stochastic::loadImuModel(cfg.model_file + ":" + m), cfg.filter, cfg.imu_rate_hz);
+              std::printf("# %s / %s: %d states\n", set.name.c_str(), m.c_str(), entry.layout.size());
+              for (const auto& n : entry.notes) std::printf("# note: %s\n", n.c_str());
+              std::fputs(entry.layout.describe().c_str(), stdout);
             }
         }
         int total = 0;

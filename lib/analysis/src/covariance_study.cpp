@@ -13,6 +13,7 @@
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
+#include "navimpact/filter/model_entry.hpp"
 #include "navimpact/emulation/trajectory.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/model_text.hpp"
@@ -196,13 +197,16 @@ CovarianceStudyResult runAlong(const CovarianceStudyConfig& cfg, long n, const N
 
   for (const ModelSet& set : cfg.model_sets) {
     for (const std::string& name : set.models) {
-      const stochastic::ImuModel model = stochastic::loadImuModel(cfg.model_file + ":" + name);
+      const filter::ModelEntry entry =
+          filter::layoutFor(stochastic::loadImuModel(cfg.model_file + ":" + name), cfg.filter, cfg.imu_rate_hz);
+      const stochastic::ImuModel& model = entry.model;
       filter::ErrorStateEkf ekf(x0, P0, model, cfg.filter);
       CovarianceRun run;
       run.model_set = set.name;
       run.model = name;
       run.model_text = modelText(model);
       run.states = ekf.size();
+      run.notes = entry.notes;
       const Eigen::MatrixXd Rb = Eigen::MatrixXd::Constant(1, 1, cfg.baro_sigma_m * cfg.baro_sigma_m);
       const Eigen::VectorXd dz0 = Eigen::VectorXd::Zero(1);
       ins::NavState xk = x0;
@@ -244,7 +248,8 @@ CovarianceBudget estimateCovarianceBudget(const CovarianceStudyConfig& cfg, long
   for (const ModelSet& set : cfg.model_sets)
     for (const std::string& name : set.models) {
       const double N =
-          filter::StateLayout::build(stochastic::loadImuModel(cfg.model_file + ":" + name), cfg.filter.imu).size();
+          filter::layoutFor(stochastic::loadImuModel(cfg.model_file + ":" + name), cfg.filter, cfg.imu_rate_hz)
+              .layout.size();
       // per IMU step: the nominal-rate Jacobian and noise (N^2); per propagation: Phi P Phi^T (2 N^3)
       b.work += double(n) * (N * N + 2.0 * N * N * N / k);
       b.memory_bytes += rows * (sizeof(double) + 9 * sizeof(double));

@@ -1313,13 +1313,7 @@ Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
   d.samples = n;
   d.options = opt;
   d.model_before = model;
-  if (std::abs(model.rate_hz - data.rate_hz) > 1e-9 * data.rate_hz) {
-    d.model_before = stochastic::convertRate(model, data.rate_hz);
-    d.notices.push_back("model " + model.source + " is at " + formatNumber(model.rate_hz, 6) +
-                        " Hz, the data at " + formatNumber(data.rate_hz, 6) +
-                        " Hz: converted exactly to the data rate (same continuous-time "
-                        "processes)");
-  }
+  d.model_before = stochastic::atRate(model, data.rate_hz, &d.notices);
   Shared sh;
   sh.data = &data;
   sh.model = &d.model_before;

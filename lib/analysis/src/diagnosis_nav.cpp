@@ -16,6 +16,7 @@
 
 #include "diagnosis_internal.hpp"
 #include "navimpact/analysis/diagnosis.hpp"
+#include "navimpact/filter/model_entry.hpp"
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
@@ -175,7 +176,7 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
     // as white noise (filter::ImuErrorOptions::white_gm_below_s); say so.
     std::size_t replaced = 0;
     for (const auto* m : {&before, &after})
-      replaced += filter::StateLayout::build(*m, filter::effectiveImuOptions(*m, p.nav.ekf)).notes().size();
+      replaced += filter::layoutFor(*m, p.nav.ekf).layout.notes().size();
     const double t_min = p.nav.ekf.propagate_every / p.rate;
     if (replaced > 0)
       g.filter_note = std::to_string(replaced) +

@@ -21,6 +21,7 @@
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/filter/error_model.hpp"
+#include "navimpact/filter/model_entry.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/core/limits.hpp"
@@ -435,6 +436,15 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
     if (opt.outages.size() == cfg.outages.size())
       r.notices.push_back("outages every " + formatNumber(cfg.outages_every->period_s, 10) + ":" +
                           formatNumber(cfg.outages_every->duration_s, 10) + " s: none fits in the data after the filter start");
+  }
+  {
+    // The one model-entry path: converted to the data's IMU rate (a rate within
+    // 0.1 % of the model's is the same sensor's clock jitter, not another rate),
+    // GMs the filter cannot carry entered as white noise; the notices say so.
+    const double rate = std::abs(model.rate_hz - r.imu_rate_hz) <= 1e-3 * r.imu_rate_hz ? model.rate_hz : r.imu_rate_hz;
+    filter::ModelEntry entry = filter::layoutFor(model, opt.ekf, rate);
+    model = std::move(entry.model);
+    for (const auto& n : entry.notes) r.notices.push_back("filter model: " + n);
   }
   r.run = runNav(in, model, opt);
   r.nav = opt;

@@ -24,6 +24,7 @@
 #include "navimpact/core/units.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/filter/error_model.hpp"
+#include "navimpact/filter/model_entry.hpp"
 #include "navimpact/filter/state_layout.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
@@ -155,10 +156,7 @@ const StudyMeta& studyMeta(const StudyPlan& plan) { return plan.meta; }
 namespace {
 
 stochastic::ImuModel atRate(const stochastic::ImuModel& m, double rate, std::vector<std::string>& notices) {
-  if (std::abs(m.rate_hz - rate) <= 1e-9 * rate) return m;
-  notices.push_back("model " + m.source + " given at " + formatNumber(m.rate_hz) + " Hz, converted exactly to " +
-                    formatNumber(rate) + " Hz");
-  return stochastic::convertRate(m, rate);
+  return stochastic::atRate(m, rate, &notices);
 }
 
 stochastic::ImuModel buildCandidate(const CandidateSpec& c, double rate, std::vector<std::string>& notices) {
@@ -198,10 +196,9 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
   for (const auto& c : cfg.candidates) {
     try {
       plan->filter_models.push_back(buildCandidate(c, rate, meta.notices));
-      const auto layout = filter::StateLayout::build(
-          plan->filter_models.back(), filter::effectiveImuOptions(plan->filter_models.back(), cfg.ekf));
-      meta.states.push_back(layout.size());
-      for (const auto& n : layout.notes()) meta.notices.push_back("candidate '" + c.label + "': " + n);
+      const filter::ModelEntry entry = filter::layoutFor(plan->filter_models.back(), cfg.ekf, rate);
+      meta.states.push_back(entry.layout.size());
+      for (const auto& n : entry.notes) meta.notices.push_back("candidate '" + c.label + "': " + n);
     } catch (const Error& e) {
       throw Error("candidate '" + c.label + "': " + e.what());
     }

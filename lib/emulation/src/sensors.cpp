@@ -25,12 +25,7 @@ std::vector<double> standardNormal(std::size_t n, std::uint64_t seed) {
 ImuErrors modelImuErrors(const stochastic::ImuModel& model, double imu_rate_hz, std::size_t n,
                          std::uint64_t seed) {
   ImuErrors e;
-  stochastic::ImuModel m = model;
-  if (std::abs(m.rate_hz - imu_rate_hz) > 1e-9 * imu_rate_hz) {
-    e.notices.push_back("IMU error model '" + model.source + "' is given at " + formatNumber(model.rate_hz) +
-                        " Hz; converted exactly to the IMU rate " + formatNumber(imu_rate_hz) + " Hz");
-    m = stochastic::convertRate(model, imu_rate_hz);
-  }
+  const stochastic::ImuModel m = stochastic::atRate(model, imu_rate_hz, &e.notices);
   for (std::size_t i = 0; i < 6; ++i) {
     e.axis[i].assign(n, 0.0);
     if (!m.axis[i].empty()) stochastic::simulateAdd(m.axis[i], stochastic::deriveSeed(seed, i), e.axis[i].data(), n);

@@ -1,6 +1,7 @@
 // Error-state EKF: structured covariance propagation, Joseph-form updates,
 // closed-loop feedback. Equation numbers: Groves 2013 ch. 3 and 14.
 #include "navimpact/filter/ekf.hpp"
+#include "navimpact/filter/model_entry.hpp"
 
 #include <Eigen/Cholesky>
 #include <boost/math/distributions/chi_squared.hpp>
@@ -112,7 +113,7 @@ ErrorStateEkf::ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
                                  1e-12 * (1.0 + P0_nav.cwiseAbs().maxCoeff()) ||
       (P0_nav.diagonal().array() < 0.0).any())
     throw Error("initial navigation covariance must be finite, symmetric, with diagonal >= 0");
-  layout_ = StateLayout::build(model, effectiveImuOptions(model, cfg));
+  layout_ = layoutFor(model, cfg).layout;  // the one model-entry path (model_entry.hpp)
   const int N = layout_.size(), m = layout_.imuSize();
   P_ = MatrixXd::Zero(N, N);
   P_.topLeftCorner<9, 9>() = P0_nav;

@@ -195,4 +195,12 @@ ImuModel convertRate(const ImuModel& m, double new_rate_hz) {
   return out;
 }
 
+ImuModel atRate(const ImuModel& m, double rate_hz, std::vector<std::string>* notes) {
+  if (std::abs(m.rate_hz - rate_hz) <= 1e-9 * rate_hz) return m;
+  if (notes)
+    notes->push_back("model " + m.source + " given at " + formatNumber(m.rate_hz) + " Hz, converted exactly to " +
+                     formatNumber(rate_hz) + " Hz (the same continuous-time processes)");
+  return convertRate(m, rate_hz);
+}
+
 }  // namespace navimpact::stochastic

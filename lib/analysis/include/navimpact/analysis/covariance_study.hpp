@@ -90,6 +90,7 @@ struct CovarianceRun {
   std::string model_set, model;
   std::string model_text;            ///< the models of the six axes, for the record
   int states = 0;                    ///< filter state dimension
+  std::vector<std::string> notes;    ///< how the model entered the filter (filter::layoutFor)
   std::vector<double> t;             ///< [s]
   std::vector<std::array<double, 9>> sigma;
 };

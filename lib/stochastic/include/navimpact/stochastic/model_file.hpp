@@ -59,4 +59,12 @@ std::string toYaml(const ImuModel& m, const std::string& comment = "");
 /// Every axis converted exactly to @p new_rate_hz (see convertRate(Model)).
 ImuModel convertRate(const ImuModel& m, double new_rate_hz);
 
+/**
+ * @p m at @p rate_hz: itself when it is at that rate (to 1e-9 relative), else
+ * converted exactly (convertRate) with one line appended to @p notes, the one
+ * wording of a rate conversion: "model SOURCE given at X Hz, converted exactly
+ * to Y Hz (the same continuous-time processes)".
+ */
+ImuModel atRate(const ImuModel& m, double rate_hz, std::vector<std::string>* notes = nullptr);
+
 }  // namespace navimpact::stochastic
