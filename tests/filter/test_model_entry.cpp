@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "filter_test_util.hpp"
@@ -34,6 +35,8 @@ TEST(ModelEntry, ConvertsToTheFilterRateAndAgreesWithTheFilter) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> lograte(std::log(50.0), std::log(1000.0)), logT(std::log(1e-3), std::log(100.0));
   std::uniform_int_distribution<int> every(1, 20);
+  std::printf("seed %llu: 40 draws\n", static_cast<unsigned long long>(seed));
+  int whites = 0;
   for (int it = 0; it < 40; ++it) {
     const double model_rate = std::round(std::exp(lograte(rng))), imu_rate = std::round(std::exp(lograte(rng)));
     const double T = std::exp(logT(rng));
@@ -56,12 +59,18 @@ TEST(ModelEntry, ConvertsToTheFilterRateAndAgreesWithTheFilter) {
           << e.notes[0];
     // the GM is a state exactly when its T exceeds the propagation interval
     const bool white = T <= cfg.propagate_every / imu_rate;
+    whites += white;
+    std::printf("  draw %d: model %.0f Hz, filter %.0f Hz, GM T %.3g s, propagate_every %d: GM %s\n", it, model_rate,
+                imu_rate, T, cfg.propagate_every, white ? "as white noise" : "a state");
     EXPECT_EQ(e.layout.imuSize(), white ? 6 : 12) << e.layout.describe();
     EXPECT_EQ(e.layout.notes().size(), white ? 6u : 0u);
     // the EKF builds the same layout from the same model and configuration
     const filter::ErrorStateEkf ekf(ftest::staticState(), filter::Matrix9d::Identity(), e.model, cfg);
     EXPECT_EQ(ekf.size(), e.layout.size());
   }
+  // both cases were drawn
+  EXPECT_GT(whites, 0);
+  EXPECT_LT(whites, 40);
 }
 
 TEST(ModelEntry, ZeroRateKeepsTheModelsOwnRate) {
