@@ -94,6 +94,15 @@ set_tests_properties(cli_import_uav_same_outage PROPERTIES FIXTURES_REQUIRED imp
 navimpact_cli_fail(cli_replay_missing_imu_label
   ARGS replay --rawlog ${CMAKE_SOURCE_DIR}/tests/data/imu_label_xsens.rawlog --imu-label NOPE --out ${_idir}/nolabel
   REGEX "imu_label_xsens.rawlog: no IMU entries with label 'NOPE' \\(labels found: XSENS \\(64\\)\\)" NOOUT ${_idir}/nolabel)
+# the same label from the replay configuration (imu_label), and an empty one refused by key
+file(WRITE ${_idir}/label_nope.yaml "imu_label: NOPE\n")
+navimpact_cli_fail(cli_replay_config_imu_label
+  ARGS replay --config ${_idir}/label_nope.yaml --rawlog ${CMAKE_SOURCE_DIR}/tests/data/imu_label_xsens.rawlog --out ${_idir}/nolabel2
+  REGEX "imu_label_xsens.rawlog: no IMU entries with label 'NOPE' \\(labels found: XSENS \\(64\\)\\)" NOOUT ${_idir}/nolabel2)
+file(WRITE ${_idir}/label_empty.yaml "gnss_label: ''\n")
+navimpact_cli_fail(cli_replay_config_empty_label
+  ARGS replay --config ${_idir}/label_empty.yaml --rawlog ${CMAKE_SOURCE_DIR}/tests/data/imu_label_xsens.rawlog --out ${_idir}/nolabel3
+  REGEX "label_empty.yaml: key 'gnss_label'" NOOUT ${_idir}/nolabel3)
 # The imported Katwijk run replayed (config/replay/katwijk.yaml): no GNSS fix at
 # the first IMU sample and a position-only reference (the RTK antenna track):
 # static levelling over the first 19 s at rest, heading from the GNSS chord,

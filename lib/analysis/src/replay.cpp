@@ -72,8 +72,10 @@ void ReplayConfig::loadFrom(const ConfigNode& root) {
   ReplayConfig& c = *this;
   root.allowKeys({"rawlog", "model", "outages", "filter", "initial_sigma", "noise", "gnss_lever_arm_B_m",
                   "initial_attitude_deg", "record_interval_s", "outages_every", "reference_sigma",
-                  "reference_lever_arm_B_m", "alignment", "imu_at_rest", "aids"});
+                  "reference_lever_arm_B_m", "alignment", "imu_at_rest", "aids", "imu_label", "gnss_label"});
   if (root.has("rawlog")) c.rawlog = root.filePath("rawlog");
+  if (root.has("imu_label")) c.imu_label = root.text("imu_label", "the sensor label of the IMU entries", true);
+  if (root.has("gnss_label")) c.gnss_label = root.text("gnss_label", "the sensor label of the GNSS entries", true);
   if (root.has("model")) c.model_spec = root.modelRef("model");
   for (const ConfigNode& o : root.list("outages", 0, SIZE_MAX, "a list of {start_s, duration_s}")) {
     o.allowKeys({"start_s", "duration_s"});

@@ -14,6 +14,8 @@
  * Configuration (YAML, every key optional; relative paths against its folder):
  * @code
  * rawlog: ../../datasets/uav_flight_260s_ref.rawlog
+ * imu_label: XSENS      # of a rawlog navimpact did not write; default: the only IMU label
+ * gnss_label: GPS       # likewise (--imu-label / --gnss-label override them)
  * model: ../models/navchip_table1.yaml:ref   # filter's IMU model; default: the rawlog's scenario model
  * outages: [{start_s: 200, duration_s: 60}]  # [s] from time zero
  * filter: {propagate_every: 10, use_gnss_velocity: true, gate_probability: 0, gate_readmit_after: 3,
