@@ -113,3 +113,8 @@ navimpact_cli_fail(cli_diagnose_run_too_long EXIT 1 NOOUT ${_dg_out}/bad12
 navimpact_cli_fail(cli_diagnose_neither_input_nor_run EXIT 1 NOOUT ${_dg_out}/bad13
   ARGS diagnose --model ${_dg_model} --out ${_dg_out}/bad13
   REGEX "^navimpact: diagnose needs --input")
+# identical inputs, identical power.md / power.json (the cost only in timing.json)
+navimpact_cli_check(cli_reproducible_diagnose_power CHECK reproducible
+  DEFINES W=${_dg_out}/power_twice
+  ARGS diagnose-power --out @OUT@ --runs 2 --null-runs 1 --snr 5:5 --samples 8192:16384
+       --causes sinusoid,level_shift,outliers --threads 2)
