@@ -13,7 +13,6 @@
 #include "cli_common.hpp"
 #include "navimpact/analysis/diagnose_power.hpp"
 #include "navimpact/core/error.hpp"
-#include "navimpact/core/format.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/report/power_report.hpp"
 
@@ -97,8 +96,7 @@ int run(const Opts& o) {
      << table;
   out.writeText("power.md", md.str());
   out.writeText("power.json", navimpact::report::powerJson(r));
-  out.writeText("timing.json", "{\n \"cpu_s\": " + navimpact::formatExact(r.cpu_s) + ",\n \"wall_s\": " +
-                                   navimpact::formatExact(r.wall_s) + "\n}\n");  // apart from the results
+  out.writeText("timing.json", navimpact::report::powerTimingJson(r));
   out.commit();
   std::cout << table << "cost: " << r.cpu_s << " s CPU, " << r.wall_s << " s wall\n"
             << "wrote " << (std::filesystem::path(o.out) / "power.md").string() << " and power.json\n";

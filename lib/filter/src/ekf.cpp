@@ -749,9 +749,13 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
   res.S = R;
   res.S.noalias() += H * PHt;
   res.innovation = dz;
-  Eigen::LLT<MatrixXd> llt(res.S);
-  if (llt.info() != Eigen::Success || !res.S.allFinite())
-    throw Error("innovation covariance not positive definite at t = " + formatNumber(res.t, 9) + " s");
+  Eigen::LLT<MatrixXd> llt;
+  auto factor = [&](const MatrixXd& S) {
+    llt.compute(S);
+    if (llt.info() != Eigen::Success || !S.allFinite())
+      throw Error("innovation covariance not positive definite at t = " + formatNumber(res.t, 9) + " s");
+  };
+  factor(res.S);
   res.nis = dz.dot(llt.solve(dz));
   if (cfg_.gate_probability > 0.0) {
     const boost::math::chi_squared chi2(mz);
@@ -772,9 +776,7 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
       PHt *= res.inflation;
       MatrixXd S2 = R;
       S2.noalias() += H * PHt;
-      llt.compute(S2);
-      if (llt.info() != Eigen::Success || !S2.allFinite())
-        throw Error("innovation covariance not positive definite at t = " + formatNumber(res.t, 9) + " s");
+      factor(S2);
     }
   }
   consecutive_rejections_ = 0;

@@ -41,9 +41,7 @@ GzMemberSink::GzMemberSink(const std::string& path, int level)
 }
 
 GzMemberSink::~GzMemberSink() {
-  for (auto& p : pending_)
-    if (p.valid()) p.wait();
-  if (f_) std::fclose(f_);
+  if (f_) std::fclose(f_);  // (pending std::async futures wait in their own destructors)
 }
 
 size_t GzMemberSink::Write(const void* buf, size_t n) {

@@ -60,4 +60,9 @@ std::string powerJson(const PowerResult& r) {
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
+std::string powerTimingJson(const PowerResult& r) {
+  const nlohmann::json j = {{"cpu_s", r.cpu_s}, {"wall_s", r.wall_s}};
+  return j.dump(1) + "\n";
+}
+
 }  // namespace navimpact::report

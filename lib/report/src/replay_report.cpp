@@ -388,25 +388,20 @@ std::string summaryJson(const ReplayResult& r) {
       ex["time_offset_s"] = {{"estimate", e.time_offset_s}, {"sigma", sg.time_offset_s}, {"prior_sigma", x.time_offset_sigma_s}};
     j["extra_states"] = ex;
   }
+  // gate events, the first 1000 of each kind; re-admissions with the factor P was scaled by
+  auto gateEvents = [&](const std::vector<RejectedUpdate>& v, bool inflation) {
+    json a = json::array();
+    for (std::size_t k = 0; k < v.size() && k < 1000; ++k) {
+      json e = {{"t_s", v[k].t - r.t_zero}, {"kind", v[k].kind}, {"nis", v[k].nis}, {"gate", v[k].gate}};
+      if (inflation) e["p_inflation"] = v[k].inflation;
+      a.push_back(e);
+    }
+    return a;
+  };
   j["rejected_updates"] = r.run.rejected.size();
-  {
-    json rej = json::array();
-    for (std::size_t k = 0; k < r.run.rejected.size() && k < 1000; ++k) {
-      const auto& u = r.run.rejected[k];
-      rej.push_back({{"t_s", u.t - r.t_zero}, {"kind", u.kind}, {"nis", u.nis}, {"gate", u.gate}});
-    }
-    j["rejected"] = rej;  // the first 1000
-  }
+  j["rejected"] = gateEvents(r.run.rejected, false);
   j["readmitted_updates"] = r.run.readmitted.size();
-  {
-    json rea = json::array();
-    for (std::size_t k = 0; k < r.run.readmitted.size() && k < 1000; ++k) {
-      const auto& u = r.run.readmitted[k];
-      rea.push_back({{"t_s", u.t - r.t_zero}, {"kind", u.kind}, {"nis", u.nis}, {"gate", u.gate},
-                     {"p_inflation", u.inflation}});
-    }
-    j["readmitted"] = rea;  // the first 1000
-  }
+  j["readmitted"] = gateEvents(r.run.readmitted, true);
   j["zupt_updates"] = r.run.zupt_updates;
   j["nhc_updates"] = r.run.nhc_updates;
   j["filter_start_s"] = r.aided_from_s;

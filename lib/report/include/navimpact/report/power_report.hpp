@@ -16,5 +16,7 @@ std::string powerTable(const analysis::power::PowerResult& r);
 
 /// power.json text.
 std::string powerJson(const analysis::power::PowerResult& r);
+/// timing.json: the sweep's CPU and wall time, kept apart from the results (identical runs, identical power.json).
+std::string powerTimingJson(const analysis::power::PowerResult& r);
 
 }  // namespace navimpact::report
