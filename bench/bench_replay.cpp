@@ -124,7 +124,7 @@ static void BM_ReplayScored(benchmark::State& st) {
   const an::NavRunInput in = p.input();
   an::NavRunOptions opt;
   opt.ekf.propagate_every = 10;
-  for (const auto& w : an::outagesEvery({60.0, 20.0}, p.x0.t, p.imu.back().t)) opt.outages.push_back({w.first, w.second});
+  for (const auto& w : navimpact::outagesEvery({60.0, 20.0}, p.x0.t, p.imu.back().t)) opt.outages.push_back(w);
   double steps = 0;
   std::size_t scored = 0;
   for (auto _ : st) {

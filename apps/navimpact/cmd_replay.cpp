@@ -62,7 +62,7 @@ navimpact::cli::Registrar reg({
           cfg.outages.clear();
           for (const auto& s : o->outages) cfg.outages.push_back(navimpact::parseOutage(s));
         }
-        if (!o->outages_every.empty()) cfg.outages_every = navimpact::analysis::parseOutagePattern(o->outages_every);
+        if (!o->outages_every.empty()) cfg.outages_every = navimpact::parseOutagePattern(o->outages_every);
         if (o->propagate_every > 0) cfg.propagate_every = o->propagate_every;
         if (o->max_imu_gap_s >= 0.0) cfg.max_imu_gap_s = o->max_imu_gap_s;
         const auto r = navimpact::analysis::runReplay(cfg);

@@ -160,7 +160,7 @@ TEST(Replay, OutagesEveryAreScoredAgainstTheReference) {
   navimpact::rawlog::writeRawlog(path, emulate60("model"));
   an::ReplayConfig c;
   c.rawlog = path;
-  c.outages_every = an::parseOutagePattern("15:5");
+  c.outages_every = navimpact::parseOutagePattern("15:5");
   const auto r = an::runReplay(c);
   // starts 10, 25, 40 (ends 15, 30, 45); 55..60 ends at 60 = the data end
   ASSERT_EQ(r.cfg.outages.size(), 4u);
@@ -189,7 +189,7 @@ TEST(Replay, OutagesEveryAreScoredAgainstTheReference) {
   c.reference_sigma_v_m = 5.0;
   const auto r2 = an::runReplay(c);
   for (std::size_t k = 0; k < 4; ++k) EXPECT_LT(r2.score->outages[k].nees, sc.outages[k].nees);
-  c.outages_every = an::OutagePattern{100.0, 5.0};  // none fits in 60 s
+  c.outages_every = navimpact::OutagePattern{100.0, 5.0};  // none fits in 60 s
   EXPECT_TRUE(an::runReplay(c).cfg.outages.empty());
 }
 

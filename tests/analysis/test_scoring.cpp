@@ -1,8 +1,7 @@
-// Scoring a run against a reference: the outage pattern's closed form, the
-// percentile, the GNSS-aided RMS, and the NEES / coverage statistics on
-// errors drawn from the predicted covariance plus the reference's (they must
-// pass) and from an inflated one (they must fail). Draws are seeded and the
-// seed and parameters printed.
+// Scoring a run against a reference: the percentile, the GNSS-aided RMS, and
+// the NEES / coverage statistics on errors drawn from the predicted covariance
+// plus the reference's (they must pass) and from an inflated one (they must
+// fail). Draws are seeded and the seed and parameters printed.
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -18,26 +17,6 @@
 namespace an = navimpact::analysis;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
-
-TEST(Scoring, OutagePatternClosedForm) {
-  const an::OutagePattern p = an::parseOutagePattern("120:30");
-  EXPECT_EQ(p.period_s, 120.0);
-  EXPECT_EQ(p.duration_s, 30.0);
-  // aided from 10 s, data to 500 s: starts 100, 220, 340 (ends 130, 250, 370);
-  // the next (460..490) fits too; 580 does not.
-  const auto w = an::outagesEvery(p, 10.0, 500.0);
-  ASSERT_EQ(w.size(), 4u);
-  for (std::size_t k = 0; k < w.size(); ++k) {
-    EXPECT_DOUBLE_EQ(w[k].first, 10.0 + (k + 1) * 120.0 - 30.0);
-    EXPECT_DOUBLE_EQ(w[k].second - w[k].first, 30.0);
-    // GNSS time before each outage = period - duration
-    const double before = k == 0 ? w[k].first - 10.0 : w[k].first - w[k - 1].second;
-    EXPECT_DOUBLE_EQ(before, 90.0);
-  }
-  EXPECT_TRUE(an::outagesEvery(p, 0.0, 119.0).empty());
-  for (const char* bad : {"30", "30:30", "20:30", "a:b", "120:0", "120:-1", ":"})
-    EXPECT_THROW(an::parseOutagePattern(bad), navimpact::Error) << bad;
-}
 
 TEST(Scoring, PercentileType7) {
   EXPECT_DOUBLE_EQ(an::percentile({3.0, 1.0, 2.0}, 0.5), 2.0);

@@ -1,6 +1,7 @@
 // The one GNSS outage: the interval (start, end] it removes, its text form
 // START:DURATION read back, and the one validation (order, overlap, span),
-// on outages drawn at random over the whole documented range (seeded, logged).
+// on outages drawn at random over the whole documented range (seeded, logged),
+// and the pattern PERIOD:DURATION of outages all along a run.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -101,4 +102,24 @@ TEST(Outage, OneValidation) {
     const double span = w.back().end_s - 1e-3;
     EXPECT_NE(errorOf(w, span).find(navimpact::outageText(w.back()) + " ends at"), std::string::npos);
   }
+}
+
+TEST(Outage, PatternClosedForm) {
+  const navimpact::OutagePattern p = navimpact::parseOutagePattern("120:30");
+  EXPECT_EQ(p.period_s, 120.0);
+  EXPECT_EQ(p.duration_s, 30.0);
+  // aided from 10 s, data to 500 s: starts 100, 220, 340 (ends 130, 250, 370);
+  // the next (460..490) fits too; 580 does not.
+  const auto w = navimpact::outagesEvery(p, 10.0, 500.0);
+  ASSERT_EQ(w.size(), 4u);
+  for (std::size_t k = 0; k < w.size(); ++k) {
+    EXPECT_DOUBLE_EQ(w[k].start_s, 10.0 + (k + 1) * 120.0 - 30.0);
+    EXPECT_DOUBLE_EQ(w[k].duration_s(), 30.0);
+    // GNSS time before each outage = period - duration
+    const double before = k == 0 ? w[k].start_s - 10.0 : w[k].start_s - w[k - 1].end_s;
+    EXPECT_DOUBLE_EQ(before, 90.0);
+  }
+  EXPECT_TRUE(navimpact::outagesEvery(p, 0.0, 119.0).empty());
+  for (const char* bad : {"30", "30:30", "20:30", "a:b", "120:0", "120:-1", ":"})
+    EXPECT_THROW(navimpact::parseOutagePattern(bad), navimpact::Error) << bad;
 }

@@ -17,11 +17,11 @@
 #include "diagnosis_internal.hpp"
 #include "navimpact/analysis/diagnosis.hpp"
 #include "navimpact/filter/model_entry.hpp"
+#include "navimpact/analysis/run_plan.hpp"
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
-#include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/filter/state_layout.hpp"
 #include "navimpact/stochastic/simulate.hpp"
@@ -30,14 +30,7 @@ namespace navimpact::analysis {
 
 struct NavGainPlan {
   NavGainOptions opt;
-  std::optional<emulation::SmoothTrajectory> traj;
-  std::vector<ins::ImuSample> perfect;
-  TruthSeries truth;
-  ins::NavState truth0;
-  double rate = 0, t0 = 0, t1 = 0;
-  std::vector<Outage> outages;         ///< absolute filter times
-  std::vector<std::size_t> end_epoch;  ///< truth index of each outage end
-  NavRunOptions nav;
+  RunPlan run;
   std::size_t samples = 0;             ///< recording samples
 };
 
@@ -48,55 +41,26 @@ std::shared_ptr<const NavGainPlan> prepareNavGain(const NavGainOptions& opt, dou
   if (!(rate > 0)) throw Error("navigation gain: recording rate must be > 0");
   auto plan = std::make_shared<NavGainPlan>();
   plan->opt = opt;
-  plan->rate = rate;
   plan->samples = samples;
-  const emulation::SampledTrajectory smp = emulation::readTrajectoryCsv(opt.trajectory);
-  plan->traj.emplace(smp, opt.smoothing);
-  const auto& tr = *plan->traj;
-  plan->t0 = tr.tBegin();
-  const std::size_t n = static_cast<std::size_t>(std::floor((tr.tEnd() - tr.tBegin()) * rate + 1e-9));
-  plan->t1 = plan->t0 + double(n) / rate;
-  const double duration = plan->t1 - plan->t0;
-  checkOutages(opt.outages, duration,
-               "the end of the trajectory " + opt.trajectory.file + " (" + formatNumber(duration) + " s)", "--outage");
-  for (const auto& o : opt.outages) plan->outages.push_back(o.shifted(plan->t0));
-  if (n > samples)
-    throw Error("static recording too short for the navigation gain: " + formatNumber(samples / rate, 6) +
-                " s available, " + formatNumber(duration, 6) + " s needed for the trajectory " +
-                opt.trajectory.file);
-  plan->perfect = emulation::perfectImu(tr, rate, plan->t0, plan->t1);
-  if (plan->perfect.size() != n)
-    throw Error("navigation gain: perfect IMU has " + std::to_string(plan->perfect.size()) +
-                " samples, expected " + std::to_string(n));
-  // Record epochs (IMU sample indices): record_rate outside, outage rate inside.
-  std::vector<std::size_t> ks;
-  const auto step_out = std::max<std::size_t>(1, std::size_t(std::llround(rate / opt.record_rate_hz)));
-  const auto step_in = std::max<std::size_t>(1, std::size_t(std::llround(rate / opt.outage_record_rate_hz)));
-  for (std::size_t k = 0; k <= n; k += step_out) ks.push_back(k);
-  std::vector<std::size_t> ends;
-  for (const auto& o : opt.outages) {
-    const auto ka = std::size_t(std::llround(o.start_s * rate)), ke = std::min(n, std::size_t(std::llround(o.end_s * rate)));
-    for (std::size_t k = ka; k < ke; k += step_in) ks.push_back(k);
-    ks.push_back(ke);
-    ends.push_back(ke);
-  }
-  std::sort(ks.begin(), ks.end());
-  ks.erase(std::unique(ks.begin(), ks.end()), ks.end());
-  for (std::size_t k : ks) {
-    const double t = plan->t0 + double(k) / rate;
-    plan->truth.t.push_back(t);
-    plan->truth.x.push_back(emulation::truthNavState(tr, t));
-  }
-  for (std::size_t ke : ends)
-    plan->end_epoch.push_back(static_cast<std::size_t>(std::lower_bound(ks.begin(), ks.end(), ke) - ks.begin()));
-  plan->truth0 = emulation::truthNavState(tr, plan->t0);
-  NavRunOptions& nav = plan->nav;
-  nav.ekf.propagate_every =
+  RunPlanOptions ro;
+  ro.trajectory = opt.trajectory;
+  ro.smoothing = opt.smoothing;
+  ro.imu_rate_hz = rate;
+  ro.outages = opt.outages;
+  ro.outage_name = "--outage";
+  ro.record_rate_hz = opt.record_rate_hz;
+  ro.outage_record_rate_hz = opt.outage_record_rate_hz;
+  ro.gnss = opt.gnss;
+  ro.baro = opt.baro;
+  ro.baro_in_outage = opt.baro_in_outage;
+  ro.ekf.propagate_every =
       opt.propagate_every > 0 ? opt.propagate_every : std::max(1, static_cast<int>(std::lround(rate / 20.0)));
-  nav.P0_nav = opt.initial_sigma.cwiseAbs2().asDiagonal();
-  nav.outages = plan->outages;
-  nav.lever_arm_B = opt.gnss.lever_arm_B;
-  nav.baro_in_outage = opt.baro_in_outage;
+  ro.initial_sigma = opt.initial_sigma;
+  plan->run = planRuns(ro);
+  if (plan->run.samples() > samples)
+    throw Error("static recording too short for the navigation gain: " + formatNumber(samples / rate, 6) +
+                " s available, " + formatNumber(plan->run.duration_s(), 6) + " s needed for the trajectory " +
+                opt.trajectory.file);
   return plan;
 }
 
@@ -142,12 +106,13 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
                        const std::function<void(double)>& progress) {
   const auto wall0 = std::chrono::steady_clock::now();
   const NavGainOptions& opt = p.opt;
-  if (std::abs(data.rate_hz - p.rate) > 1e-9 * p.rate || data.size() != p.samples)
+  const RunPlan& run = p.run;
+  if (std::abs(data.rate_hz - run.rate_hz) > 1e-9 * run.rate_hz || data.size() != p.samples)
     throw Error("navigation gain: the plan was prepared for another recording");
-  const std::size_t n = p.perfect.size();
+  const std::size_t n = run.samples();
   NavGain g;
-  g.imu_rate_hz = p.rate;
-  g.duration_s = p.t1 - p.t0;
+  g.imu_rate_hz = run.rate_hz;
+  g.duration_s = run.duration_s();
   g.runs = opt.runs;
   g.seed = opt.seed;
   g.trajectory = opt.trajectory.file + " (" + formatNumber(g.duration_s, 6) + " s used)";
@@ -176,8 +141,8 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
     // as white noise (filter::ImuErrorOptions::white_gm_below_s); say so.
     std::size_t replaced = 0;
     for (const auto* m : {&before, &after})
-      replaced += filter::layoutFor(*m, p.nav.ekf).layout.notes().size();
-    const double t_min = p.nav.ekf.propagate_every / p.rate;
+      replaced += filter::layoutFor(*m, run.nav.ekf).layout.notes().size();
+    const double t_min = run.nav.ekf.propagate_every / run.rate_hz;
     if (replaced > 0)
       g.filter_note = std::to_string(replaced) +
                       " Gauss-Markov term(s) with T at most the covariance propagation interval (" +
@@ -190,7 +155,7 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
                        : "the whole-record extension (model_after): the second half of the record is "
                          "shorter than the emulation, so truth windows and fit share data (in-sample)";
   if (!held_out)
-    d.notices.push_back("navigation gain is in-sample: the held-out half (" + formatNumber((N - nh) / p.rate, 6) +
+    d.notices.push_back("navigation gain is in-sample: the held-out half (" + formatNumber((N - nh) / run.rate_hz, 6) +
                         " s) is shorter than the trajectory (" + formatNumber(g.duration_s, 6) + " s)");
   // Evenly spaced window offsets over the available span.
   const std::size_t avail = rec.size() - n;
@@ -199,27 +164,27 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
     const double frac = opt.runs > 1 ? double(r) / double(opt.runs - 1) : 0.0;
     const std::size_t off = static_cast<std::size_t>(std::floor(frac * double(avail)));
     offs.push_back(off);
-    g.window_offsets_s.push_back(double(first + off) / p.rate);
+    g.window_offsets_s.push_back(double(first + off) / run.rate_hz);
   }
   g.truth = "measured static recording " + data.source + ": run r takes the " + formatNumber(g.duration_s, 6) +
             " s window starting at offset r/(R-1) of the " + (held_out ? "second half" : "whole record") +
             " (R = " + std::to_string(opt.runs) + "), window mean removed per axis";
   {
     std::ostringstream st;
-    st << "IMU " << formatNumber(p.rate, 6) << " Hz; GNSS " << formatNumber(opt.gnss.rate_hz, 4)
+    st << "IMU " << formatNumber(run.rate_hz, 6) << " Hz; GNSS " << formatNumber(opt.gnss.rate_hz, 4)
        << " Hz, position sigma " << formatNumber(opt.gnss.sigma_pos_h_m, 4) << " m horizontal / "
        << formatNumber(opt.gnss.sigma_pos_v_m, 4) << " m vertical, velocity sigma "
        << formatNumber(opt.gnss.sigma_vel_h_mps, 4) << " / " << formatNumber(opt.gnss.sigma_vel_v_mps, 4)
        << " m/s; barometer " << formatNumber(opt.baro.rate_hz, 4) << " Hz, sigma " << formatNumber(opt.baro.sigma_m, 4)
        << " m, " << (opt.baro_in_outage ? "kept" : "off") << " during outages; EKF covariance every "
-       << p.nav.ekf.propagate_every << " IMU samples; initial error sigmas " << formatNumber(opt.initial_sigma(0), 3)
+       << run.nav.ekf.propagate_every << " IMU samples; initial error sigmas " << formatNumber(opt.initial_sigma(0), 3)
        << " m, " << formatNumber(opt.initial_sigma(3), 3) << " m/s, roll/pitch "
        << formatNumber(opt.initial_sigma(6) / units::kDeg, 3) << " deg, yaw "
        << formatNumber(opt.initial_sigma(8) / units::kDeg, 3) << " deg (drawn per run, same for both models)";
     g.settings = st.str();
   }
 
-  const std::size_t O = p.outages.size(), E = p.truth.t.size();
+  const std::size_t O = run.nav.outages.size(), E = run.truth.t.size();
   std::vector<RunOut> outs(opt.runs);
   std::atomic<int> next{0}, done{0};
   std::mutex mu;
@@ -232,14 +197,13 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
         const std::uint64_t seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(r));
         emulation::StaticRecordingSpec spec;
         spec.file = data.source;
-        spec.offset_s = double(offs[r]) / p.rate;
-        const auto err = emulation::staticImuErrors(rec, spec, p.rate, n).axis;
-        const EmulatedRun run =
-            emulateRun(p.perfect, err, *p.traj, p.t0, p.t1, opt.gnss, opt.baro, p.truth0, opt.initial_sigma, seed);
-        const NavRunInput in = run.input(p.truth);
+        spec.offset_s = double(offs[r]) / run.rate_hz;
+        const auto err = emulation::staticImuErrors(rec, spec, run.rate_hz, n).axis;
+        const EmulatedRun emulated = run.emulate(err, seed);
+        const NavRunInput in = run.input(emulated);
         RunOut& o = outs[r];
         for (int m = 0; m < 2; ++m) {
-          const NavRunResult res = runNav(in, m == 0 ? before : after, p.nav);
+          const NavRunResult res = runNav(in, m == 0 ? before : after, run.nav);
           if (res.epochs.size() != E)
             throw Error("navigation gain: run " + std::to_string(r) + " recorded " +
                         std::to_string(res.epochs.size()) + " epochs, expected " + std::to_string(E));
@@ -250,7 +214,7 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
             o.sh[m].push_back(std::hypot(ep.sigma(0), ep.sigma(1)));
           }
           for (std::size_t q = 0; q < O; ++q) {
-            const auto& ep = res.epochs[p.end_epoch[q]];
+            const auto& ep = res.epochs[run.outage_end_epoch[q]];
             o.h[m].push_back(std::hypot(ep.err(0), ep.err(1)));
             o.v[m].push_back(std::abs(ep.err(2)));
             o.nees[m].push_back(ep.nees[0]);
@@ -280,8 +244,8 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
   // Per outage, paired over runs.
   for (std::size_t q = 0; q < O; ++q) {
     NavOutageGain og;
-    og.start_s = p.outages[q].start_s - p.t0;
-    og.duration_s = p.outages[q].end_s - p.outages[q].start_s;
+    og.start_s = run.nav.outages[q].start_s - run.t0;
+    og.duration_s = run.nav.outages[q].end_s - run.nav.outages[q].start_s;
     for (const auto& o : outs) {
       og.h_before.push_back(o.h[0][q]);
       og.h_after.push_back(o.h[1][q]);
@@ -314,7 +278,7 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
   // RMS time series for the figure.
   g.t_s.resize(E);
   for (std::size_t e = 0; e < E; ++e) {
-    g.t_s[e] = p.truth.t[e] - p.t0;
+    g.t_s[e] = run.truth.t[e] - run.t0;
     double hb = 0, ha = 0, vb = 0, va = 0, sb = 0, sa = 0;
     for (const auto& o : outs) {
       hb += o.eh[0][e] * o.eh[0][e];

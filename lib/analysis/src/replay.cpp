@@ -431,9 +431,9 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   }
   // Outages all along the run, each after period - duration of GNSS from the filter start.
   if (cfg.outages_every) {
-    for (const auto& w : outagesEvery(*cfg.outages_every, in.x0.t, t_last)) {
-      opt.outages.push_back({w.first, w.second});
-      r.cfg.outages.push_back({w.first - r.t_zero, w.second - r.t_zero});
+    for (const Outage& w : outagesEvery(*cfg.outages_every, in.x0.t, t_last)) {
+      opt.outages.push_back(w);
+      r.cfg.outages.push_back({w.start_s - r.t_zero, w.end_s - r.t_zero});
     }
     if (opt.outages.size() == cfg.outages.size())
       r.notices.push_back("outages every " + formatNumber(cfg.outages_every->period_s, 10) + ":" +

@@ -22,7 +22,7 @@
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 #include "navimpact/core/units.hpp"
-#include "navimpact/emulation/perfect_imu.hpp"
+#include "navimpact/analysis/run_plan.hpp"
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/filter/model_entry.hpp"
 #include "navimpact/filter/state_layout.hpp"
@@ -139,16 +139,11 @@ class StudyPlan {
  public:
   StudyConfig cfg;
   StudyMeta meta;
-  std::optional<emulation::SmoothTrajectory> traj;
-  std::vector<ins::ImuSample> perfect;
-  TruthSeries truth;
-  ins::NavState truth0;
-  double t0 = 0.0, t1 = 0.0;
+  RunPlan run;
   stochastic::ImuModel truth_model;
   std::optional<ImuSeries> recording;
   std::size_t rec_block = 1;  // recording samples per IMU sample
   std::vector<stochastic::ImuModel> filter_models;
-  NavRunOptions nav;
 };
 
 const StudyMeta& studyMeta(const StudyPlan& plan) { return plan.meta; }
@@ -206,23 +201,30 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
     meta.sources.push_back(describeModel(plan->filter_models.back()));
   }
 
-  // Trajectory and its smooth truth.
-  const emulation::SampledTrajectory samples = emulation::readTrajectoryCsv(cfg.trajectory);
-  plan->traj.emplace(samples, cfg.smoothing);
-  const auto& tr = *plan->traj;
-  plan->t0 = tr.tBegin();
-  const std::size_t n = static_cast<std::size_t>(std::floor((tr.tEnd() - tr.tBegin()) * rate + 1e-9));
-  plan->t1 = plan->t0 + double(n) / rate;
-  const double duration = plan->t1 - plan->t0;
-  meta.t0 = plan->t0;
+  // The runs: trajectory, outages, perfect IMU, record epochs and their truth, filter options.
+  RunPlanOptions ro;
+  ro.trajectory = cfg.trajectory;
+  ro.smoothing = cfg.smoothing;
+  ro.imu_rate_hz = rate;
+  ro.outages = cfg.outages;
+  ro.record_rate_hz = cfg.record_rate_hz;
+  ro.outage_record_rate_hz = cfg.outage_record_rate_hz;
+  ro.gnss = cfg.gnss;
+  ro.baro = cfg.baro;
+  ro.use_baro = cfg.use_baro;
+  ro.baro_in_outage = cfg.baro_in_outage;
+  ro.ekf = cfg.ekf;
+  ro.initial_sigma = cfg.initial_sigma;
+  plan->run = planRuns(ro);
+  const RunPlan& run = plan->run;
+  const std::size_t n = run.samples();
+  const double duration = run.duration_s();
+  meta.t0 = run.t0;
   meta.duration_s = duration;
   meta.imu_rate_hz = rate;
   meta.trajectory = cfg.trajectory.file + " (" + formatNumber(duration) + " s used)";
-
-  // Outages inside the trajectory.
-  checkOutages(cfg.outages, duration,
-               "the end of the trajectory (" + formatNumber(duration) + " s of " + cfg.trajectory.file + ")");
-  for (const auto& o : cfg.outages) meta.outages.push_back(o.shifted(plan->t0));
+  meta.outages = run.nav.outages;
+  meta.epochs = run.truth.t;
 
   // True errors.
   if (cfg.truth.kind == "model") {
@@ -246,38 +248,6 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
                              " s window chosen by its seed, mean removed per axis" +
                              (plan->rec_block > 1 ? ", block means of " + std::to_string(plan->rec_block) : "");
   }
-
-  // Perfect IMU and record epochs (as IMU sample indices, t = t0 + k / rate).
-  plan->perfect = emulation::perfectImu(tr, rate, plan->t0, plan->t1);
-  if (plan->perfect.size() != n)
-    throw Error("study: perfect IMU has " + std::to_string(plan->perfect.size()) + " samples, expected " +
-                std::to_string(n));
-  std::vector<std::size_t> ks;
-  const auto step_out = std::max<std::size_t>(1, std::size_t(std::llround(rate / cfg.record_rate_hz)));
-  const auto step_in = std::max<std::size_t>(1, std::size_t(std::llround(rate / cfg.outage_record_rate_hz)));
-  for (std::size_t k = 0; k <= n; k += step_out) ks.push_back(k);
-  for (const auto& o : cfg.outages) {
-    const auto ks0 = std::size_t(std::llround(o.start_s * rate)), ke = std::size_t(std::llround(o.end_s * rate));
-    for (std::size_t k = ks0; k < ke; k += step_in) ks.push_back(k);
-    ks.push_back(std::min(ke, n));
-  }
-  std::sort(ks.begin(), ks.end());
-  ks.erase(std::unique(ks.begin(), ks.end()), ks.end());
-  for (std::size_t k : ks) {
-    const double t = plan->t0 + double(k) / rate;
-    plan->truth.t.push_back(t);
-    plan->truth.x.push_back(emulation::truthNavState(tr, t));
-    meta.epochs.push_back(t);
-  }
-  plan->truth0 = emulation::truthNavState(tr, plan->t0);
-
-  // Filter options.
-  NavRunOptions& nav = plan->nav;
-  nav.ekf = cfg.ekf;
-  nav.P0_nav = cfg.initial_sigma.cwiseAbs2().asDiagonal();
-  nav.outages = meta.outages;
-  nav.lever_arm_B = cfg.gnss.lever_arm_B;
-  nav.baro_in_outage = cfg.baro_in_outage;
 
   meta.version = version;
   meta.versions = buildVersions();
@@ -317,7 +287,7 @@ RunRecord doRun(const StudyPlan& p, std::uint64_t index) {
   RunRecord rec;
   rec.index = index;
   rec.seed = stochastic::deriveSeed(cfg.seed, index);
-  const std::size_t n = p.perfect.size();
+  const std::size_t n = p.run.samples();
 
   // IMU errors, shared by every candidate model.
   std::array<std::vector<double>, 6> err;
@@ -331,14 +301,12 @@ RunRecord doRun(const StudyPlan& p, std::uint64_t index) {
   } else {
     err = emulation::modelImuErrors(p.truth_model, cfg.imu_rate_hz, n, stochastic::deriveSeed(rec.seed, 0)).axis;
   }
-  const EmulatedRun run = emulateRun(p.perfect, err, *p.traj, p.t0, p.t1, cfg.gnss, cfg.baro, p.truth0,
-                                     cfg.initial_sigma, rec.seed);
-  NavRunInput in = run.input(p.truth);
-  if (!cfg.use_baro) in.baro = nullptr;
+  const EmulatedRun run = p.run.emulate(err, rec.seed);
+  const NavRunInput in = p.run.input(run);
 
-  const std::size_t E = p.truth.t.size(), O = p.nav.outages.size();
+  const std::size_t E = p.run.truth.t.size(), O = p.run.nav.outages.size();
   for (const auto& model : p.filter_models) {
-    const NavRunResult r = runNav(in, model, p.nav);
+    const NavRunResult r = runNav(in, model, p.run.nav);
     if (r.epochs.size() != E)
       throw Error("study: run " + std::to_string(index) + " recorded " + std::to_string(r.epochs.size()) +
                   " epochs, expected " + std::to_string(E));
@@ -435,7 +403,7 @@ StudyResults runStudy(const std::shared_ptr<const StudyPlan>& plan, const Shard&
   const std::size_t N = res.run_indices.size();
   if (N == 0) throw Error("study: shard " + std::to_string(shard.k) + "/" + std::to_string(shard.n) +
                           " holds no run (only " + std::to_string(p.cfg.runs) + " runs)");
-  const std::size_t E = p.truth.t.size(), O = p.nav.outages.size();
+  const std::size_t E = p.run.truth.t.size(), O = p.run.nav.outages.size();
   threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(N)));
 
   std::atomic<std::size_t> next{0};

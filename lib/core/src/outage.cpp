@@ -29,6 +29,31 @@ Outage parseOutage(const std::string& text, const std::string& what) {
   return Outage::fromStartDuration(start, duration);
 }
 
+OutagePattern parseOutagePattern(const std::string& text) {
+  const auto c = text.find(':');
+  OutagePattern p;
+  if (c == std::string::npos || !parseDouble(trim(std::string_view(text).substr(0, c)), p.period_s) ||
+      !parseDouble(trim(std::string_view(text).substr(c + 1)), p.duration_s))
+    throw Error("outages every '" + text + "': expected PERIOD:DURATION in seconds, e.g. 120:30");
+  if (!(p.duration_s > 0.0) || !(p.period_s > p.duration_s) || !std::isfinite(p.period_s))
+    throw Error("outages every '" + text +
+                "': DURATION must be > 0 s and PERIOD > DURATION (GNSS time between outages to reconverge)");
+  return p;
+}
+
+std::vector<Outage> outagesEvery(const OutagePattern& p, double aided_from, double end) {
+  if (!(p.duration_s > 0.0) || !(p.period_s > p.duration_s))
+    throw Error("outages every " + formatNumber(p.period_s, 10) + ":" + formatNumber(p.duration_s, 10) + ": PERIOD must exceed DURATION > 0");
+  std::vector<Outage> out;
+  for (long k = 0;; ++k) {
+    // start_k = aided_from + (k + 1) period - duration, computed from k (no accumulated rounding)
+    const double a = aided_from + double(k + 1) * p.period_s - p.duration_s, b = a + p.duration_s;
+    if (b > end + 1e-9) break;
+    out.push_back({a, b});
+  }
+  return out;
+}
+
 void checkOutages(const std::vector<Outage>& outages, double span_s, const std::string& after,
                   const std::string& what) {
   for (std::size_t i = 0; i < outages.size(); ++i) {

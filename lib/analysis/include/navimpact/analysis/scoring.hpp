@@ -36,25 +36,6 @@
 
 namespace navimpact::analysis {
 
-/// Outages all along a run: every PERIOD seconds one of DURATION seconds.
-struct OutagePattern {
-  double period_s = 0.0;    ///< [s], > duration_s
-  double duration_s = 0.0;  ///< [s], > 0
-};
-
-/// Parse "PERIOD:DURATION" (seconds), PERIOD > DURATION > 0.
-/// @throws navimpact::Error naming the text.
-OutagePattern parseOutagePattern(const std::string& text);
-
-/**
- * The outage windows [start, start + duration] of @p p over [aided_from_s, end_s]:
- * each outage follows period - duration seconds of GNSS (time to reconverge),
- * the first one too: start_k = aided_from_s + (k + 1) period - duration; only
- * outages ending by end_s. Empty when none fits.
- * @return (start, end) pairs in the same time base as the arguments.
- */
-std::vector<std::pair<double, double>> outagesEvery(const OutagePattern& p, double aided_from_s, double end_s);
-
 /// What is known about the reference.
 struct ReferenceInfo {
   double sigma_h_m = 0.0;       ///< its own 1-sigma per horizontal axis [m], >= 0

@@ -2,7 +2,8 @@
  * @file outage.hpp
  * @brief The one GNSS outage of navimpact: its type, its text form
  *        START:DURATION and its validation, used by every command
- *        (replay, study, sweep, diagnose) and by the navigation run.
+ *        (replay, study, sweep, diagnose) and by the navigation run; and
+ *        the pattern PERIOD:DURATION of outages all along a run.
  *
  * An outage is the half-open interval (start_s, end_s]: GNSS fixes with
  * start_s < t <= end_s are not used (a fix at start_s is the last one used).
@@ -44,6 +45,25 @@ std::string outageText(const Outage& o);
 /// @throws navimpact::Error "WHAT 'TEXT': expected START:DURATION in seconds, e.g. 200:60"
 ///         or "WHAT 'TEXT': START must be >= 0 s and DURATION > 0 s".
 Outage parseOutage(const std::string& text, const std::string& what = "outage");
+
+/// Outages all along a run: every PERIOD seconds one of DURATION seconds.
+struct OutagePattern {
+  double period_s = 0.0;    ///< [s], > duration_s
+  double duration_s = 0.0;  ///< [s], > 0
+};
+
+/// Parses "PERIOD:DURATION" [s] (e.g. "120:30"; spaces around the numbers allowed), PERIOD > DURATION > 0.
+/// @throws navimpact::Error "outages every 'TEXT': expected PERIOD:DURATION in seconds, e.g. 120:30"
+///         or "outages every 'TEXT': DURATION must be > 0 s and PERIOD > DURATION (...)".
+OutagePattern parseOutagePattern(const std::string& text);
+
+/**
+ * The outages of @p p over [aided_from_s, end_s]: each follows
+ * period - duration seconds of GNSS (time to reconverge), the first one too:
+ * start_k = aided_from_s + (k + 1) period - duration, end_k = start_k + duration;
+ * only outages ending by end_s. Empty when none fits. Times in the base of the arguments.
+ */
+std::vector<Outage> outagesEvery(const OutagePattern& p, double aided_from_s, double end_s);
 
 /// The one validation of a list of outages in run time [s]: each starts at a
 /// finite time >= 0 and lasts a finite time > 0, they are in time order
