@@ -121,12 +121,16 @@ INSTANTIATE_TEST_SUITE_P(AllCauses, HiddenCause,
                          [](const auto& info) { return std::string(na::causeName(info.param)); });
 
 TEST(Diagnose, TwoEffectsOnOneChannel) {
-  // A random pair of different causes on one channel, each at 5x its limit in
-  // the noise it sits in (the base model plus the other effect's random part).
-  const int R = runs(24);
+  // A random pair of different causes (any two of the eight) on one channel,
+  // each at 5x its limit in the noise it sits in (the base model plus the
+  // other effect's random part), every other parameter drawn as for one
+  // effect. Both must come out with the right cause and parameter and
+  // nothing else on the record.
+  const int R = runs(60);
   std::mt19937_64 rng(rootSeed() + 77);
-  const std::vector<na::Cause> all = {na::Cause::WhiteNoise, na::Cause::RandomWalk, na::Cause::GaussMarkov,
-                                      na::Cause::Sinusoid,   na::Cause::LevelShift, na::Cause::Outliers};
+  const std::vector<na::Cause> all = {na::Cause::WhiteNoise, na::Cause::QuantizationNoise, na::Cause::RandomWalk,
+                                      na::Cause::Drift,      na::Cause::GaussMarkov,       na::Cause::Sinusoid,
+                                      na::Cause::LevelShift, na::Cause::Outliers};
   int both = 0;
   for (int r = 0; r < R; ++r) {
     na::Cause a = all[rng() % all.size()], b = a;
@@ -141,14 +145,15 @@ TEST(Diagnose, TwoEffectsOnOneChannel) {
     const pw::Outcome out = pw::judge(c, d);
     const bool ok = out.right[0] && out.right[1];
     both += ok;
-    if (!ok) std::cout << "  [" << na::causeName(a) << "+" << na::causeName(b) << " seed " << s << "] " << out.why << "\n";
+    std::cout << "  [" << na::causeName(a) << "+" << na::causeName(b) << " seed " << s << "] "
+              << (ok ? "right: " + c.text : out.why) << "\n";
   }
-  std::cout << "two effects on one channel: both right " << both << "/" << R << "\n";
-  // Known gap (README "Detection power"): below the issue's 90 % (17/24 at
-  // the root seed): a random walk next to a Gauss-Markov process is taken
-  // for a drift or absorbed into a longer GM, white noise next to a GM for
-  // quantisation noise.
-  EXPECT_GE(both, 0.6 * R);
+  // The issue's bar is 90 %; the estimate from R draws has a Monte Carlo
+  // standard error of about sqrt(0.9 * 0.1 / R) (3.9 points at R = 60).
+  const double rate = static_cast<double>(both) / R, se = std::sqrt(0.9 * 0.1 / R);
+  std::cout << "two effects on one channel: both right " << both << "/" << R << " (" << 100.0 * rate
+            << " %, Monte Carlo se " << 100.0 * se << " points; root seed " << rootSeed() << ")\n";
+  EXPECT_GE(rate, 0.9);
 }
 
 TEST(Diagnose, GainIsSignificantOnlyWhenTheHeldOutCriteriaImprove) {
@@ -260,3 +265,4 @@ TEST(Diagnose, IssueCasesLowFrequencyLinesAndFourteenSeLevelShifts) {
   EXPECT_EQ(lines_ok, R);
   EXPECT_GE(steps_ok, R - 1);
 }
+

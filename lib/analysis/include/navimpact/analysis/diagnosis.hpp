@@ -21,11 +21,15 @@
  *     its chi-square CI (eta_j = max(M_j / 2^j, 1), Percival & Walden 2000
  *     §8.4; lowered to the dof seen in the model's own simulations where
  *     those are fewer), Bonferroni over scales; the excess is matched against
- *     each process family (add WN, QN, RW, DR, GM with T <= record/5, or
- *     retune one term) by the chi-square (gamma) deviance on the FIRST half,
- *     chosen by AIC = deviance + 2 p; when the winner is slow (RW, DR, long
- *     GM) the slow candidates are ranked again by AIC on the exact Gaussian
- *     likelihood of ~512 block means; the runner-up is reported; a term that
+ *     every extension by one process family (add WN, QN, RW, DR, GM with
+ *     T <= record/5, or retune one term) or by two fitted jointly (every term
+ *     refitted with the others held: backfitting), by the chi-square (gamma)
+ *     deviance on the whole cleaned record, chosen by AIC = deviance + 2 p (a
+ *     pair only when it beats every one-term explanation by the 1 %
+ *     chi-square margin); when the winner is slow (RW, DR, long GM) the sets
+ *     differing only in their slow terms are ranked again by AIC on the exact
+ *     Gaussian likelihood of ~512 block means (more terms only by a nested
+ *     likelihood-ratio test at 1 %); the runner-up is reported; a term that
  *     changes the WV by less than the CI width at every scale, or has a
  *     vanishing parameter, is not a finding;
  *  5. gain: the first-half extension and the user's model are judged on the
