@@ -12,6 +12,7 @@ PKGS=(
   mrpt-apps
   libopencv-dev libopencv-contrib-dev fonts-dejavu-core
   libgtest-dev libbenchmark-dev
+  clang-14 libclang-rt-14-dev llvm-14
   slurm-wlm munge
 )
 missing=()

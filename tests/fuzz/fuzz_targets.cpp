@@ -13,7 +13,9 @@
 #include "navimpact/emulation/trajectory.hpp"
 #include "navimpact/rawlog/imu_reader.hpp"
 #include "navimpact/rawlog/writer.hpp"
+#include "navimpact/core/text_io.hpp"
 #include "navimpact/stochastic/model_file.hpp"
+#include "navimpact/stochastic/model_text.hpp"
 
 namespace navimpact::fuzz {
 
@@ -32,6 +34,22 @@ const std::vector<Target>& targets() {
          emulation::TrajectorySpec s;
          s.file = p;
          (void)emulation::readTrajectoryCsv(s);
+       }},
+      {"model_text", ".txt",
+       [](const std::string& p) {
+         // The one text form of a model: a structure spec and a model string.
+         // A model that parses must survive its own text form exactly
+         // (formatTerms with 17 digits round-trips by contract).
+         const std::string text = readFileMaybeGz(p, std::size_t(1) << 20);
+         try {
+           (void)stochastic::formatStructure(stochastic::parseStructure(text));
+         } catch (const Error&) {
+         }
+         const auto terms = stochastic::parseTerms(text, 200.0);
+         const std::string once = stochastic::formatTerms(terms, 17);
+         const std::string twice = stochastic::formatTerms(stochastic::parseTerms(once, 200.0), 17);
+         if (once != twice) throw std::logic_error("model text does not round-trip: '" + once + "' -> '" + twice + "'");
+         (void)stochastic::formatTerms(terms);
        }},
       {"model_file", ".yaml",
        [](const std::string& p) {

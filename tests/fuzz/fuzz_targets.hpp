@@ -13,7 +13,8 @@ struct Target {
   void (*read)(const std::string& path);
 };
 
-/// Every reader: IMU CSV, trajectory CSV, model file, covariance / replay /
+/// Every reader: IMU CSV, trajectory CSV, model text (structure and model
+/// strings, which must round-trip), model file, covariance / replay /
 /// emulation / study configurations, IMU rawlog and full rawlog readers.
 const std::vector<Target>& targets();
 

@@ -74,6 +74,12 @@ std::map<std::string, std::vector<std::string>> seeds(const fs::path& dir) {
   auto src = [](const std::string& rel) { return test::sourcePath(rel); };
   s["imu_csv"] = {headLines(gunzip(src("datasets/adis16405_static_excerpt.csv.gz")), 150)};
   s["trajectory_csv"] = {headLines(gunzip(src("datasets/uav_flight_260s.csv.gz")), 150)};
+  s["model_text"] = {"WN(sigma=9.788e-4) + GM(sigma=4.805e-5, T=59.22) + GM(sigma=2.209e-5, T=1.457)",
+                     "WN(sigma=5.521e-3) + GM(sigma=4.811e-4, T=3.22) + DR(omega=9.302e-10)",
+                     "QN(Q=1e-5) + RW(gamma=2e-7) + SIN(amp=1e-3, freq=12.5)",
+                     "AR1(phi=0.999, sigma2=1e-6) + WN(sigma=1e-3)",
+                     "WN+3GM+DR",
+                     "none"};
   s["model_file"] = {slurp(src("config/models/navchip_table1.yaml")), slurp(src("config/models/adis16405_fitted.yaml"))};
   s["covariance_config"] = {slurp(src("config/paper/covariance_static.yaml"))};
   s["replay_config"] = {slurp(src("config/replay/default.yaml")),
@@ -231,6 +237,7 @@ void fuzzTarget(const std::string& name) {
 
 TEST(FuzzReaders, ImuCsv) { fuzzTarget("imu_csv"); }
 TEST(FuzzReaders, TrajectoryCsv) { fuzzTarget("trajectory_csv"); }
+TEST(FuzzReaders, ModelText) { fuzzTarget("model_text"); }
 TEST(FuzzReaders, ModelFile) { fuzzTarget("model_file"); }
 TEST(FuzzReaders, CovarianceConfig) { fuzzTarget("covariance_config"); }
 TEST(FuzzReaders, ReplayConfig) { fuzzTarget("replay_config"); }

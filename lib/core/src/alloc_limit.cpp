@@ -57,9 +57,8 @@ std::size_t AllocationLimit::current() { return t_limit; }
 
 }  // namespace navimpact
 
-// Replacements of the global allocation functions (the nothrow forms of
-// libstdc++ call these; the default operator delete frees with free(), which
-// matches malloc and posix_memalign).
+// Replacements of every global allocation function (throwing, nothrow,
+// aligned) and, below, every deallocation function.
 void* operator new(std::size_t n) { return navimpact::allocate(n); }
 void* operator new[](std::size_t n) { return navimpact::allocate(n); }
 void* operator new(std::size_t n, std::align_val_t a) {
@@ -68,6 +67,53 @@ void* operator new(std::size_t n, std::align_val_t a) {
 void* operator new[](std::size_t n, std::align_val_t a) {
   return navimpact::allocateAligned(n, static_cast<std::size_t>(a));
 }
+
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  try {
+    return navimpact::allocate(n);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
+  try {
+    return navimpact::allocate(n);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  try {
+    return navimpact::allocateAligned(n, static_cast<std::size_t>(a));
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  try {
+    return navimpact::allocateAligned(n, static_cast<std::size_t>(a));
+  } catch (...) {
+    return nullptr;
+  }
+}
+
+// The matching deallocation functions free() what the functions above took
+// from malloc / posix_memalign (what libstdc++'s defaults do too; replacing
+// them with the allocation functions keeps the pair consistent for tools that
+// check it, such as AddressSanitizer's alloc-dealloc-mismatch).
+extern "C" void free(void* p);
+void operator delete(void* p) noexcept { free(p); }
+void operator delete[](void* p) noexcept { free(p); }
+void operator delete(void* p, std::size_t) noexcept { free(p); }
+void operator delete[](void* p, std::size_t) noexcept { free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { free(p); }
 
 // MRPT allocates its matrices and images through mrpt::aligned_malloc, which
 // calls aligned_alloc and uses the result unchecked (a rawlog matrix of

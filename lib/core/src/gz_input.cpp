@@ -31,8 +31,10 @@ GzInput::GzInput(std::string path) : path_(std::move(path)), z_(std::make_unique
   f_ = std::fopen(path_.c_str(), "rb");
   if (!f_) throw Error(path_ + ": cannot open (" + std::strerror(errno) + ")");
   fileSize_ = S_ISREG(st.st_mode) ? static_cast<std::uint64_t>(st.st_size) : 0;
-  in_.resize(kChunk);
-  out_.resize(kChunk);
+  // buffers of at most one chunk, no larger than a small file needs (+1 byte
+  // so that a full read also tells the end of the file)
+  const std::size_t first = fileSize_ > 0 && fileSize_ < kChunk ? static_cast<std::size_t>(fileSize_) + 1 : kChunk;
+  in_.resize(first);
   inEnd_ = std::fread(in_.data(), 1, in_.size(), f_);
   inEof_ = inEnd_ < in_.size();
   gzip_ = inEnd_ >= 2 && in_[0] == 0x1f && in_[1] == 0x8b;
@@ -46,10 +48,11 @@ GzInput::GzInput(std::string path) : path_(std::move(path)), z_(std::make_unique
         statedSize_ = std::max(std::min(isize, std::uint64_t(1032) * fileSize_), fileSize_);
       }
     }
+    out_.resize(statedSize_ > 0 ? static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, statedSize_ + 1)) : kChunk);
     if (inflateInit2(&z_->s, 15 + 16) != Z_OK) throw Error(path_ + ": cannot start gzip decompression");
     z_->init = true;
   } else {  // the bytes read to sniff the format are the first data
-    std::swap(in_, out_);
+    std::swap(in_, out_);  // (in_ is not used again)
     outEnd_ = inEnd_;
     inHead_ = inEnd_ = 0;
   }
@@ -147,7 +150,8 @@ int GzInput::peek() {
 }
 
 LineReader::LineReader(const std::string& path, std::size_t max_line) : in_(path), maxLine_(max_line) {
-  buf_.resize(std::size_t(1) << 20);
+  const std::uint64_t n = in_.statedSize();  // 0: not known (not a regular file)
+  buf_.resize(n > 0 ? static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, n + 1)) : kChunk);
 }
 
 bool LineReader::next(std::string_view& line) {
