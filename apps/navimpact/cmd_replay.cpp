@@ -65,8 +65,10 @@ navimpact::cli::Registrar reg({
         if (!o->outages_every.empty()) cfg.outages_every = navimpact::parseOutagePattern(o->outages_every);
         if (o->propagate_every > 0) cfg.propagate_every = o->propagate_every;
         if (o->max_imu_gap_s >= 0.0) cfg.max_imu_gap_s = o->max_imu_gap_s;
-        const auto r = navimpact::analysis::runReplay(cfg);
-        navimpact::report::writeReplayOutputs(r, out);
+        // read, filtered and written as it goes (bounded memory, see ReplayWriter)
+        navimpact::report::ReplayWriter writer(&out);
+        const auto r = navimpact::analysis::runReplay(cfg, writer);
+        writer.finish(r);
         out.commit();
         std::fputs(navimpact::report::replaySummary(r).c_str(), stdout);
         // what the folder holds now (the per-outage figures counted, not listed)

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <random>
+#include <sstream>
 
 #include "navimpact/analysis/replay.hpp"
 #include "navimpact/core/error.hpp"
@@ -321,5 +322,54 @@ TEST(Replay, ExtraStatesFromTheConfigurationAreEstimated) {
     EXPECT_NE(std::string(err.what()).find("key 'filter.extra_states.lever_arm.sigma_m': must be in (0, 10] m"),
               std::string::npos)
         << err.what();
+  }
+}
+
+// The replay that keeps nothing per epoch (an observer writes as it goes)
+// gives the same solution.csv and summary.json as the one that keeps every
+// epoch, and the outages every PERIOD:DURATION it decides one by one while
+// reading are those laid over the whole data (outagesEvery from the filter
+// start to the last IMU sample). Pattern drawn at random (seed printed), with
+// and without a reference (aligning phase), with an explicit outage besides.
+TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) {
+  const auto dir = navimpact::test::tempDir();
+  navimpact::Recording rec = emulate60("model");
+  const auto withGt = (dir / "gt.rawlog").string();
+  navimpact::rawlog::writeRawlog(withGt, rec);
+  rec.reference.clear();
+  const auto noGt = (dir / "nogt.rawlog").string();
+  navimpact::rawlog::writeRawlog(noGt, rec);
+  const std::uint64_t seed = std::random_device{}();
+  std::mt19937_64 rng(seed);
+  for (int draw = 0; draw < 3; ++draw) {
+    const double period = std::uniform_real_distribution<double>(4.0, 30.0)(rng);
+    const double duration = std::uniform_real_distribution<double>(0.5, period - 0.5)(rng);
+    const double explicitStart = std::uniform_real_distribution<double>(0.0, 40.0)(rng);
+    std::printf("seed %llu draw %d: outages every %.4f:%.4f s, explicit outage %.4f:5 s\n",
+                static_cast<unsigned long long>(seed), draw, period, duration, explicitStart);
+    for (const auto& path : {withGt, noGt}) {
+      SCOPED_TRACE(path + " seed " + std::to_string(seed) + " draw " + std::to_string(draw));
+      an::ReplayConfig c;
+      c.rawlog = path;
+      c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
+      c.outages.push_back(navimpact::Outage::fromStartDuration(explicitStart, 5.0));
+      c.outages_every = navimpact::OutagePattern{period, duration};
+      const an::ReplayResult whole = an::runReplay(c);
+      std::ostringstream csv;
+      navimpact::report::ReplayWriter writer(csv);
+      const an::ReplayResult streamed = an::runReplay(c, writer);
+      EXPECT_TRUE(streamed.run.epochs.empty());
+      EXPECT_EQ(csv.str(), navimpact::report::solutionCsv(whole));
+      EXPECT_EQ(writer.summary(streamed), navimpact::report::summaryJson(whole));
+      // the windows over the whole data, from the filter start
+      const double x0 = whole.t_zero + whole.aided_from_s;
+      const double t_last = navimpact::rawlog::readRawlog(path).imu.back().t;
+      const auto expected = navimpact::outagesEvery(c.outages_every.value(), x0, t_last);
+      ASSERT_EQ(streamed.run.outages.size(), 1 + expected.size());
+      for (std::size_t k = 0; k < expected.size(); ++k) {
+        EXPECT_EQ(streamed.run.outages[1 + k].window.start_s, expected[k].start_s);
+        EXPECT_EQ(streamed.run.outages[1 + k].window.end_s, expected[k].end_s);
+      }
+    }
   }
 }

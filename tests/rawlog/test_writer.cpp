@@ -11,6 +11,7 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/rawlog/reader.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "test_support.hpp"
 
@@ -292,4 +293,60 @@ TEST(RawlogWriter, LegacyGroundTruthAsImuObservationReads) {
   ASSERT_EQ(b.reference.size(), 2601u);
   EXPECT_TRUE(b.reference.front().v_N && b.reference.front().q_BtoN);
   EXPECT_EQ(b.imu.size(), 52000u);
+}
+
+// The record-by-record reader returns what readRawlog collects, record for
+// record, in time order (a GT with its velocity entry as one record), for the
+// pose-observation reference, the legacy one and a foreign rawlog.
+TEST(RawlogReader, ReturnsTheRecordsOfReadRawlogInTimeOrder) {
+  const auto dir = navimpact::test::tempDir();
+  const std::string p = (dir / "sample.rawlog").string();
+  navimpact::rawlog::writeRawlog(p, sample());
+  for (const std::string& path : {p, navimpact::test::sourcePath("datasets/uav_flight_260s_ref.rawlog"),
+                                  navimpact::test::dataPath("imu_label_xsens.rawlog")}) {
+    SCOPED_TRACE(path);
+    const Recording whole = navimpact::rawlog::readRawlog(path);
+    navimpact::rawlog::RawlogReader reader(path);
+    Recording d = reader.header();
+    navimpact::rawlog::RawlogRecord r;
+    double last = -1e300;
+    std::size_t n = 0;
+    while (reader.next(r)) {
+      ++n;
+      EXPECT_GE(r.t, last);
+      last = r.t;
+      using K = navimpact::rawlog::RawlogRecord::Kind;
+      if (r.kind == K::Imu) d.imu.push_back(r.imu);
+      if (r.kind == K::Gnss) d.gnss.push_back(r.gnss);
+      if (r.kind == K::Baro) d.baro.push_back(r.baro);
+      if (r.kind == K::Reference) d.reference.push_back(r.reference);
+    }
+    EXPECT_EQ(n, whole.imu.size() + whole.gnss.size() + whole.baro.size() + whole.reference.size());
+    EXPECT_GT(whole.imu.size(), 50u);
+    EXPECT_EQ(reader.header().notices, whole.notices);
+    EXPECT_EQ(reader.header().origin.lat, whole.origin.lat);
+    EXPECT_EQ(reader.header().start_unix_s, whole.start_unix_s);
+    EXPECT_EQ(reader.header().t_start_s, whole.t_start_s);
+    ASSERT_EQ(d.imu.size(), whole.imu.size());
+    for (std::size_t i = 0; i < d.imu.size(); ++i) {
+      EXPECT_EQ(d.imu[i].t, whole.imu[i].t);
+      EXPECT_EQ(d.imu[i].w_IB_B, whole.imu[i].w_IB_B);
+      EXPECT_EQ(d.imu[i].f_B, whole.imu[i].f_B);
+    }
+    ASSERT_EQ(d.gnss.size(), whole.gnss.size());
+    for (std::size_t i = 0; i < d.gnss.size(); ++i) {
+      EXPECT_EQ(d.gnss[i].t, whole.gnss[i].t);
+      EXPECT_EQ(d.gnss[i].pos.lat, whole.gnss[i].pos.lat);
+      EXPECT_EQ(d.gnss[i].v_N.has_value(), whole.gnss[i].v_N.has_value());
+    }
+    ASSERT_EQ(d.baro.size(), whole.baro.size());
+    for (std::size_t i = 0; i < d.baro.size(); ++i) EXPECT_EQ(d.baro[i].h, whole.baro[i].h);
+    ASSERT_EQ(d.reference.size(), whole.reference.size());
+    for (std::size_t i = 0; i < d.reference.size(); ++i) {
+      EXPECT_EQ(d.reference[i].t, whole.reference[i].t);
+      EXPECT_EQ(d.reference[i].p_L, whole.reference[i].p_L);
+      ASSERT_EQ(d.reference[i].v_N.has_value(), whole.reference[i].v_N.has_value());
+      if (d.reference[i].v_N) EXPECT_EQ(*d.reference[i].v_N, *whole.reference[i].v_N);
+    }
+  }
 }

@@ -3,6 +3,7 @@
 
 #include <Eigen/Cholesky>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -35,45 +36,43 @@ std::array<double, 4> navNees(const filter::Vector9d& err, const filter::Matrix9
   return out;
 }
 
-NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
-                    const NavRunOptions& opt) {
-  if (!in.imu || in.imu->empty()) throw Error("navigation run: no IMU samples");
-  const TruthSeries noTruth;
-  const bool hasTruth = in.truth != nullptr;
-  if (!hasTruth && !(opt.record_interval_s > 0.0 && std::isfinite(opt.record_interval_s)))
-    throw Error("navigation run: record interval must be > 0 s without truth, got " + formatNumber(opt.record_interval_s, 10));
-  const auto& imu = *in.imu;
-  const auto& truth = hasTruth ? *in.truth : noTruth;
-  if (truth.t.size() != truth.x.size())
-    throw Error("navigation run: truth series has " + std::to_string(truth.t.size()) + " times but " +
-                std::to_string(truth.x.size()) + " states");
-  for (const auto& o : opt.outages)
-    if (!(o.end_s > o.start_s))
-      throw Error("navigation run: outage (" + formatNumber(o.start_s, 10) + ", " + formatNumber(o.end_s, 10) + "] is empty");
+struct NavRunner::Impl {
+  Impl(const ins::NavState& x0_, double dt0_, bool hasTruth_, const stochastic::ImuModel& model,
+       const NavRunOptions& opt_)
+      : x0(x0_), dt0(dt0_), hasTruth(hasTruth_), opt(opt_), t_start(std::chrono::steady_clock::now()),
+        ekf(x0_, opt_.P0_nav, model, opt_.ekf) {}
 
-  const auto t_start = std::chrono::steady_clock::now();
-  filter::ErrorStateEkf ekf(in.x0, opt.P0_nav, model, opt.ekf);
+  ins::NavState x0;
+  double dt0;
+  bool hasTruth;
+  NavRunOptions opt;  // its outages grow with addOutage
+  std::chrono::steady_clock::time_point t_start;
+  filter::ErrorStateEkf ekf;
   NavRunResult res;
-  res.has_truth = hasTruth;
-  res.states = ekf.size();
-  res.outages.resize(opt.outages.size());
-  for (std::size_t i = 0; i < opt.outages.size(); ++i) res.outages[i].window = opt.outages[i];
+  std::deque<GnssFix> gnss;
+  std::deque<BaroSample> baro;
+  std::deque<std::pair<double, ins::NavState>> truth;
+  std::vector<std::size_t> live;  // outages that may still contain an epoch
+  std::optional<filter::StaticDetector> detector;
+  double next_zupt = -1e300, next_nhc = -1e300;
+  double next_record = 0.0;  // without truth
+  double t_prev = 0.0;
+  std::size_t epochs = 0;
+  bool started = false;
+  std::function<void(const NavEpoch&, const ins::NavState*)>* on_epoch = nullptr;
+  bool* keep_epochs = nullptr;
 
-  std::size_t ig = 0, ib = 0, it = 0;
-  const std::size_t ng = in.gnss ? in.gnss->size() : 0, nb = in.baro ? in.baro->size() : 0;
-  const double dt0 = imu.front().dt;
-  // Truth epochs before the first sample end that are not at x0.t are skipped.
-  while (it < truth.t.size() && truth.t[it] < in.x0.t - 0.5 * dt0) ++it;
-
-  auto check = [&](const filter::UpdateResult& u, const char* kind) {
+  bool check(const filter::UpdateResult& u, const char* kind) {
     if (!u.accepted) res.rejected.push_back({u.t, kind, u.nis, u.gate, 1.0});
     if (u.readmitted) res.readmitted.push_back({u.t, kind, u.nis, u.gate, u.inflation});
     return u.accepted;
-  };
-  auto applyAiding = [&](double t_now, double half_dt) {
-    while (ig < ng && (*in.gnss)[ig].t <= t_now + half_dt) {
-      const GnssFix& f = (*in.gnss)[ig++];
-      if (f.t < in.x0.t - half_dt) continue;  // before the run
+  }
+
+  void applyAiding(double t_now, double half_dt) {
+    while (!gnss.empty() && gnss.front().t <= t_now + half_dt) {
+      const GnssFix f = std::move(gnss.front());
+      gnss.pop_front();
+      if (f.t < x0.t - half_dt) continue;  // before the run
       if (inOutage(f.t, opt.outages)) continue;
       if (!f.cov_pos_N) throw Error("navigation run: GNSS fix at " + formatNumber(f.t, 10) + " s has no position covariance");
       // the fix's own epoch relative to the filter time (0 when on a sample)
@@ -90,26 +89,18 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       }
       if (used) ++res.gnss_updates;
     }
-    while (ib < nb && (*in.baro)[ib].t <= t_now + half_dt) {
-      const BaroSample& b = (*in.baro)[ib++];
-      if (b.t < in.x0.t - half_dt) continue;
+    while (!baro.empty() && baro.front().t <= t_now + half_dt) {
+      const BaroSample b = baro.front();
+      baro.pop_front();
+      if (b.t < x0.t - half_dt) continue;
       if (!opt.baro_in_outage && inOutage(b.t, opt.outages)) continue;
       if (!b.sigma_m) throw Error("navigation run: baro sample at " + formatNumber(b.t, 10) + " s has no sigma");
       if (check(ekf.updateBaro(b.h, *b.sigma_m), "baro")) ++res.baro_updates;
     }
-  };
-  // ground-vehicle aids (off by default)
-  std::optional<filter::StaticDetector> detector;
-  if (opt.zupt) {
-    if (!(opt.zupt_sigma_mps > 0.0) || !(opt.zupt_interval_s > 0.0))
-      throw Error("navigation run: ZUPT sigma and interval must be > 0");
-    detector.emplace(opt.zupt_detector, 1.0 / imu.front().dt);
   }
-  if (opt.nhc && (!(opt.nhc_sigma_lateral_mps > 0.0) || !(opt.nhc_sigma_vertical_mps > 0.0) ||
-                  !(opt.nhc_interval_s > 0.0) || !(opt.nhc_min_speed_mps >= 0.0)))
-    throw Error("navigation run: non-holonomic sigmas and interval must be > 0, minimum speed >= 0");
-  double next_zupt = -1e300, next_nhc = -1e300;
-  auto applyAids = [&](const ins::ImuSample& s) {
+
+  // ground-vehicle aids (off by default)
+  void applyAids(const ins::ImuSample& s) {
     if (detector && detector->push(s) && s.t >= next_zupt) {
       next_zupt = s.t + opt.zupt_interval_s - 0.5 * s.dt;
       if (check(ekf.updateZeroVelocity(opt.zupt_sigma_mps), "zupt")) ++res.zupt_updates;
@@ -120,10 +111,32 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
                 "nhc"))
         ++res.nhc_updates;
     }
-  };
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  double next_record = in.x0.t;  // without truth
-  auto record = [&](double t_now, double half_dt) {
+  }
+
+  // One recorded epoch: the outages containing it, the observer, the kept series.
+  void emit(NavEpoch&& e, const ins::NavState* x) {
+    const std::size_t k = epochs++;
+    for (std::size_t j = 0; j < live.size();) {
+      OutageSummary& o = res.outages[live[j]];
+      if (e.t > o.window.end_s + 1e-9) {  // epochs only move on: this outage is over
+        live.erase(live.begin() + static_cast<std::ptrdiff_t>(j));
+        continue;
+      }
+      ++j;
+      if (e.t <= o.window.start_s) continue;
+      o.end_epoch = static_cast<int>(k);
+      o.end = e;
+      if (!hasTruth) continue;
+      o.max_drift_h = std::max(o.max_drift_h, e.err.head<2>().norm());
+      o.max_drift_v = std::max(o.max_drift_v, std::abs(e.err[2]));
+      o.max_drift_3d = std::max(o.max_drift_3d, e.err.head<3>().norm());
+    }
+    if (*on_epoch) (*on_epoch)(e, x);
+    if (*keep_epochs) res.epochs.push_back(std::move(e));
+  }
+
+  void record(double t_now, double half_dt) {
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     if (!hasTruth) {
       if (t_now + half_dt < next_record) return;
       while (next_record <= t_now + half_dt) next_record += opt.record_interval_s;
@@ -136,63 +149,136 @@ NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
       e.P_pos = P9.topLeftCorner<3, 3>();
       e.nees.fill(kNaN);
-      res.epochs.push_back(e);
+      emit(std::move(e), nullptr);
       return;
     }
-    while (it < truth.t.size() && truth.t[it] <= t_now + half_dt) {
+    while (!truth.empty() && truth.front().first <= t_now + half_dt) {
+      const double tt = truth.front().first;
+      const ins::NavState& xt = truth.front().second;
       // nearest sample; an epoch exactly between two samples may land on either
-      if (std::abs(truth.t[it] - t_now) > half_dt * (1.0 + 1e-6) + 1e-9)
-        throw Error("navigation run: truth epoch " + formatNumber(truth.t[it], 10) +
+      if (std::abs(tt - t_now) > half_dt * (1.0 + 1e-6) + 1e-9)
+        throw Error("navigation run: truth epoch " + formatNumber(tt, 10) +
                     " s does not fall on an IMU sample (nearest " + formatNumber(t_now, 10) + " s)");
       ekf.flushPropagation();
       NavEpoch e;
-      e.t = truth.t[it];
+      e.t = tt;
       e.est = ekf.state();
-      e.err = filter::navError(ekf.state(), truth.x[it]);
+      e.err = filter::navError(ekf.state(), xt);
       if (opt.reference_lever_B.squaredNorm() > 0.0) e.err.head<3>() += ekf.state().C_BtoN() * opt.reference_lever_B;
       const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
       e.P_pos = P9.topLeftCorner<3, 3>();
       e.nees = navNees(e.err, P9);
-      res.epochs.push_back(e);
-      ++it;
-    }
-  };
-
-  applyAiding(in.x0.t, 0.5 * dt0);
-  record(in.x0.t, 0.5 * dt0);
-  double t_prev = in.x0.t;
-  for (const ins::ImuSample& s : imu) {
-    if (!(s.dt > 0.0) || std::abs(s.t - s.dt - t_prev) > 1e-6 * (1.0 + std::abs(t_prev)))
-      throw Error("navigation run: IMU sample at " + formatNumber(s.t, 10) + " s (dt " + formatNumber(s.dt, 10) +
-                  " s) does not follow the previous one at " + formatNumber(t_prev, 10) + " s");
-    ekf.predict(s);
-    ++res.steps;
-    applyAids(s);
-    applyAiding(s.t, 0.5 * s.dt);
-    record(s.t, 0.5 * s.dt);
-    t_prev = s.t;
-  }
-  res.rejections = ekf.rejections();
-
-  // Outage summaries from the recorded epochs.
-  for (auto& o : res.outages) {
-    for (std::size_t k = 0; k < res.epochs.size(); ++k) {
-      const NavEpoch& e = res.epochs[k];
-      if (e.t <= o.window.start_s || e.t > o.window.end_s + 1e-9) continue;
-      o.end_epoch = static_cast<int>(k);
-      if (!hasTruth) continue;
-      o.max_drift_h = std::max(o.max_drift_h, e.err.head<2>().norm());
-      o.max_drift_3d = std::max(o.max_drift_3d, e.err.head<3>().norm());
+      emit(std::move(e), &xt);
+      truth.pop_front();
     }
   }
-  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  if (ekf.layout().hasExtra()) {
-    ekf.flushPropagation();
-    res.extra_estimates = ekf.extraEstimates();
-    res.extra_sigmas = ekf.extraSigmas();
+};
+
+NavRunner::NavRunner(const ins::NavState& x0, double dt0, bool has_truth, const stochastic::ImuModel& model,
+                     const NavRunOptions& opt) {
+  if (!has_truth && !(opt.record_interval_s > 0.0 && std::isfinite(opt.record_interval_s)))
+    throw Error("navigation run: record interval must be > 0 s without truth, got " + formatNumber(opt.record_interval_s, 10));
+  for (const auto& o : opt.outages)
+    if (!(o.end_s > o.start_s))
+      throw Error("navigation run: outage (" + formatNumber(o.start_s, 10) + ", " + formatNumber(o.end_s, 10) + "] is empty");
+  if (!(dt0 > 0.0)) throw Error("navigation run: the first IMU interval must be > 0 s, got " + formatNumber(dt0, 10));
+  impl_ = std::make_unique<Impl>(x0, dt0, has_truth, model, opt);
+  Impl& m = *impl_;
+  m.on_epoch = &on_epoch;
+  m.keep_epochs = &keep_epochs;
+  m.res.has_truth = has_truth;
+  m.res.states = m.ekf.size();
+  m.res.outages.resize(opt.outages.size());
+  for (std::size_t i = 0; i < opt.outages.size(); ++i) {
+    m.res.outages[i].window = opt.outages[i];
+    m.live.push_back(i);
   }
-  return res;
+  if (opt.zupt) {
+    if (!(opt.zupt_sigma_mps > 0.0) || !(opt.zupt_interval_s > 0.0))
+      throw Error("navigation run: ZUPT sigma and interval must be > 0");
+    m.detector.emplace(opt.zupt_detector, 1.0 / dt0);
+  }
+  if (opt.nhc && (!(opt.nhc_sigma_lateral_mps > 0.0) || !(opt.nhc_sigma_vertical_mps > 0.0) ||
+                  !(opt.nhc_interval_s > 0.0) || !(opt.nhc_min_speed_mps >= 0.0)))
+    throw Error("navigation run: non-holonomic sigmas and interval must be > 0, minimum speed >= 0");
+  m.next_record = x0.t;
+  m.t_prev = x0.t;
+}
+
+NavRunner::~NavRunner() = default;
+
+void NavRunner::addGnss(const GnssFix& f) { impl_->gnss.push_back(f); }
+void NavRunner::addBaro(const BaroSample& b) { impl_->baro.push_back(b); }
+void NavRunner::addTruth(double t, const ins::NavState& x) {
+  Impl& m = *impl_;
+  // truth epochs before the first sample end that are not at x0.t are skipped
+  if (!m.started && t < m.x0.t - 0.5 * m.dt0) return;
+  m.truth.emplace_back(t, x);
+}
+void NavRunner::addOutage(const Outage& o) {
+  Impl& m = *impl_;
+  if (!(o.end_s > o.start_s))
+    throw Error("navigation run: outage (" + formatNumber(o.start_s, 10) + ", " + formatNumber(o.end_s, 10) + "] is empty");
+  m.opt.outages.push_back(o);
+  m.res.outages.emplace_back();
+  m.res.outages.back().window = o;
+  m.live.push_back(m.res.outages.size() - 1);
+}
+const std::vector<Outage>& NavRunner::outages() const { return impl_->opt.outages; }
+std::size_t NavRunner::epochCount() const { return impl_->epochs; }
+
+void NavRunner::start() {
+  Impl& m = *impl_;
+  if (m.started) throw Error("navigation run: started twice");
+  m.started = true;
+  while (!m.truth.empty() && m.truth.front().first < m.x0.t - 0.5 * m.dt0) m.truth.pop_front();
+  m.applyAiding(m.x0.t, 0.5 * m.dt0);
+  m.record(m.x0.t, 0.5 * m.dt0);
+}
+
+void NavRunner::step(const ins::ImuSample& s) {
+  Impl& m = *impl_;
+  if (!(s.dt > 0.0) || std::abs(s.t - s.dt - m.t_prev) > 1e-6 * (1.0 + std::abs(m.t_prev)))
+    throw Error("navigation run: IMU sample at " + formatNumber(s.t, 10) + " s (dt " + formatNumber(s.dt, 10) +
+                " s) does not follow the previous one at " + formatNumber(m.t_prev, 10) + " s");
+  m.ekf.predict(s);
+  ++m.res.steps;
+  m.applyAids(s);
+  m.applyAiding(s.t, 0.5 * s.dt);
+  m.record(s.t, 0.5 * s.dt);
+  m.t_prev = s.t;
+}
+
+NavRunResult NavRunner::finish() {
+  Impl& m = *impl_;
+  m.res.rejections = m.ekf.rejections();
+  m.res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - m.t_start).count();
+  if (m.ekf.layout().hasExtra()) {
+    m.ekf.flushPropagation();
+    m.res.extra_estimates = m.ekf.extraEstimates();
+    m.res.extra_sigmas = m.ekf.extraSigmas();
+  }
+  return std::move(m.res);
+}
+
+NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
+                    const NavRunOptions& opt) {
+  if (!in.imu || in.imu->empty()) throw Error("navigation run: no IMU samples");
+  const auto& imu = *in.imu;
+  if (in.truth && in.truth->t.size() != in.truth->x.size())
+    throw Error("navigation run: truth series has " + std::to_string(in.truth->t.size()) + " times but " +
+                std::to_string(in.truth->x.size()) + " states");
+  NavRunner run(in.x0, imu.front().dt, in.truth != nullptr, model, opt);
+  if (in.gnss)
+    for (const auto& f : *in.gnss) run.addGnss(f);
+  if (in.baro)
+    for (const auto& b : *in.baro) run.addBaro(b);
+  if (in.truth)
+    for (std::size_t i = 0; i < in.truth->t.size(); ++i) run.addTruth(in.truth->t[i], in.truth->x[i]);
+  run.start();
+  for (const ins::ImuSample& s : imu) run.step(s);
+  return run.finish();
 }
 
 NavRunInput EmulatedRun::input(const TruthSeries& truth) const {

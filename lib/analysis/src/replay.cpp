@@ -5,8 +5,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include <cmath>
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <optional>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -22,7 +26,7 @@
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/filter/model_entry.hpp"
-#include "navimpact/rawlog/writer.hpp"
+#include "navimpact/rawlog/reader.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/core/limits.hpp"
 
@@ -173,20 +177,292 @@ void ReplayConfig::loadFrom(const ConfigNode& root) {
 }
 
 
-ReplayResult runReplay(const ReplayConfig& cfg) {
-  if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
-  const std::clock_t c0 = std::clock();
-  Recording d = rawlog::readRawlog(cfg.rawlog, {cfg.imu_label, cfg.gnss_label});
-  ReplayResult r;
-  r.read_s = double(std::clock() - c0) / CLOCKS_PER_SEC;
-  r.cfg = cfg;
-  r.scenario_yaml = d.metadata;
-  r.notices = d.notices;
-  if (d.imu.size() < 2) throw Error(cfg.rawlog + ": no IMU data (label IMU) to replay");
+namespace {
 
-  YAML::Node scen;
+/// A replay read record by record: the rawlog, the records read ahead of the
+/// filter, the IMU samples (gaps filled when allowed), and the runner once it
+/// exists (then records go straight to it).
+class ReplayDriver {
+ public:
+  ReplayDriver(const ReplayConfig& cfg, ReplayResult& r, ReplayObserver* obs)
+      : cfg_(cfg), r_(r), obs_(obs), reader_(cfg.rawlog, {cfg.imu_label, cfg.gnss_label}) {}
+
+  void run();
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  const ReplayConfig& cfg_;
+  ReplayResult& r_;
+  ReplayObserver* obs_;
+  rawlog::RawlogReader reader_;
+  YAML::Node scen_;
+
+  // records read ahead (before the runner exists)
+  std::deque<ImuRecord> imuQ_;
+  std::deque<GnssFix> gnssQ_;
+  std::deque<BaroSample> baroQ_;
+  std::deque<ReferenceRecord> refQ_;
+  bool eof_ = false;
+  bool setup_ = false;       // noise, time zero and the reference decided: records are taken as they come
+  double readT_ = -1e300;    // time of the last record read
+  double lastImuT_ = -1e300; // time of the last IMU record read (the data's end once eof_)
+  std::size_t imuRecords_ = 0;
+  double readS_ = 0.0;
+
+  // IMU samples
+  double med_ = 0.0, dt_ = 0.0;
+  double prevT_ = 0.0;               // time of the last IMU record turned into samples
+  std::size_t produced_ = 0;         // samples produced (gap fillers included)
+  std::deque<ins::ImuSample> samples_;
+  std::size_t gaps_ = 0;
+  double longest_ = 0.0, longestAt_ = 0.0;
+  bool firstRecord_ = true;
+
+  // measurements
+  double sBaro_ = NAN;
+  bool hasTruth_ = false, refSigmaFromData_ = true;
+  ReferenceInfo refInfo_;
+  std::size_t truthInside_ = 0, ignoredRef_ = 0;
+  struct RefFlags {
+    double t;
+    bool v, q;
+    std::optional<Eigen::Vector3d> sigma;
+  };
+  std::deque<RefFlags> refTail_;  // reference entries after the last IMU record read (inside the data or not)
+  earth::Geodetic origin_;
+
+  // the filter
+  NavRunOptions opt_;
+  std::optional<NavRunner> runner_;
+  std::optional<RunScorer> scorer_;
+  std::vector<ins::NavState> truthKept_;
+  TruthSeries truthAhead_;  // reference states read before the filter starts
+
+  // outages every PERIOD:DURATION, decided one by one
+  bool windowsOpen_ = false;
+  long nextWindow_ = 0;
+  double aidedFrom_ = 0.0;
+
+  static std::string g10(double v) {  // 10 significant digits
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.10g", v);
+    return std::string(buf);
+  }
+
+  bool readOne();
+  void fillTo(double t) {
+    while (!eof_ && readT_ <= t) readOne();
+  }
+  bool nextSample(ins::ImuSample& s);
+  bool peekSample();
+  void takeGnss(GnssFix f);
+  void takeBaro(BaroSample b);
+  void takeReference(const ReferenceRecord& g);
+  void foldRefFlags(const RefFlags& f);
+  void decideWindows(double t_now);
+};
+
+void ReplayDriver::foldRefFlags(const RefFlags& f) {
+  refInfo_.has_velocity = refInfo_.has_velocity && f.v;
+  refInfo_.has_attitude = refInfo_.has_attitude && f.q;
+  if (refSigmaFromData_ && f.sigma) {  // the reference's own sigma as recorded (largest seen)
+    refInfo_.sigma_h_m = std::max(refInfo_.sigma_h_m, f.sigma->head<2>().maxCoeff());
+    refInfo_.sigma_v_m = std::max(refInfo_.sigma_v_m, (*f.sigma)[2]);
+  }
+  ++truthInside_;
+}
+
+// Read one record and hand it on: to the runner once it exists, else to the queues.
+bool ReplayDriver::readOne() {
+  rawlog::RawlogRecord rec;
+  const auto c0 = Clock::now();
+  const bool got = reader_.next(rec);
+  readS_ += std::chrono::duration<double>(Clock::now() - c0).count();
+  if (!got) {
+    eof_ = true;
+    refTail_.clear();  // reference entries after the data's end count for nothing
+    return false;
+  }
+  readT_ = rec.t;
+  switch (rec.kind) {
+    case rawlog::RawlogRecord::Kind::Imu:
+      ++imuRecords_;
+      lastImuT_ = rec.t;
+      while (!refTail_.empty() && refTail_.front().t <= lastImuT_ + 0.5 * dt_) {
+        foldRefFlags(refTail_.front());
+        refTail_.pop_front();
+      }
+      imuQ_.push_back(rec.imu);
+      break;
+    case rawlog::RawlogRecord::Kind::Gnss:
+      if (setup_) takeGnss(std::move(rec.gnss));
+      else gnssQ_.push_back(std::move(rec.gnss));
+      break;
+    case rawlog::RawlogRecord::Kind::Baro:
+      if (setup_) takeBaro(rec.baro);
+      else baroQ_.push_back(rec.baro);
+      break;
+    case rawlog::RawlogRecord::Kind::Reference:
+      if (setup_) takeReference(rec.reference);
+      else refQ_.push_back(rec.reference);
+      break;
+  }
+  return true;
+}
+
+// Measurement noise: overridden by the configuration, else recorded with the
+// sample, else (baro) the scenario's.
+void ReplayDriver::takeGnss(GnssFix f) {
+  const Eigen::Vector3d kNaN3 = Eigen::Vector3d::Constant(NAN);
+  Eigen::Vector3d sp = f.cov_pos_N ? Eigen::Vector3d(f.cov_pos_N->diagonal().cwiseSqrt()) : kNaN3;
+  Eigen::Vector3d sv = f.cov_vel_N ? Eigen::Vector3d(f.cov_vel_N->diagonal().cwiseSqrt()) : kNaN3;
+  if (cfg_.sigma_pos_h_m) sp.head<2>().setConstant(*cfg_.sigma_pos_h_m);
+  if (cfg_.sigma_pos_v_m) sp[2] = *cfg_.sigma_pos_v_m;
+  if (cfg_.sigma_vel_h_mps) sv.head<2>().setConstant(*cfg_.sigma_vel_h_mps);
+  if (cfg_.sigma_vel_v_mps) sv[2] = *cfg_.sigma_vel_v_mps;
+  if (!sp.allFinite() || (f.v_N && !sv.allFinite()))
+    throw Error(cfg_.rawlog + ": GNSS fix at t = " + formatNumber(f.t, 10) + " s has no covariance: set the noise.* sigmas");
+  f.cov_pos_N = Eigen::Matrix3d(sp.cwiseAbs2().asDiagonal());
+  if (sv.allFinite()) f.cov_vel_N = Eigen::Matrix3d(sv.cwiseAbs2().asDiagonal());
+  if (runner_) {
+    if (!obs_) r_.gnss.push_back(f);
+    runner_->addGnss(f);
+  } else {
+    gnssQ_.push_back(std::move(f));
+  }
+}
+
+void ReplayDriver::takeBaro(BaroSample b) {
+  if (cfg_.sigma_baro_m) b.sigma_m = *cfg_.sigma_baro_m;
+  else if (!b.sigma_m) b.sigma_m = sBaro_;
+  if (!std::isfinite(*b.sigma_m))
+    throw Error(cfg_.rawlog + ": barometer sigma not recorded in the scenario: set noise.sigma_baro_m");
+  if (!obs_) r_.baro.push_back(b);
+  if (runner_) runner_->addBaro(b);
+  else baroQ_.push_back(b);
+}
+
+// Reference entries (GT: tangent-plane NED at the origin -> geodetic) inside
+// the IMU data; each counts for the reference's content and own sigma.
+void ReplayDriver::takeReference(const ReferenceRecord& g) {
+  if (!hasTruth_) {
+    if (cfg_.use_reference) ++ignoredRef_;
+    return;
+  }
+  if (g.t < r_.t_zero - 0.5 * dt_) return;
+  RefFlags fl{g.t, g.v_N.has_value(), g.q_BtoN.has_value(), g.sigma_p_L};
+  if (g.t <= lastImuT_ + 0.5 * dt_) foldRefFlags(fl);
+  else refTail_.push_back(fl);
+  ins::NavState x;
+  x.t = g.t;
+  const earth::Geodetic p = earth::nedToGeodetic(origin_, g.p_L);
+  x.lat = p.lat;
+  x.lon = p.lon;
+  x.h = p.h;
+  x.v_N = g.v_N ? *g.v_N : Eigen::Vector3d::Constant(NAN);
+  x.q_BtoN = g.q_BtoN ? g.q_BtoN->normalized() : Eigen::Quaterniond(NAN, NAN, NAN, NAN);
+  if (runner_) {
+    runner_->addTruth(g.t, x);
+  } else {
+    truthAhead_.t.push_back(g.t);
+    truthAhead_.x.push_back(x);
+  }
+}
+
+// The next IMU sample: IMU records in order, an interval longer than
+// kImuGapSteps nominal steps is a gap: an error unless the configuration
+// allows gaps up to max_imu_gap_s, then the filter propagates across it in
+// nominal-length sub-steps with the rates of the sample after the gap held
+// constant, and the outputs say so.
+bool ReplayDriver::nextSample(ins::ImuSample& s) {
+  while (samples_.empty()) {
+    while (imuQ_.empty() && !eof_) readOne();
+    if (imuQ_.empty()) return false;
+    const ImuRecord rec = imuQ_.front();
+    imuQ_.pop_front();
+    const double h = rec.t - prevT_;
+    if (!firstRecord_ && h > kImuGapSteps * med_) {
+      if (!(h <= cfg_.max_imu_gap_s))
+        throw Error(cfg_.rawlog + ": IMU gap of " + g10(h) + " s ending at t = " + g10(rec.t - r_.t_zero) +
+                    " s (nominal step " + g10(med_) + " s; the filter would coast across it unnoticed): allow gaps "
+                    "up to a length with filter.max_imu_gap_s or --max-imu-gap S (accepted 0-" +
+                    g10(kMaxImuGapS) + " s)");
+      const auto m = static_cast<std::size_t>(std::llround(h / med_));
+      // the work gaps add is bounded: no more filled sub-steps than twice the
+      // samples read so far, plus one longest allowed gap
+      const auto oneGap = static_cast<std::size_t>(std::llround(cfg_.max_imu_gap_s / med_)) + 1;
+      if (produced_ + m > 2 * imuRecords_ + 16 + oneGap)
+        throw Error(cfg_.rawlog + ": IMU gaps hold more missing samples than the data has samples");
+      double last = prevT_;
+      for (std::size_t j = 1; j <= m; ++j) {
+        const double t = j == m ? rec.t : prevT_ + h * static_cast<double>(j) / static_cast<double>(m);
+        samples_.push_back(ins::ImuSample::fromRates(t, t - last, rec.w_IB_B, rec.f_B));
+        last = t;
+      }
+      produced_ += m;
+      ++gaps_;
+      if (h > longest_) {
+        longest_ = h;
+        longestAt_ = rec.t - r_.t_zero;
+      }
+    } else {
+      samples_.push_back(ins::ImuSample::fromRates(rec.t, h, rec.w_IB_B, rec.f_B));
+      ++produced_;
+    }
+    firstRecord_ = false;
+    prevT_ = rec.t;
+  }
+  s = samples_.front();
+  samples_.pop_front();
+  return true;
+}
+
+bool ReplayDriver::peekSample() {
+  if (!samples_.empty()) return true;
+  ins::ImuSample s;
+  if (!nextSample(s)) return false;
+  samples_.push_front(s);
+  return true;
+}
+
+// Outages all along the run, each after period - duration of GNSS from the
+// filter start, only those ending by the end of the IMU data. Each is decided
+// one duration before it starts, by reading ahead to its end (so the records
+// read ahead are at most about two outage durations).
+void ReplayDriver::decideWindows(double t_now) {
+  if (!windowsOpen_) return;
+  const OutagePattern& p = *cfg_.outages_every;
+  for (;;) {
+    // start_k = aided_from + (k + 1) period - duration, computed from k (no accumulated rounding)
+    const double a = aidedFrom_ + double(nextWindow_ + 1) * p.period_s - p.duration_s, b = a + p.duration_s;
+    if (a - p.duration_s > t_now) return;
+    while (!eof_ && lastImuT_ < b - 1e-9) readOne();
+    if (b > lastImuT_ + 1e-9) {  // ends after the data
+      windowsOpen_ = false;
+      return;
+    }
+    runner_->addOutage({a, b});
+    r_.cfg.outages.push_back({a - r_.t_zero, b - r_.t_zero});
+    ++nextWindow_;
+  }
+}
+
+void ReplayDriver::run() {
+  ReplayResult& r = r_;
+  const ReplayConfig& cfg = cfg_;
+  const Recording& head = reader_.header();
+  r.cfg = cfg;
+  r.scenario_yaml = head.metadata;
+  origin_ = head.origin;
+
+  // The look-ahead: the first kReplayLookaheadImu IMU intervals set the nominal
+  // step and tell whether the reference can start the filter.
+  while (!eof_ && imuQ_.size() <= kReplayLookaheadImu) readOne();
+  if (imuQ_.size() < 2) throw Error(cfg.rawlog + ": no IMU data (label IMU) to replay");
+  origin_ = head.origin;
+
   try {
-    if (!d.metadata.empty()) scen = YAML::Load(d.metadata)["navimpact_scenario"];
+    if (!head.metadata.empty()) scen_ = YAML::Load(head.metadata)["navimpact_scenario"];
   } catch (const YAML::Exception&) {
   }
   // IMU model of the filter.
@@ -197,106 +473,48 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   } else if (!cfg.model_spec.empty()) {
     model = stochastic::loadImuModel(cfg.model_spec);
     r.model_source = model.source;
-  } else if (scen && scen["imu_model_yaml"]) {
-    model = stochastic::parseImuModel(scen["imu_model_yaml"].as<std::string>(),
+  } else if (scen_ && scen_["imu_model_yaml"]) {
+    model = stochastic::parseImuModel(scen_["imu_model_yaml"].as<std::string>(),
                                       cfg.rawlog + " (scenario imu_model_yaml)");
-    const std::string src = scen["imu"] && scen["imu"]["model"] ? scen["imu"]["model"].as<std::string>() : "";
+    const std::string src = scen_["imu"] && scen_["imu"]["model"] ? scen_["imu"]["model"].as<std::string>() : "";
     model.source = "rawlog scenario model (" + src + ")";
     r.model_source = model.source;
   } else {
     throw Error(cfg.rawlog + ": the scenario records no IMU error model: give one with --model FILE[:NAME]");
   }
 
-  // IMU samples and time zero. The nominal step is the median interval; an
-  // interval longer than kGapSteps nominal steps is a gap: an error unless the
-  // configuration allows gaps up to max_imu_gap_s, then the filter propagates
-  // across it in nominal-length sub-steps with the rates of the sample after
-  // the gap held constant, and the outputs say so.
-  std::vector<double> steps(d.imu.size() - 1);
-  for (std::size_t k = 1; k < d.imu.size(); ++k) steps[k - 1] = d.imu[k].t - d.imu[k - 1].t;
-  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-  const double med = steps[steps.size() / 2];
-  const double dt0 = d.imu[1].t - d.imu[0].t;
-  const double dt = std::abs(dt0 - med) <= 0.01 * med ? dt0 : med;
-  r.imu_rate_hz = 1.0 / dt;
-  r.t_zero = d.imu.front().t - dt;
-  std::vector<ins::ImuSample> imu;
-  imu.reserve(d.imu.size());
-  double prev = r.t_zero;
-  auto g10 = [](double v) {  // 10 significant digits
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.10g", v);
-    return std::string(buf);
-  };
-  std::size_t gaps = 0;
-  double longest = 0.0, longestAt = 0.0;
-  for (std::size_t k = 0; k < d.imu.size(); ++k) {
-    const double h = d.imu[k].t - prev;
-    if (k > 0 && h > kImuGapSteps * med) {
-      if (!(h <= cfg.max_imu_gap_s))
-        throw Error(cfg.rawlog + ": IMU gap of " + g10(h) + " s ending at t = " + g10(d.imu[k].t - r.t_zero) +
-                    " s (nominal step " + g10(med) + " s; the filter would coast across it unnoticed): allow gaps "
-                    "up to a length with filter.max_imu_gap_s or --max-imu-gap S (accepted 0-" +
-                    g10(kMaxImuGapS) + " s)");
-      const auto m = static_cast<std::size_t>(std::llround(h / med));
-      if (imu.size() + m > 2 * d.imu.size() + 16)
-        throw Error(cfg.rawlog + ": IMU gaps hold more missing samples than the data has samples");
-      for (std::size_t j = 1; j <= m; ++j) {
-        const double t = j == m ? d.imu[k].t : prev + h * static_cast<double>(j) / static_cast<double>(m);
-        imu.push_back(ins::ImuSample::fromRates(t, t - imu.back().t, d.imu[k].w_IB_B, d.imu[k].f_B));
-      }
-      ++gaps;
-      if (h > longest) {
-        longest = h;
-        longestAt = d.imu[k].t - r.t_zero;
-      }
-    } else {
-      imu.push_back(ins::ImuSample::fromRates(d.imu[k].t, h, d.imu[k].w_IB_B, d.imu[k].f_B));
-    }
-    prev = d.imu[k].t;
+  // The nominal step: the median interval of the look-ahead; time zero one step before the first sample.
+  {
+    std::vector<double> steps(imuQ_.size() - 1);
+    for (std::size_t k = 1; k < imuQ_.size(); ++k) steps[k - 1] = imuQ_[k].t - imuQ_[k - 1].t;
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    med_ = steps[steps.size() / 2];
+    const double dt0 = imuQ_[1].t - imuQ_[0].t;
+    dt_ = std::abs(dt0 - med_) <= 0.01 * med_ ? dt0 : med_;
   }
-  if (gaps > 0)
-    r.notices.push_back(std::to_string(gaps) + " IMU gap(s) longer than " + g10(kImuGapSteps) +
-                        " nominal steps accepted (longest " + g10(longest) + " s, ending at t = " + g10(longestAt) +
-                        " s; filter.max_imu_gap_s = " + g10(cfg.max_imu_gap_s) +
-                        " s): the filter propagated across each with the rates of the sample after it held constant");
-  r.imu_gaps = gaps;
-  const double t_last = d.imu.back().t;
+  r.imu_rate_hz = 1.0 / dt_;
+  r.t_zero = imuQ_.front().t - dt_;
+  prevT_ = r.t_zero;
 
-  // Outages in rawlog time.
-  NavRunOptions opt;
-  checkOutages(cfg.outages, t_last - r.t_zero,
-               "the data (IMU data span 0.." + formatNumber(t_last - r.t_zero, 10) + " s)");
-  for (const auto& o : cfg.outages) opt.outages.push_back(o.shifted(r.t_zero));
+  // Outages in rawlog time (their end against the data's end is checked when it is known).
+  checkOutages(cfg.outages, std::numeric_limits<double>::infinity(), "the data");
+  for (const auto& o : cfg.outages) opt_.outages.push_back(o.shifted(r.t_zero));
 
-  // Measurement noise: overridden by the configuration, else recorded with the
-  // sample, else (baro) the scenario's.
-  double sBaro = NAN;
-  if (scen && scen["baro"] && scen["baro"]["sigma_m"]) sBaro = scen["baro"]["sigma_m"].as<double>();
-  if (std::isfinite(sBaro) && !cfg.sigma_baro_m)
-    limits::check(cfg.rawlog, "scenario baro.sigma_m", sBaro, limits::kPositionSigmaM);
-  for (auto& b : d.baro) {
-    if (cfg.sigma_baro_m) b.sigma_m = *cfg.sigma_baro_m;
-    else if (!b.sigma_m) b.sigma_m = sBaro;
-    if (!std::isfinite(*b.sigma_m))
-      throw Error(cfg.rawlog + ": barometer sigma not recorded in the scenario: set noise.sigma_baro_m");
-  }
-  const Eigen::Vector3d kNaN3 = Eigen::Vector3d::Constant(NAN);
-  for (auto& f : d.gnss) {
-    Eigen::Vector3d sp = f.cov_pos_N ? Eigen::Vector3d(f.cov_pos_N->diagonal().cwiseSqrt()) : kNaN3;
-    Eigen::Vector3d sv = f.cov_vel_N ? Eigen::Vector3d(f.cov_vel_N->diagonal().cwiseSqrt()) : kNaN3;
-    if (cfg.sigma_pos_h_m) sp.head<2>().setConstant(*cfg.sigma_pos_h_m);
-    if (cfg.sigma_pos_v_m) sp[2] = *cfg.sigma_pos_v_m;
-    if (cfg.sigma_vel_h_mps) sv.head<2>().setConstant(*cfg.sigma_vel_h_mps);
-    if (cfg.sigma_vel_v_mps) sv[2] = *cfg.sigma_vel_v_mps;
-    if (!sp.allFinite() || (f.v_N && !sv.allFinite()))
-      throw Error(cfg.rawlog + ": GNSS fix at t = " + formatNumber(f.t, 10) + " s has no covariance: set the noise.* sigmas");
-    f.cov_pos_N = Eigen::Matrix3d(sp.cwiseAbs2().asDiagonal());
-    if (sv.allFinite()) f.cov_vel_N = Eigen::Matrix3d(sv.cwiseAbs2().asDiagonal());
+  if (scen_ && scen_["baro"] && scen_["baro"]["sigma_m"]) sBaro_ = scen_["baro"]["sigma_m"].as<double>();
+  if (std::isfinite(sBaro_) && !cfg.sigma_baro_m)
+    limits::check(cfg.rawlog, "scenario baro.sigma_m", sBaro_, limits::kPositionSigmaM);
+  setup_ = true;
+  {  // the measurements read ahead, with their noise
+    std::deque<GnssFix> g;
+    std::deque<BaroSample> b;
+    g.swap(gnssQ_);
+    b.swap(baroQ_);
+    for (auto& f : g) takeGnss(std::move(f));
+    for (auto& x : b) takeBaro(x);
   }
   Eigen::Vector3d lever = Eigen::Vector3d::Zero();
-  if (scen && scen["gnss"] && scen["gnss"]["lever_arm_B_m"]) {
-    const auto l = scen["gnss"]["lever_arm_B_m"].as<std::vector<double>>();
+  if (scen_ && scen_["gnss"] && scen_["gnss"]["lever_arm_B_m"]) {
+    const auto l = scen_["gnss"]["lever_arm_B_m"].as<std::vector<double>>();
     if (l.size() == 3 && !cfg.lever_arm_B) {
       for (int k = 0; k < 3; ++k)
         limits::check(cfg.rawlog, "scenario gnss.lever_arm_B_m[" + std::to_string(k) + "]", l[k], limits::kLeverArmM);
@@ -304,99 +522,95 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
     }
   }
   if (cfg.lever_arm_B) lever = *cfg.lever_arm_B;
-  opt.lever_arm_B = lever;
+  opt_.lever_arm_B = lever;
 
-  // Reference series (GT: tangent-plane NED at the origin -> geodetic). A
-  // reference without velocity or attitude is scored on what it has (the
-  // missing parts NaN); the filter starts from it only when it is complete
-  // and has an entry at time zero, else after an aligning phase.
-  const bool hasTruth = cfg.use_reference && !d.reference.empty();
-  TruthSeries truth;
-  bool fullRef = true;
-  ReferenceInfo refInfo;
-  refInfo.sigma_h_m = cfg.reference_sigma_h_m;
-  refInfo.sigma_v_m = cfg.reference_sigma_v_m;
-  bool refSigmaFromData = cfg.reference_sigma_h_m == 0.0 && cfg.reference_sigma_v_m == 0.0;
-  for (const auto& g : d.reference) {
-    if (g.t < r.t_zero - 0.5 * dt || g.t > t_last + 0.5 * dt) continue;
-    ins::NavState x;
-    x.t = g.t;
-    const earth::Geodetic p = earth::nedToGeodetic(d.origin, g.p_L);
-    x.lat = p.lat;
-    x.lon = p.lon;
-    x.h = p.h;
-    x.v_N = g.v_N ? *g.v_N : Eigen::Vector3d::Constant(NAN);
-    x.q_BtoN = g.q_BtoN ? g.q_BtoN->normalized() : Eigen::Quaterniond(NAN, NAN, NAN, NAN);
-    refInfo.has_velocity = refInfo.has_velocity && g.v_N.has_value();
-    refInfo.has_attitude = refInfo.has_attitude && g.q_BtoN.has_value();
-    fullRef = fullRef && g.v_N && g.q_BtoN;
-    if (refSigmaFromData && g.sigma_p_L) {  // the reference's own sigma as recorded (largest seen)
-      refInfo.sigma_h_m = std::max(refInfo.sigma_h_m, g.sigma_p_L->head<2>().maxCoeff());
-      refInfo.sigma_v_m = std::max(refInfo.sigma_v_m, (*g.sigma_p_L)[2]);
+  // Reference series. A reference without velocity or attitude is scored on
+  // what it has (the missing parts NaN); the filter starts from it only when it
+  // is complete over the look-ahead and has an entry at time zero, else after
+  // an aligning phase.
+  refInfo_.sigma_h_m = cfg.reference_sigma_h_m;
+  refInfo_.sigma_v_m = cfg.reference_sigma_v_m;
+  refSigmaFromData_ = cfg.reference_sigma_h_m == 0.0 && cfg.reference_sigma_v_m == 0.0;
+  bool fullRef = true, anyRef = false;
+  {
+    const double hi = eof_ ? lastImuT_ + 0.5 * dt_ : std::numeric_limits<double>::infinity();
+    for (const auto& g : refQ_) {
+      if (g.t < r.t_zero - 0.5 * dt_ || g.t > hi) continue;
+      anyRef = true;
+      fullRef = fullRef && g.v_N && g.q_BtoN;
     }
-    truth.t.push_back(g.t);
-    truth.x.push_back(x);
+    hasTruth_ = cfg.use_reference && !refQ_.empty();
+    if (hasTruth_ && !anyRef) throw Error(cfg.rawlog + ": the reference (GT) has no entry inside the IMU data");
+    std::deque<ReferenceRecord> q;
+    q.swap(refQ_);
+    for (const auto& g : q) takeReference(g);
   }
-  if (hasTruth && truth.t.empty())
-    throw Error(cfg.rawlog + ": the reference (GT) has no entry inside the IMU data");
-  const bool startFromRef = hasTruth && fullRef && std::abs(truth.t.front() - r.t_zero) <= 0.5 * dt;
-  if (hasTruth && !startFromRef)
-    r.notices.push_back(std::string("the reference ") +
-                        (fullRef ? "has no entry at the start of the IMU data"
-                                 : std::string("has no ") +
-                                       (!refInfo.has_velocity && !refInfo.has_attitude ? "velocity and attitude"
-                                        : refInfo.has_velocity                         ? "attitude"
-                                                                                       : "velocity")) +
-                        ": the filter starts after an aligning phase and is scored on what the reference has");
+  const bool startFromRef = hasTruth_ && fullRef && std::abs(truthAhead_.t.front() - r.t_zero) <= 0.5 * dt_;
+  std::string refNotice;
+  if (hasTruth_ && !startFromRef)
+    refNotice = std::string("the reference ") +
+                (fullRef ? "has no entry at the start of the IMU data"
+                         : std::string("has no ") +
+                               (!refInfo_.has_velocity && !refInfo_.has_attitude ? "velocity and attitude"
+                                : refInfo_.has_velocity                         ? "attitude"
+                                                                                : "velocity")) +
+                ": the filter starts after an aligning phase and is scored on what the reference has";
 
-  NavRunInput in;
-  in.imu = &imu;
-  in.gnss = &d.gnss;
-  in.baro = &d.baro;
-  in.truth = hasTruth ? &truth : nullptr;
-  opt.record_interval_s = cfg.record_interval_s;
-  opt.ekf.propagate_every = cfg.propagate_every;
-  opt.ekf.gate_probability = cfg.gate_probability;
-  opt.ekf.gate_readmit_after = cfg.gate_readmit_after;
-  opt.ekf.imu.extra = cfg.extra_states;
-  opt.use_gnss_velocity = cfg.use_gnss_velocity;
-  opt.P0_nav.setZero();
+  opt_.record_interval_s = cfg.record_interval_s;
+  opt_.ekf.propagate_every = cfg.propagate_every;
+  opt_.ekf.gate_probability = cfg.gate_probability;
+  opt_.ekf.gate_readmit_after = cfg.gate_readmit_after;
+  opt_.ekf.imu.extra = cfg.extra_states;
+  opt_.use_gnss_velocity = cfg.use_gnss_velocity;
+  opt_.P0_nav.setZero();
   const double ph = cfg.p0_pos_h_m, pv = cfg.p0_pos_v_m, vv = cfg.p0_vel_mps;
   const double rp = cfg.p0_roll_pitch_deg * kDeg, yw = cfg.p0_yaw_deg * kDeg;
-  opt.P0_nav.diagonal() << ph * ph, ph * ph, pv * pv, vv * vv, vv * vv, vv * vv, rp * rp, rp * rp, yw * yw;
-  opt.reference_lever_B = cfg.reference_lever_arm_B;
-  opt.zupt = cfg.aids.zupt;
-  opt.zupt_detector = cfg.alignment.detector;
-  opt.zupt_sigma_mps = cfg.aids.zupt_sigma_mps;
-  opt.zupt_interval_s = cfg.aids.zupt_interval_s;
-  opt.nhc = cfg.aids.nhc;
-  opt.nhc_sigma_lateral_mps = cfg.aids.nhc_sigma_lateral_mps;
-  opt.nhc_sigma_vertical_mps = cfg.aids.nhc_sigma_vertical_mps;
-  opt.nhc_interval_s = cfg.aids.nhc_interval_s;
-  opt.nhc_min_speed_mps = cfg.aids.nhc_min_speed_mps;
-  opt.nhc_point_B = cfg.aids.nhc_point_B;
-  std::vector<GnssFix> gnssAfter;
+  opt_.P0_nav.diagonal() << ph * ph, ph * ph, pv * pv, vv * vv, vv * vv, vv * vv, rp * rp, rp * rp, yw * yw;
+  opt_.reference_lever_B = cfg.reference_lever_arm_B;
+  opt_.zupt = cfg.aids.zupt;
+  opt_.zupt_detector = cfg.alignment.detector;
+  opt_.zupt_sigma_mps = cfg.aids.zupt_sigma_mps;
+  opt_.zupt_interval_s = cfg.aids.zupt_interval_s;
+  opt_.nhc = cfg.aids.nhc;
+  opt_.nhc_sigma_lateral_mps = cfg.aids.nhc_sigma_lateral_mps;
+  opt_.nhc_sigma_vertical_mps = cfg.aids.nhc_sigma_vertical_mps;
+  opt_.nhc_interval_s = cfg.aids.nhc_interval_s;
+  opt_.nhc_min_speed_mps = cfg.aids.nhc_min_speed_mps;
+  opt_.nhc_point_B = cfg.aids.nhc_point_B;
+
+  ins::NavState x0;
+  std::vector<std::string> alignNotices;
   if (startFromRef) {
-    in.x0 = truth.x.front();
-    in.x0.t = r.t_zero;
+    x0 = truthAhead_.x.front();
+    x0.t = r.t_zero;
   } else {
     // The aligning phase: from time zero until the aligner has an attitude,
-    // a position and a velocity; the filter starts at that IMU sample.
+    // a position and a velocity; the filter starts at the next IMU sample.
     filter::AlignmentOptions ao = cfg.alignment;
     ao.lever_arm_B = lever;
     if (!ao.yaw_rad && cfg.initial_attitude_deg) {
       ao.yaw_rad = (*cfg.initial_attitude_deg)[2] * kDeg;
       ao.yaw_source = "configuration (initial_attitude_deg)";
     }
-    std::size_t k = 0, ig = 0;
-    try {
-      filter::CoarseAligner al(ao, r.t_zero, r.imu_rate_hz);
-      for (; k < imu.size() && !al.done(); ++k) {
-        al.addImu(imu[k]);
-        while (!al.done() && ig < d.gnss.size() && d.gnss[ig].t <= imu[k].t + 1e-9) {
-          const GnssFix& f = d.gnss[ig++];
+    auto aligning = [&](auto&& f) {
+      try {
+        return f();
+      } catch (const Error& e) {
+        throw Error(cfg.rawlog + ": aligning (no complete reference at the start): " + e.what());
+      }
+    };
+    std::optional<filter::CoarseAligner> al;
+    aligning([&] { al.emplace(ao, r.t_zero, r.imu_rate_hz); });
+    std::size_t ig = 0;
+    ins::ImuSample s;
+    while (!al->done() && nextSample(s)) {
+      fillTo(s.t + 1e-9);
+      aligning([&] {
+        al->addImu(s);
+        while (!al->done() && ig < gnssQ_.size() && gnssQ_[ig].t <= s.t + 1e-9) {
+          const GnssFix& f = gnssQ_[ig++];
           bool out = false;
-          for (const auto& o : opt.outages) out = out || o.covers(f.t);
+          for (const auto& o : opt_.outages) out = out || o.covers(f.t);
           if (out) continue;
           filter::AlignmentFix af;
           af.t = f.t;
@@ -406,60 +620,123 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
             af.v_N = *f.v_N;
             af.sigma_vel_N = f.cov_vel_N->diagonal().cwiseSqrt();
           }
-          al.addFix(af);
+          al->addFix(af);
         }
-      }
-      if (!al.done())
-        throw Error("the IMU data end before the aligning phase does: " + al.missing());
-      if (k >= imu.size()) throw Error("the aligning phase ends with the IMU data: nothing left to navigate");
-      in.x0 = al.state();
-      opt.P0_nav = al.P0();
-      r.alignment = al.report();
-      for (const auto& f : d.gnss)
-        if (f.t > al.usedFixTime() + 1e-9) gnssAfter.push_back(f);
-    } catch (const Error& e) {
-      throw Error(cfg.rawlog + ": aligning (no complete reference at the start): " + e.what());
+      });
     }
-    imu.erase(imu.begin(), imu.begin() + static_cast<std::ptrdiff_t>(k));
-    in.gnss = &gnssAfter;
-    r.aided_from_s = in.x0.t - r.t_zero;
-    r.notices.push_back(std::string(hasTruth ? "" : "no ground truth in the rawlog: ") + "aligning phase from 0 to " +
-                        formatNumber(r.aided_from_s, 10) + " s (levelling " + r.alignment->levelling + ", heading from " +
-                        r.alignment->heading + "), the filter runs from there" +
-                        (hasTruth ? "" : "; errors and NEES are not available"));
-    for (const auto& n : r.alignment->notes) r.notices.push_back("alignment: " + n);
+    aligning([&] {
+      if (!al->done()) throw Error("the IMU data end before the aligning phase does: " + al->missing());
+    });
+    const bool more = peekSample();
+    aligning([&] {
+      if (!more) throw Error("the aligning phase ends with the IMU data: nothing left to navigate");
+      x0 = al->state();
+      opt_.P0_nav = al->P0();
+      r.alignment = al->report();
+    });
+    while (!gnssQ_.empty() && gnssQ_.front().t <= al->usedFixTime() + 1e-9) gnssQ_.pop_front();
+    r.aided_from_s = x0.t - r.t_zero;
+    alignNotices.push_back(std::string(hasTruth_ ? "" : "no ground truth in the rawlog: ") + "aligning phase from 0 to " +
+                           formatNumber(r.aided_from_s, 10) + " s (levelling " + r.alignment->levelling +
+                           ", heading from " + r.alignment->heading + "), the filter runs from there" +
+                           (hasTruth_ ? "" : "; errors and NEES are not available"));
+    for (const auto& n : r.alignment->notes) alignNotices.push_back("alignment: " + n);
   }
-  // Outages all along the run, each after period - duration of GNSS from the filter start.
-  if (cfg.outages_every) {
-    for (const Outage& w : outagesEvery(*cfg.outages_every, in.x0.t, t_last)) {
-      opt.outages.push_back(w);
-      r.cfg.outages.push_back({w.start_s - r.t_zero, w.end_s - r.t_zero});
-    }
-    if (opt.outages.size() == cfg.outages.size())
-      r.notices.push_back("outages every " + formatNumber(cfg.outages_every->period_s, 10) + ":" +
-                          formatNumber(cfg.outages_every->duration_s, 10) + " s: none fits in the data after the filter start");
-  }
+  std::vector<std::string> modelNotices;
   {
     // The one model-entry path: converted to the data's IMU rate (a rate within
     // 0.1 % of the model's is the same sensor's clock jitter, not another rate),
     // GMs the filter cannot carry entered as white noise; the notices say so.
     const double rate = std::abs(model.rate_hz - r.imu_rate_hz) <= 1e-3 * r.imu_rate_hz ? model.rate_hz : r.imu_rate_hz;
-    filter::ModelEntry entry = filter::layoutFor(model, opt.ekf, rate);
+    filter::ModelEntry entry = filter::layoutFor(model, opt_.ekf, rate);
     model = std::move(entry.model);
-    for (const auto& n : entry.notes) r.notices.push_back("filter model: " + n);
+    for (const auto& n : entry.notes) modelNotices.push_back("filter model: " + n);
   }
-  r.run = runNav(in, model, opt);
-  r.nav = opt;
-  r.gnss = *in.gnss;
-  r.baro = d.baro;
-  if (hasTruth) r.score = scoreRun(r.run, r.t_zero, in.x0.t, refInfo);
-  std::size_t i = 0;
-  for (const auto& e : r.run.epochs) {
-    r.estimate.push_back(e.est);
-    if (!hasTruth) continue;
-    while (i < truth.t.size() && truth.t[i] < e.t - 1e-9) ++i;
-    r.truth.push_back(truth.x[std::min(i, truth.t.size() - 1)]);
+
+  // The filter, fed as the records come.
+  if (!peekSample()) throw Error("navigation run: no IMU samples");
+  const double dt0 = samples_.front().dt;
+  runner_.emplace(x0, dt0, hasTruth_, model, opt_);
+  NavRunner& run = *runner_;
+  run.keep_epochs = obs_ == nullptr;
+  aidedFrom_ = x0.t;
+  if (hasTruth_) scorer_.emplace(x0.t);
+  windowsOpen_ = cfg.outages_every.has_value();
+  if (windowsOpen_) (void)outagesEvery(*cfg.outages_every, 0.0, 0.0);  // the one message for a bad pattern
+  run.on_epoch = [&](const NavEpoch& e, const ins::NavState* truth) {
+    if (scorer_) scorer_->add(e, run.outages());
+    if (obs_) {
+      obs_->epoch(r, e, truth, run.outages());
+    } else {
+      r.estimate.push_back(e.est);
+      if (truth) r.truth.push_back(*truth);
+    }
+  };
+  for (auto& f : gnssQ_) {
+    if (!obs_) r.gnss.push_back(f);
+    run.addGnss(f);
   }
+  gnssQ_.clear();
+  for (const auto& b : baroQ_) run.addBaro(b);
+  baroQ_.clear();
+  for (std::size_t i = 0; i < truthAhead_.t.size(); ++i) run.addTruth(truthAhead_.t[i], truthAhead_.x[i]);
+  truthAhead_ = {};
+  if (obs_) obs_->begin(r);
+  decideWindows(x0.t + dt0);
+  fillTo(x0.t + 0.5 * dt0);
+  run.start();
+  ins::ImuSample s;
+  while (nextSample(s)) {
+    decideWindows(s.t + s.dt);
+    fillTo(s.t + 0.5 * s.dt);
+    run.step(s);
+  }
+  const double t_last = lastImuT_;
+  r.run = run.finish();
+  r.nav = opt_;
+  r.nav.outages = run.outages();
+  r.read_s = readS_;
+  r.imu_gaps = gaps_;
+
+  // What needed the end of the data.
+  checkOutages(cfg.outages, t_last - r.t_zero,
+               "the data (IMU data span 0.." + formatNumber(t_last - r.t_zero, 10) + " s)");
+  if (hasTruth_ && truthInside_ == 0)
+    throw Error(cfg.rawlog + ": the reference (GT) has no entry inside the IMU data");
+  // notices in one order: the reader's, gaps, the reference, the alignment, the outages, the model
+  r.notices = reader_.header().notices;
+  if (gaps_ > 0)
+    r.notices.push_back(std::to_string(gaps_) + " IMU gap(s) longer than " + g10(kImuGapSteps) +
+                        " nominal steps accepted (longest " + g10(longest_) + " s, ending at t = " + g10(longestAt_) +
+                        " s; filter.max_imu_gap_s = " + g10(cfg.max_imu_gap_s) +
+                        " s): the filter propagated across each with the rates of the sample after it held constant");
+  if (!refNotice.empty()) r.notices.push_back(refNotice);
+  if (ignoredRef_ > 0)
+    r.notices.push_back(std::to_string(ignoredRef_) + " reference (GT) entries ignored: the reference starts after the "
+                        "first " + std::to_string(kReplayLookaheadImu) + " IMU samples the replay decides from");
+  for (auto& n : alignNotices) r.notices.push_back(std::move(n));
+  if (cfg.outages_every && r.cfg.outages.size() == cfg.outages.size())
+    r.notices.push_back("outages every " + formatNumber(cfg.outages_every->period_s, 10) + ":" +
+                        formatNumber(cfg.outages_every->duration_s, 10) + " s: none fits in the data after the filter start");
+  for (auto& n : modelNotices) r.notices.push_back(std::move(n));
+  if (scorer_) r.score = scorer_->finish(r.run, r.t_zero, refInfo_);
+}
+
+}  // namespace
+
+ReplayResult runReplay(const ReplayConfig& cfg) {
+  if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
+  InputScope scope(cfg.rawlog);
+  ReplayResult r;
+  ReplayDriver(cfg, r, nullptr).run();
+  return r;
+}
+
+ReplayResult runReplay(const ReplayConfig& cfg, ReplayObserver& observer) {
+  if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
+  InputScope scope(cfg.rawlog);
+  ReplayResult r;
+  ReplayDriver(cfg, r, &observer).run();
   return r;
 }
 

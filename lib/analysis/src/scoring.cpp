@@ -31,7 +31,42 @@ double percentile(std::vector<double> v, double q) {
   return v[lo] + (h - double(lo)) * (v[hi] - v[lo]);
 }
 
+void RunScorer::add(const NavEpoch& e, const std::vector<Outage>& outages) {
+  // Errors along the run over the GNSS-aided time.
+  if (e.t < aided_from_ - 1e-9) return;
+  for (const auto& o : outages)
+    if (e.t > o.start_s && e.t <= o.end_s + 1e-9) return;
+  ++aided_epochs_;
+  sh_ += e.err.head<2>().squaredNorm();
+  sv_ += e.err[2] * e.err[2];
+  svel_ += e.err.segment<3>(3).squaredNorm();
+  satt_ += e.err.segment<3>(6).cwiseAbs2();
+}
+
 RunScore scoreRun(const NavRunResult& run, double t_zero, double aided_from, const ReferenceInfo& ref) {
+  if (!run.has_truth) throw Error("scoring: the run has no reference");
+  RunScorer scorer(aided_from);
+  std::vector<Outage> windows;
+  for (const auto& o : run.outages) windows.push_back(o.window);
+  for (const NavEpoch& e : run.epochs) scorer.add(e, windows);
+  // each outage's end epoch and drifts from the epochs
+  NavRunResult ends;
+  ends.has_truth = true;
+  ends.outages = run.outages;
+  for (auto& o : ends.outages) {
+    if (o.end_epoch < 0) continue;
+    o.end = run.epochs.at(static_cast<std::size_t>(o.end_epoch));
+    o.max_drift_h = o.max_drift_v = 0.0;
+    for (const NavEpoch& k : run.epochs) {
+      if (k.t <= o.window.start_s || k.t > o.window.end_s + 1e-9) continue;
+      o.max_drift_h = std::max(o.max_drift_h, k.err.head<2>().norm());
+      o.max_drift_v = std::max(o.max_drift_v, std::abs(k.err[2]));
+    }
+  }
+  return scorer.finish(ends, t_zero, ref);
+}
+
+RunScore RunScorer::finish(const NavRunResult& run, double t_zero, const ReferenceInfo& ref) const {
   if (!run.has_truth) throw Error("scoring: the run has no reference");
   if (!(ref.sigma_h_m >= 0.0) || !(ref.sigma_v_m >= 0.0) || !std::isfinite(ref.sigma_h_m) ||
       !std::isfinite(ref.sigma_v_m))
@@ -40,30 +75,13 @@ RunScore scoreRun(const NavRunResult& run, double t_zero, double aided_from, con
   s.reference = ref;
   const Eigen::Vector3d R_ref(ref.sigma_h_m * ref.sigma_h_m, ref.sigma_h_m * ref.sigma_h_m,
                               ref.sigma_v_m * ref.sigma_v_m);
-  auto inOutage = [&](double t) {
-    for (const auto& o : run.outages)
-      if (t > o.window.start_s && t <= o.window.end_s + 1e-9) return true;
-    return false;
-  };
-
-  // Errors along the run over the GNSS-aided time.
-  double sh = 0.0, sv = 0.0, svel = 0.0;
-  Eigen::Vector3d satt = Eigen::Vector3d::Zero();
-  for (const NavEpoch& e : run.epochs) {
-    if (e.t < aided_from - 1e-9 || inOutage(e.t)) continue;
-    ++s.aided_epochs;
-    sh += e.err.head<2>().squaredNorm();
-    sv += e.err[2] * e.err[2];
-    svel += e.err.segment<3>(3).squaredNorm();
-    satt += e.err.segment<3>(6).cwiseAbs2();
-  }
+  s.aided_epochs = aided_epochs_;
   const double n = double(std::max<std::size_t>(s.aided_epochs, 1));
-  s.horizontal_rms_m = s.aided_epochs ? std::sqrt(sh / n) : kNaN;
-  s.vertical_rms_m = s.aided_epochs ? std::sqrt(sv / n) : kNaN;
-  s.velocity_rms_mps = s.aided_epochs && ref.has_velocity ? std::sqrt(svel / n) : kNaN;
-  s.attitude_rms_rad = s.aided_epochs && ref.has_attitude ? Eigen::Vector3d((satt / n).cwiseSqrt())
+  s.horizontal_rms_m = s.aided_epochs ? std::sqrt(sh_ / n) : kNaN;
+  s.vertical_rms_m = s.aided_epochs ? std::sqrt(sv_ / n) : kNaN;
+  s.velocity_rms_mps = s.aided_epochs && ref.has_velocity ? std::sqrt(svel_ / n) : kNaN;
+  s.attitude_rms_rad = s.aided_epochs && ref.has_attitude ? Eigen::Vector3d((satt_ / n).cwiseSqrt())
                                                            : Eigen::Vector3d::Constant(kNaN);
-
   // Per outage, at its end.
   OutageDistribution& d = s.distribution;
   d.nees_band_lo = chi2q(3.0, 0.025);
@@ -76,7 +94,7 @@ RunScore scoreRun(const NavRunResult& run, double t_zero, double aided_from, con
       s.unscored.push_back(i);
       continue;
     }
-    const NavEpoch& e = run.epochs.at(static_cast<std::size_t>(o.end_epoch));
+    const NavEpoch& e = o.end;
     OutageScore q;
     q.start_s = o.window.start_s - t_zero;
     q.duration_s = o.window.end_s - o.window.start_s;
@@ -87,11 +105,8 @@ RunScore scoreRun(const NavRunResult& run, double t_zero, double aided_from, con
     q.vertical_error_m = std::abs(q.err_N[2]);
     q.horizontal_sigma_m = std::sqrt(std::max(0.0, e.P_pos(0, 0) + e.P_pos(1, 1)));
     q.vertical_sigma_m = q.sigma_N[2];
-    for (const NavEpoch& k : run.epochs) {
-      if (k.t <= o.window.start_s || k.t > o.window.end_s + 1e-9) continue;
-      q.max_drift_h_m = std::max(q.max_drift_h_m, k.err.head<2>().norm());
-      q.max_drift_v_m = std::max(q.max_drift_v_m, std::abs(k.err[2]));
-    }
+    q.max_drift_h_m = o.max_drift_h;
+    q.max_drift_v_m = o.max_drift_v;
     const Eigen::Matrix3d S = e.P_pos + Eigen::Matrix3d(R_ref.asDiagonal());
     Eigen::LLT<Eigen::Matrix3d> llt(S);
     q.nees = llt.info() == Eigen::Success ? q.err_N.dot(llt.solve(q.err_N)) : kNaN;

@@ -8,9 +8,11 @@
 #include <array>
 #include <cstdio>
 #include <cmath>
+#include <fstream>
 #include <iomanip>
 #include <sstream>
 
+#include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
 
@@ -46,16 +48,251 @@ Eigen::Vector3d eulerSigma(const ins::NavState& truth, const Eigen::Vector3d& si
   return S.diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 
+constexpr const char* kSolutionHeader =
+    "time_s,lat_deg,lon_deg,h_m,vN_mps,vE_mps,vD_mps,roll_deg,pitch_deg,yaw_deg,"
+    "sig_pN_m,sig_pE_m,sig_pD_m,sig_vN_mps,sig_vE_mps,sig_vD_mps,sig_roll_deg,sig_pitch_deg,sig_yaw_deg,"
+    "err_pN_m,err_pE_m,err_pD_m,err_vN_mps,err_vE_mps,err_vD_mps,err_roll_deg,err_pitch_deg,err_yaw_deg,"
+    "nees_pos,nees_vel,nees_att,nees_all,gnss\n";
+
 /// Per-outage zoomed figures are written for the first this many outages.
 constexpr std::size_t kMaxOutageFigures = 12;
 
+/// One epoch as the figures draw it.
+struct FigurePoint {
+  double t_abs = 0.0, t = 0.0;            ///< filter time, time from time zero [s]
+  std::array<double, 9> err{}, sig{};     ///< errors and 1-sigma as plotted (attitude in deg, roll/pitch/yaw)
+  double est_n = 0.0, est_e = 0.0;        ///< estimate, tangent plane at the first epoch [m]
+  double ref_n = 0.0, ref_e = 0.0;        ///< reference, same plane [m]
+};
+
+/// At most `cap` points of a series: every stride-th point, the stride doubled
+/// (every other kept point dropped) whenever the count would exceed the cap;
+/// all points while there are at most `cap`.
+class Decimated {
+ public:
+  explicit Decimated(std::size_t cap) : cap_(cap) {}
+  void add(const FigurePoint& p) {
+    last_ = p;
+    if (seen_++ % stride_ != 0) return;
+    pts_.push_back(p);
+    if (pts_.size() <= cap_) return;
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < pts_.size(); i += 2) pts_[j++] = pts_[i];
+    pts_.resize(j);
+    stride_ *= 2;
+  }
+  /// The kept points, the last point added included.
+  std::vector<FigurePoint> points() const {
+    std::vector<FigurePoint> v = pts_;
+    if (seen_ > 0 && (seen_ - 1) % stride_ != 0) v.push_back(last_);
+    return v;
+  }
+  std::size_t stride() const { return stride_; }
+  std::size_t seen() const { return seen_; }
+
+ private:
+  std::size_t cap_;
+  std::size_t stride_ = 1, seen_ = 0;
+  std::vector<FigurePoint> pts_;
+  FigurePoint last_;
+};
+
+/// Points drawn per series of errors_full.png and trajectory.png (a run with
+/// more epochs is decimated: every 2^k-th epoch, the last one included).
+constexpr std::size_t kMaxFigurePoints = 40000;
+/// Points kept per zoomed outage figure when the whole run is decimated.
+constexpr std::size_t kMaxZoomPoints = 8000;
+
+/// What a zoomed outage figure shows: its time range and the points in it
+/// (one before and one after, so the lines reach the edges).
+struct Zoom {
+  double a = 0.0, b = 0.0;   ///< [s] from time zero
+  Decimated pts{kMaxZoomPoints};
+  bool closed = false;
+};
+
+/// Running statistics of one outage over its epochs (summary.json).
+struct OutageStats {
+  double maxPh = 0, maxPv = 0, maxVh = 0, maxVv = 0, neesSum = 0;
+  Eigen::Vector3d maxAtt = Eigen::Vector3d::Zero();
+  std::array<double, 4> neesB{};
+  int n = 0;
+  ins::NavState endTruth;  ///< the reference at its end epoch
+};
+
+}  // namespace
+
+/// Everything written per epoch and what the summary and figures keep of it.
+struct ReplayWriter::State {
+  std::ostream* csv = nullptr;
+  std::ofstream file;
+  std::vector<char> buffer;
+  std::filesystem::path csvPath;
+  bool begun = false;
+  // summary
+  std::vector<OutageStats> outages;  // one per outage known so far
+  std::vector<std::size_t> live;     // outages that may still contain an epoch
+  double sPh = 0, sPv = 0, sV = 0;
+  Eigen::Vector3d sA = Eigen::Vector3d::Zero();
+  std::size_t epochs = 0;
+  // figures
+  bool haveOrigin = false;
+  earth::Geodetic o0;
+  Decimated all{kMaxFigurePoints};
+  std::vector<Zoom> zooms;
+  std::optional<FigurePoint> prev;
+
+  void begin(const ReplayResult& r) {
+    begun = true;
+    (void)r;
+  }
+
+  void epoch(const ReplayResult& r, const NavEpoch& e, const ins::NavState* truth, const std::vector<Outage>& windows) {
+    const ins::NavState& x = e.est;
+    const bool hasTruth = truth != nullptr;
+    const Eigen::Vector3d se = eulerSigma(hasTruth ? *truth : x, e.sigma.segment<3>(6)) / kDeg;
+    const Eigen::Vector3d ee = hasTruth ? Eigen::Vector3d(eulerError(x, *truth) / kDeg) : Eigen::Vector3d::Zero();
+    // solution.csv
+    if (csv) {
+      std::ostream& o = *csv;
+      const Eigen::Vector3d rpy = x.rollPitchYaw() / kDeg;
+      bool gnss = true;
+      for (const auto& w : r.cfg.outages)
+        if (e.t - r.t_zero > w.start_s + 1e-9 && e.t - r.t_zero <= w.end_s + 1e-9) gnss = false;
+      o << std::setprecision(10);
+      o << e.t - r.t_zero << ',' << std::setprecision(12) << x.lat / kDeg << ',' << x.lon / kDeg << ','
+        << std::setprecision(10) << x.h << ',' << x.v_N[0] << ',' << x.v_N[1] << ',' << x.v_N[2] << ',' << rpy[0]
+        << ',' << rpy[1] << ',' << rpy[2];
+      for (int i = 0; i < 6; ++i) o << ',' << e.sigma[i];
+      for (int i = 0; i < 3; ++i) o << ',' << se[i];
+      if (hasTruth) {
+        for (int i = 0; i < 6; ++i) o << ',' << e.err[i];
+        for (int i = 0; i < 3; ++i) o << ',' << ee[i];
+        for (int i = 0; i < 4; ++i) o << ',' << e.nees[i];
+      } else {
+        o << ",,,,,,,,,,,,,";  // no ground truth: errors and NEES empty
+      }
+      o << ',' << (gnss ? 1 : 0) << '\n';
+    }
+    // per-outage statistics over the epochs in (start, end]
+    while (outages.size() < windows.size()) {
+      live.push_back(outages.size());
+      outages.emplace_back();
+    }
+    for (std::size_t j = 0; j < live.size();) {
+      const Outage& w = windows[live[j]];
+      if (e.t > w.end_s + 1e-9) {
+        live.erase(live.begin() + static_cast<std::ptrdiff_t>(j));
+        continue;
+      }
+      OutageStats& st = outages[live[j]];
+      ++j;
+      if (e.t <= w.start_s || !hasTruth) continue;
+      const auto block = [&](int b) { return e.err.segment<3>(3 * b); };
+      st.maxPh = std::max(st.maxPh, block(0).head<2>().norm());
+      st.maxPv = std::max(st.maxPv, std::abs(block(0)[2]));
+      st.maxVh = std::max(st.maxVh, block(1).head<2>().norm());
+      st.maxVv = std::max(st.maxVv, std::abs(block(1)[2]));
+      st.maxAtt = st.maxAtt.cwiseMax(eulerError(x, *truth).cwiseAbs() / kDeg);
+      for (int b = 0; b < 4; ++b) st.neesB[b] += e.nees[b];
+      st.neesSum += e.nees[3];
+      ++st.n;
+      st.endTruth = *truth;
+    }
+    // overall RMS
+    if (hasTruth) {
+      const auto block = [&](int b) { return e.err.segment<3>(3 * b); };
+      sPh += block(0).head<2>().squaredNorm();
+      sPv += block(0)[2] * block(0)[2];
+      sV += block(1).squaredNorm();
+      sA += (eulerError(x, *truth) / kDeg).cwiseAbs2();
+    }
+    ++epochs;
+    // figures
+    if (!haveOrigin) {
+      o0 = hasTruth ? truth->geodetic() : x.geodetic();
+      haveOrigin = true;
+    }
+    FigurePoint p;
+    p.t_abs = e.t;
+    p.t = e.t - r.t_zero;
+    for (int i = 0; i < 6; ++i) {
+      p.err[i] = e.err[i];
+      p.sig[i] = e.sigma[i];
+    }
+    for (int i = 0; i < 3; ++i) {
+      p.err[6 + i] = ee[i];
+      p.sig[6 + i] = se[i];
+    }
+    const Eigen::Vector3d pe = earth::geodeticToNed(o0, x.geodetic());
+    p.est_n = pe.x();
+    p.est_e = pe.y();
+    if (hasTruth) {
+      const Eigen::Vector3d q = earth::geodeticToNed(o0, truth->geodetic());
+      p.ref_n = q.x();
+      p.ref_e = q.y();
+    }
+    all.add(p);
+    for (std::size_t i = zooms.size(); i < r.cfg.outages.size() && i < kMaxOutageFigures; ++i) {
+      const auto& o = r.cfg.outages[i];
+      Zoom z;
+      z.a = std::max(0.0, o.start_s - 0.1 * o.duration_s());
+      z.b = o.start_s + 1.1 * o.duration_s();
+      zooms.push_back(std::move(z));
+    }
+    for (auto& z : zooms) {
+      if (z.closed || p.t < z.a) continue;
+      if (z.pts.seen() == 0 && prev) z.pts.add(*prev);
+      z.pts.add(p);
+      if (p.t > z.b) z.closed = true;
+    }
+    prev = p;
+  }
+};
+
+namespace {
+
+/// The 3x3 error figure (error and ±1σ per axis) over [x0, x1] from @p pts.
+plot::Figure errorsFigure(const ReplayResult& r, const std::vector<FigurePoint>& pts, double x0, double x1,
+                          const std::string& title) {
+  const char* names[9] = {"north", "east", "down", "north", "east", "down", "roll", "pitch", "yaw"};
+  const char* units[3] = {"position error [m]", "velocity error [m/s]", "attitude error [deg]"};
+  const std::size_t n = pts.size();
+  std::vector<double> t(n);
+  for (std::size_t k = 0; k < n; ++k) t[k] = pts[k].t;
+  plot::Figure fig;
+  fig.width = 1800;
+  fig.height = 1200;
+  fig.rows = 3;
+  fig.cols = 3;
+  fig.title = title;
+  for (int i = 0; i < 9; ++i) {
+    plot::Axes ax;
+    ax.title = names[i];
+    if (i % 3 == 0) ax.ylabel = units[i / 3];
+    if (i >= 6) ax.xlabel = "time [s]";
+    ax.xlim = std::make_pair(x0, x1);
+    for (const auto& o : r.cfg.outages) ax.spans.push_back({"GNSS outage", o.start_s, o.end_s, {128, 128, 128}, 0.18});
+    std::vector<double> lo(n), hi(n), err(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      lo[k] = -pts[k].sig[i];
+      hi[k] = pts[k].sig[i];
+      err[k] = pts[k].err[i];
+    }
+    ax.bands.push_back({"±1σ predicted", t, lo, hi, plot::palette(0), 0.22});
+    if (r.run.has_truth)
+      ax.series.push_back({"error", t, err, plot::palette(1), plot::LineStyle::Solid, plot::Marker::None, 1.6});
+    ax.legend = i == 0 ? plot::LegendPos::Best : plot::LegendPos::None;
+    fig.axes.push_back(ax);
+  }
+  return fig;
+}
+
 /// Horizontal track in metres from the first epoch: estimate (and reference),
 /// the estimate during each outage drawn over it, its end marked.
-void writeTrajectoryFigure(const ReplayResult& r, OutputSet& out) {
-  const auto& ep = r.run.epochs;
-  if (ep.empty()) return;
-  const earth::Geodetic o0 = r.run.has_truth ? r.truth.front().geodetic() : ep.front().est.geodetic();
-  auto ne = [&](const ins::NavState& x) { return earth::geodeticToNed(o0, x.geodetic()); };
+void writeTrajectoryFigure(const ReplayResult& r, const std::vector<FigurePoint>& pts, const earth::Geodetic& o0,
+                           OutputSet& out) {
+  if (pts.empty()) return;
   plot::Axes ax;
   ax.xlabel = "east [m]";
   ax.ylabel = "north [m]";
@@ -63,28 +300,25 @@ void writeTrajectoryFigure(const ReplayResult& r, OutputSet& out) {
   plot::Series ref{"reference", {}, {}, plot::palette(6), plot::LineStyle::Dashed, plot::Marker::None, 1.2};
   plot::Series ends{"outage end (estimate)", {}, {}, plot::palette(1), plot::LineStyle::None, plot::Marker::Cross, 2.0};
   std::vector<plot::Series> outs;
-  for (std::size_t k = 0; k < ep.size(); ++k) {
-    const Eigen::Vector3d p = ne(ep[k].est);
-    est.x.push_back(p.y());
-    est.y.push_back(p.x());
+  for (const auto& p : pts) {
+    est.x.push_back(p.est_e);
+    est.y.push_back(p.est_n);
     if (r.run.has_truth) {
-      const Eigen::Vector3d q = ne(r.truth[k]);
-      ref.x.push_back(q.y());
-      ref.y.push_back(q.x());
+      ref.x.push_back(p.ref_e);
+      ref.y.push_back(p.ref_n);
     }
   }
   for (std::size_t i = 0; i < r.run.outages.size(); ++i) {
     const auto& w = r.run.outages[i];
     plot::Series s{i == 0 ? "estimate in a GNSS outage" : "", {}, {}, plot::palette(1), plot::LineStyle::Solid,
                    plot::Marker::None, 2.4};
-    for (const auto& e : ep)
-      if (e.t > w.window.start_s && e.t <= w.window.end_s + 1e-9) {
-        const Eigen::Vector3d p = ne(e.est);
-        s.x.push_back(p.y());
-        s.y.push_back(p.x());
+    for (const auto& p : pts)
+      if (p.t_abs > w.window.start_s && p.t_abs <= w.window.end_s + 1e-9) {
+        s.x.push_back(p.est_e);
+        s.y.push_back(p.est_n);
       }
     if (w.end_epoch >= 0) {
-      const Eigen::Vector3d p = ne(ep[static_cast<std::size_t>(w.end_epoch)].est);
+      const Eigen::Vector3d p = earth::geodeticToNed(o0, w.end.est.geodetic());
       ends.x.push_back(p.y());
       ends.y.push_back(p.x());
     }
@@ -155,115 +389,7 @@ void writeOutageEndFigure(const RunScore& sc, OutputSet& out) {
   plot::savePng(fig, out.stage("outage_end_error.png").string());
 }
 
-void writeReplayFigures(const ReplayResult& r, OutputSet& out) {
-  const auto& ep = r.run.epochs;
-  const std::size_t n = ep.size();
-  std::vector<double> t(n);
-  std::array<std::vector<double>, 9> err, sig;
-  for (auto& v : err) v.resize(n);
-  for (auto& v : sig) v.resize(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    t[k] = ep[k].t - r.t_zero;
-    const bool truth = r.run.has_truth;
-    for (int i = 0; i < 6; ++i) {
-      err[i][k] = ep[k].err[i];
-      sig[i][k] = ep[k].sigma[i];
-    }
-    const Eigen::Vector3d ee =
-        truth ? Eigen::Vector3d(eulerError(r.estimate[k], r.truth[k]) / kDeg) : Eigen::Vector3d::Zero();
-    const Eigen::Vector3d se = eulerSigma(truth ? r.truth[k] : r.estimate[k], ep[k].sigma.segment<3>(6)) / kDeg;
-    for (int i = 0; i < 3; ++i) {
-      err[6 + i][k] = ee[i];
-      sig[6 + i][k] = se[i];
-    }
-  }
-  const char* names[9] = {"north", "east", "down", "north", "east", "down", "roll", "pitch", "yaw"};
-  const char* units[3] = {"position error [m]", "velocity error [m/s]", "attitude error [deg]"};
-  auto figure = [&](double x0, double x1, const std::string& title) {
-    plot::Figure fig;
-    fig.width = 1800;
-    fig.height = 1200;
-    fig.rows = 3;
-    fig.cols = 3;
-    fig.title = title;
-    for (int i = 0; i < 9; ++i) {
-      plot::Axes ax;
-      ax.title = names[i];
-      if (i % 3 == 0) ax.ylabel = units[i / 3];
-      if (i >= 6) ax.xlabel = "time [s]";
-      ax.xlim = std::make_pair(x0, x1);
-      for (const auto& o : r.cfg.outages)
-        ax.spans.push_back({"GNSS outage", o.start_s, o.end_s, {128, 128, 128}, 0.18});
-      std::vector<double> lo(n), hi(n);
-      for (std::size_t k = 0; k < n; ++k) {
-        lo[k] = -sig[i][k];
-        hi[k] = sig[i][k];
-      }
-      ax.bands.push_back({"±1σ predicted", t, lo, hi, plot::palette(0), 0.22});
-      if (r.run.has_truth)
-        ax.series.push_back({"error", t, err[i], plot::palette(1), plot::LineStyle::Solid, plot::Marker::None, 1.6});
-      ax.legend = i == 0 ? plot::LegendPos::Best : plot::LegendPos::None;
-      fig.axes.push_back(ax);
-    }
-    return fig;
-  };
-  writeTrajectoryFigure(r, out);
-  if (r.score && !r.score->outages.empty()) writeOutageEndFigure(*r.score, out);
-  const double tEnd = n ? t.back() : 1.0;
-  plot::savePng(figure(0.0, tEnd,
-                       (r.run.has_truth ? "Navigation errors (estimate − truth), filter model: "
-                                        : "Predicted ±1σ (no ground truth in the rawlog), filter model: ") +
-                           r.model_source),
-                out.stage("errors_full.png").string());
-  for (std::size_t i = 0; i < r.cfg.outages.size() && i < kMaxOutageFigures; ++i) {
-    const auto& o = r.cfg.outages[i];
-    const double a = std::max(0.0, o.start_s - 0.1 * o.duration_s());
-    const double b = std::min(tEnd, o.start_s + 1.1 * o.duration_s());
-    const std::string name = "errors_outage_" + std::to_string(i + 1) + ".png";
-    plot::savePng(figure(a, b, "GNSS outage " + std::to_string(i + 1) + ": " + formatNumber(o.duration_s(), 10) + " s from " +
-                                   formatNumber(o.start_s, 10) + " s — errors and ±1σ"),
-                  out.stage(name).string());
-  }
-}
-
-
-}  // namespace
-
-std::string solutionCsv(const ReplayResult& r) {
-  std::ostringstream o;
-  o << "time_s,lat_deg,lon_deg,h_m,vN_mps,vE_mps,vD_mps,roll_deg,pitch_deg,yaw_deg,"
-       "sig_pN_m,sig_pE_m,sig_pD_m,sig_vN_mps,sig_vE_mps,sig_vD_mps,sig_roll_deg,sig_pitch_deg,sig_yaw_deg,"
-       "err_pN_m,err_pE_m,err_pD_m,err_vN_mps,err_vE_mps,err_vD_mps,err_roll_deg,err_pitch_deg,err_yaw_deg,"
-       "nees_pos,nees_vel,nees_att,nees_all,gnss\n";
-  o << std::setprecision(10);
-  for (std::size_t k = 0; k < r.run.epochs.size(); ++k) {
-    const auto& e = r.run.epochs[k];
-    const auto& x = r.estimate[k];
-    const Eigen::Vector3d rpy = x.rollPitchYaw() / kDeg;
-    const bool truth = r.run.has_truth;
-    const Eigen::Vector3d se = eulerSigma(truth ? r.truth[k] : x, e.sigma.segment<3>(6)) / kDeg;
-    const Eigen::Vector3d ee = truth ? Eigen::Vector3d(eulerError(x, r.truth[k]) / kDeg) : Eigen::Vector3d::Zero();
-    bool gnss = true;
-    for (const auto& w : r.cfg.outages)
-      if (e.t - r.t_zero > w.start_s + 1e-9 && e.t - r.t_zero <= w.end_s + 1e-9) gnss = false;
-    o << e.t - r.t_zero << ',' << std::setprecision(12) << x.lat / kDeg << ',' << x.lon / kDeg << ','
-      << std::setprecision(10) << x.h << ',' << x.v_N[0] << ',' << x.v_N[1] << ',' << x.v_N[2] << ',' << rpy[0]
-      << ',' << rpy[1] << ',' << rpy[2];
-    for (int i = 0; i < 6; ++i) o << ',' << e.sigma[i];
-    for (int i = 0; i < 3; ++i) o << ',' << se[i];
-    if (truth) {
-      for (int i = 0; i < 6; ++i) o << ',' << e.err[i];
-      for (int i = 0; i < 3; ++i) o << ',' << ee[i];
-      for (int i = 0; i < 4; ++i) o << ',' << e.nees[i];
-    } else {
-      o << ",,,,,,,,,,,,,";  // no ground truth: errors and NEES empty
-    }
-    o << ',' << (gnss ? 1 : 0) << '\n';
-  }
-  return o.str();
-}
-
-std::string summaryJson(const ReplayResult& r) {
+std::string summaryFrom(const ReplayResult& r, const ReplayWriter::State& st) {
   using nlohmann::json;
   json j;
   j["rawlog"] = r.cfg.rawlog;
@@ -288,8 +414,6 @@ std::string summaryJson(const ReplayResult& r) {
     }
   } catch (const YAML::Exception&) {
   }
-  const auto& ep = r.run.epochs;
-  auto block = [&](std::size_t k, int b) { return ep[k].err.segment<3>(3 * b); };
   json outs = json::array();
   for (std::size_t i = 0; i < r.run.outages.size(); ++i) {
     const auto& o = r.run.outages[i];
@@ -301,7 +425,8 @@ std::string summaryJson(const ReplayResult& r) {
       outs.push_back(jo);
       continue;
     }
-    const std::size_t ke = static_cast<std::size_t>(o.end_epoch);
+    const NavEpoch& e = o.end;
+    const ins::NavState& estEnd = o.end.est;
     if (r.score) {  // the scored outage (reference sigma counted in the NEES)
       for (const auto& q : r.score->outages)
         if (std::abs(q.start_s - r.cfg.outages[i].start_s) < 1e-9 &&
@@ -319,8 +444,7 @@ std::string summaryJson(const ReplayResult& r) {
         }
     }
     if (!r.run.has_truth) {  // predicted sigmas only
-      const auto& e = ep[ke];
-      const Eigen::Vector3d attSig = eulerSigma(r.estimate[ke], e.sigma.segment<3>(6)) / kDeg;
+      const Eigen::Vector3d attSig = eulerSigma(estEnd, e.sigma.segment<3>(6)) / kDeg;
       jo["end_epoch_s"] = e.t - r.t_zero;
       jo["note"] = "no ground truth: predicted sigmas only";
       jo["position"] = {{"horizontal_sigma_end_m", e.sigma.head<2>().norm()}, {"vertical_sigma_end_m", e.sigma[2]}};
@@ -330,24 +454,13 @@ std::string summaryJson(const ReplayResult& r) {
       outs.push_back(jo);
       continue;
     }
-    double maxPh = 0, maxPv = 0, maxVh = 0, maxVv = 0, neesSum = 0;
-    Eigen::Vector3d maxAtt = Eigen::Vector3d::Zero();
-    std::array<double, 4> neesB{};
-    int n = 0;
-    for (std::size_t k = 0; k <= ke; ++k) {
-      if (ep[k].t <= o.window.start_s) continue;
-      maxPh = std::max(maxPh, block(k, 0).head<2>().norm());
-      maxPv = std::max(maxPv, std::abs(block(k, 0)[2]));
-      maxVh = std::max(maxVh, block(k, 1).head<2>().norm());
-      maxVv = std::max(maxVv, std::abs(block(k, 1)[2]));
-      maxAtt = maxAtt.cwiseMax(eulerError(r.estimate[k], r.truth[k]).cwiseAbs() / kDeg);
-      for (int b = 0; b < 4; ++b) neesB[b] += ep[k].nees[b];
-      neesSum += ep[k].nees[3];
-      ++n;
-    }
-    const auto& e = ep[ke];
-    const Eigen::Vector3d attEnd = eulerError(r.estimate[ke], r.truth[ke]) / kDeg;
-    const Eigen::Vector3d attSig = eulerSigma(r.truth[ke], e.sigma.segment<3>(6)) / kDeg;
+    const OutageStats& os = st.outages.at(i);
+    const double maxPh = os.maxPh, maxPv = os.maxPv, maxVh = os.maxVh, maxVv = os.maxVv, neesSum = os.neesSum;
+    const Eigen::Vector3d& maxAtt = os.maxAtt;
+    const std::array<double, 4>& neesB = os.neesB;
+    const int n = os.n;
+    const Eigen::Vector3d attEnd = eulerError(estEnd, os.endTruth) / kDeg;
+    const Eigen::Vector3d attSig = eulerSigma(os.endTruth, e.sigma.segment<3>(6)) / kDeg;
     jo["end_epoch_s"] = e.t - r.t_zero;
     jo["position"] = {{"horizontal_error_end_m", e.err.head<2>().norm()},
                       {"vertical_error_end_m", std::abs(e.err[2])},
@@ -450,27 +563,106 @@ std::string summaryJson(const ReplayResult& r) {
   if (!r.run.has_truth) {
     j["note"] = "the rawlog has no ground truth (label GT): errors, NEES and RMS are not available; "
                 "solution.csv holds the estimate and the predicted sigmas, its error and NEES columns are empty";
-    j["epochs"] = ep.size();
+    j["epochs"] = st.epochs;
     j["notices"] = r.notices;
     return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   }
   // Overall RMS over all epochs.
-  double sPh = 0, sPv = 0, sV = 0;
-  Eigen::Vector3d sA = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < ep.size(); ++k) {
-    sPh += block(k, 0).head<2>().squaredNorm();
-    sPv += block(k, 0)[2] * block(k, 0)[2];
-    sV += block(k, 1).squaredNorm();
-    sA += (eulerError(r.estimate[k], r.truth[k]) / kDeg).cwiseAbs2();
-  }
-  const double n = std::max<std::size_t>(1, ep.size());
+  const double sPh = st.sPh, sPv = st.sPv, sV = st.sV;
+  const Eigen::Vector3d sA = st.sA;
+  const double n = std::max<std::size_t>(1, st.epochs);
   j["overall_rms"] = {{"horizontal_position_m", std::sqrt(sPh / n)},
                       {"vertical_position_m", std::sqrt(sPv / n)},
                       {"velocity_3d_mps", std::sqrt(sV / n)},
                       {"roll_pitch_yaw_deg", {std::sqrt(sA[0] / n), std::sqrt(sA[1] / n), std::sqrt(sA[2] / n)}},
-                      {"epochs", ep.size()}};
+                      {"epochs", st.epochs}};
   j["notices"] = r.notices;
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+}  // namespace
+
+ReplayWriter::ReplayWriter(OutputSet* out) : out_(out), st_(std::make_unique<State>()) {
+  if (!out_) return;
+  st_->csvPath = out_->stage("solution.csv");
+  st_->buffer.resize(std::size_t(1) << 20);
+  st_->file.rdbuf()->pubsetbuf(st_->buffer.data(), static_cast<std::streamsize>(st_->buffer.size()));
+  st_->file.open(st_->csvPath, std::ios::binary);
+  if (!st_->file) throw Error(st_->csvPath.string() + ": cannot write");
+  st_->csv = &st_->file;
+}
+
+ReplayWriter::ReplayWriter(std::ostream& csv) : st_(std::make_unique<State>()) { st_->csv = &csv; }
+
+ReplayWriter::~ReplayWriter() = default;
+
+void ReplayWriter::begin(const ReplayResult& r) {
+  st_->begin(r);
+  if (st_->csv) *st_->csv << kSolutionHeader;
+}
+
+void ReplayWriter::epoch(const ReplayResult& r, const NavEpoch& e, const ins::NavState* truth,
+                         const std::vector<Outage>& windows) {
+  st_->epoch(r, e, truth, windows);
+}
+
+void ReplayWriter::feed(const ReplayResult& r) {
+  std::vector<Outage> windows;
+  for (const auto& o : r.run.outages) windows.push_back(o.window);
+  begin(r);
+  for (std::size_t k = 0; k < r.run.epochs.size(); ++k)
+    epoch(r, r.run.epochs[k], r.run.has_truth ? &r.truth[k] : nullptr, windows);
+}
+
+std::string ReplayWriter::summary(const ReplayResult& r) const { return summaryFrom(r, *st_); }
+
+void ReplayWriter::finish(const ReplayResult& r) {
+  if (!out_) throw Error("replay writer: no output folder");
+  State& st = *st_;
+  st.file.flush();
+  if (!st.file) throw Error(st.csvPath.string() + ": cannot write (disk full?)");
+  st.file.close();
+  out_->writeText("summary.json", summaryFrom(r, st));
+  // wall-clock figures apart, so that two identical runs give identical result files
+  const nlohmann::json t = {{"replay_wall_s", r.run.wall_s}, {"rawlog_read_wall_s", r.read_s}};
+  out_->writeText("timing.json", t.dump(1) + "\n");
+  // figures
+  const std::vector<FigurePoint> pts = st.all.points();
+  writeTrajectoryFigure(r, pts, st.o0, *out_);
+  if (r.score && !r.score->outages.empty()) writeOutageEndFigure(*r.score, *out_);
+  const double tEnd = pts.empty() ? 1.0 : pts.back().t;
+  const std::string every =
+      st.all.stride() > 1 ? " (every " + std::to_string(st.all.stride()) + "th epoch drawn)" : std::string();
+  plot::savePng(errorsFigure(r, pts, 0.0, tEnd,
+                             (r.run.has_truth ? "Navigation errors (estimate − truth), filter model: "
+                                              : "Predicted ±1σ (no ground truth in the rawlog), filter model: ") +
+                                 r.model_source + every),
+                out_->stage("errors_full.png").string());
+  for (std::size_t i = 0; i < r.cfg.outages.size() && i < kMaxOutageFigures; ++i) {
+    const auto& o = r.cfg.outages[i];
+    const double a = std::max(0.0, o.start_s - 0.1 * o.duration_s());
+    const double b = std::min(tEnd, o.start_s + 1.1 * o.duration_s());
+    const std::string name = "errors_outage_" + std::to_string(i + 1) + ".png";
+    // all epochs when none was dropped (the same figure as over the whole series), else the zoom's own
+    const std::vector<FigurePoint> zp = st.all.stride() == 1 || i >= st.zooms.size() ? pts : st.zooms[i].pts.points();
+    plot::savePng(errorsFigure(r, zp, a, b,
+                               "GNSS outage " + std::to_string(i + 1) + ": " + formatNumber(o.duration_s(), 10) +
+                                   " s from " + formatNumber(o.start_s, 10) + " s — errors and ±1σ"),
+                  out_->stage(name).string());
+  }
+}
+
+std::string solutionCsv(const ReplayResult& r) {
+  std::ostringstream o;
+  ReplayWriter w(o);
+  w.feed(r);
+  return o.str();
+}
+
+std::string summaryJson(const ReplayResult& r) {
+  ReplayWriter w(nullptr);
+  w.feed(r);
+  return w.summary(r);
 }
 
 std::string replaySummary(const ReplayResult& r) {
@@ -479,9 +671,9 @@ std::string replaySummary(const ReplayResult& r) {
   for (const auto& n : r.notices) s += "notice: " + n + "\n";
   std::snprintf(b, sizeof b,
                 "replayed %s: %zu IMU steps at %g Hz, %zu GNSS and %zu baro updates, filter model %s "
-                "(rawlog read %.3f s CPU, filter %.3f s)\n",
+                "(%.3f s wall, %.3f s of it reading the rawlog)\n",
                 r.cfg.rawlog.c_str(), r.run.steps, r.imu_rate_hz, r.run.gnss_updates, r.run.baro_updates,
-                r.model_source.c_str(), r.read_s, r.run.wall_s);
+                r.model_source.c_str(), r.run.wall_s, r.read_s);
   s += b;
   if (!r.run.has_truth) s += "no ground truth in the rawlog: estimate and predicted sigmas only\n";
   if (!r.run.rejected.empty()) {
@@ -518,7 +710,7 @@ std::string replaySummary(const ReplayResult& r) {
   for (std::size_t i = 0; i < r.run.outages.size() && i < 20; ++i) {
     const auto& w = r.run.outages[i];
     if (w.end_epoch < 0) continue;
-    const auto& e = r.run.epochs[static_cast<std::size_t>(w.end_epoch)];
+    const auto& e = w.end;
     const auto& o = r.cfg.outages[i];
     if (!r.run.has_truth)
       std::snprintf(b, sizeof b, "outage %zu (%g s from %g s): predicted horizontal 1-sigma at end %.2f m, vertical %.2f m\n",
@@ -535,12 +727,9 @@ std::string replaySummary(const ReplayResult& r) {
 }
 
 void writeReplayOutputs(const ReplayResult& r, OutputSet& out) {
-  out.writeText("solution.csv", solutionCsv(r));
-  out.writeText("summary.json", summaryJson(r));
-  // wall-clock figures apart, so that two identical runs give identical result files
-  const nlohmann::json t = {{"filter_wall_s", r.run.wall_s}, {"rawlog_read_cpu_s", r.read_s}};
-  out.writeText("timing.json", t.dump(1) + "\n");
-  writeReplayFigures(r, out);
+  ReplayWriter w(&out);
+  w.feed(r);
+  w.finish(r);
 }
 
 }  // namespace navimpact::report

@@ -37,8 +37,13 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -138,15 +143,17 @@ struct NavEpoch {
 /// What one outage did to this run.
 struct OutageSummary {
   Outage window;                    ///< the outage, absolute filter time [s]
-  int end_epoch = -1;               ///< index into NavRunResult::epochs of the last epoch <= end (-1: none)
+  int end_epoch = -1;               ///< index of the last recorded epoch in (start, end] (-1: none)
+  NavEpoch end;                     ///< that epoch (kept also when the epochs are not)
   double max_drift_h = 0.0;         ///< max horizontal position error over the epochs in (start, end] [m]
+  double max_drift_v = 0.0;         ///< max |vertical position error| over the same epochs [m]
   double max_drift_3d = 0.0;        ///< max 3-D position error over the same epochs [m]
 };
 
 /// Result of one run.
 struct NavRunResult {
   bool has_truth = true;            ///< false: errors, NEES and outage drifts are absent (NaN / 0)
-  std::vector<NavEpoch> epochs;     ///< one per truth epoch inside the IMU span (or per record interval)
+  std::vector<NavEpoch> epochs;     ///< one per truth epoch inside the IMU span (or per record interval); empty when not kept
   std::vector<OutageSummary> outages;  ///< one per NavRunOptions::outages
   int states = 0;                   ///< EKF state count
   std::size_t steps = 0;            ///< IMU samples processed
@@ -175,6 +182,56 @@ struct NavRunResult {
  */
 NavRunResult runNav(const NavRunInput& in, const stochastic::ImuModel& model,
                     const NavRunOptions& opt);
+
+/**
+ * The navigation loop of runNav() fed one IMU sample at a time, for data that
+ * are not held in memory (a long rawlog read record by record). runNav() is
+ * this runner over vectors, so both give the same numbers.
+ *
+ * Contract: measurements of each kind are added in time order, and every GNSS
+ * fix, barometer sample and truth epoch with t <= s.t + s.dt / 2 is added
+ * before step(s) (before start() for those at x0.t + dt0 / 2); an outage is
+ * added before any fix it covers is reached. Measurements are kept only until
+ * the filter time reaches them, so memory is bounded by what the caller adds
+ * ahead (plus the epochs when keep_epochs).
+ */
+class NavRunner {
+ public:
+  /// @param x0        initial estimate at x0.t.
+  /// @param dt0       interval of the first IMU sample [s] (> 0).
+  /// @param has_truth epochs at the truth epochs with errors (true), or every record_interval_s.
+  /// @throws navimpact::Error as runNav() for bad options.
+  NavRunner(const ins::NavState& x0, double dt0, bool has_truth, const stochastic::ImuModel& model,
+            const NavRunOptions& opt);
+  ~NavRunner();
+  NavRunner(const NavRunner&) = delete;
+  NavRunner& operator=(const NavRunner&) = delete;
+
+  void addGnss(const GnssFix& f);
+  void addBaro(const BaroSample& b);
+  void addTruth(double t, const ins::NavState& x);
+  /// A GNSS outage (absolute filter time), appended to NavRunResult::outages.
+  void addOutage(const Outage& o);
+  /// The measurements at x0.t and the first epoch; once, before step().
+  void start();
+  /// One IMU sample (contiguous with the previous one).
+  void step(const ins::ImuSample& s);
+  /// The result; the runner is done.
+  NavRunResult finish();
+
+  /// Called with each recorded epoch and the truth state at it (nullptr without truth).
+  std::function<void(const NavEpoch& e, const ins::NavState* truth)> on_epoch;
+  /// Keep the epochs in NavRunResult::epochs (false: only on_epoch sees them).
+  bool keep_epochs = true;
+  /// The outages added so far (absolute filter time).
+  const std::vector<Outage>& outages() const;
+  /// Epochs recorded so far.
+  std::size_t epochCount() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// The data of one emulated run, owned; input() points a NavRunInput at them.
 struct EmulatedRun {

@@ -74,6 +74,11 @@
 
 namespace navimpact::analysis {
 
+/// IMU samples read ahead before the filter starts: their median interval is
+/// the nominal step (gaps are measured against it), and the reference (GT)
+/// entries among them tell whether the filter can start from the reference
+/// (complete entries, one at time zero) or needs an aligning phase.
+constexpr std::size_t kReplayLookaheadImu = 16384;
 /// An IMU interval longer than this many nominal (median) steps is a gap.
 constexpr double kImuGapSteps = 1.5;
 /// Largest accepted filter.max_imu_gap_s [s].
@@ -130,7 +135,7 @@ struct ReplayResult {
   NavRunResult run;                         ///< errors, sigmas, NEES at the GT epochs (run.has_truth)
   std::vector<ins::NavState> truth;         ///< truth at the epochs (empty without GT)
   std::vector<ins::NavState> estimate;      ///< estimate at the epochs
-  double read_s = 0.0;                      ///< CPU time of reading the rawlog [s]
+  double read_s = 0.0;                      ///< wall-clock time spent reading the rawlog [s]
   std::size_t imu_gaps = 0;                 ///< IMU gaps propagated across (allowed by max_imu_gap_s)
   std::vector<std::string> notices;
   /// The aligning phase (rawlogs without GT): from time zero to report.t_end the
@@ -144,10 +149,45 @@ struct ReplayResult {
 };
 
 /**
- * Run a replay: read the rawlog, check outages against the data, run the EKF.
+ * What a replay that keeps nothing per epoch hands on as it goes (the report
+ * layer writes solution.csv row by row and keeps bounded figure series).
+ */
+class ReplayObserver {
+ public:
+  virtual ~ReplayObserver() = default;
+  /// Once, before the first epoch: @p r has its configuration, time zero,
+  /// IMU rate, filter model and alignment (notices, score and run come at the end).
+  virtual void begin(const ReplayResult& r) = 0;
+  /// One recorded epoch and the reference state at it (nullptr without one).
+  /// @p windows: the outages so far in filter time (NavRunResult::outages
+  /// order), r.cfg.outages the same from time zero; both hold every outage
+  /// that contains the epoch or started before it.
+  virtual void epoch(const ReplayResult& r, const NavEpoch& e, const ins::NavState* truth,
+                     const std::vector<Outage>& windows) = 0;
+};
+
+/**
+ * Run a replay: the rawlog is read record by record while the EKF runs over
+ * it, with a bounded read-ahead (kReplayLookaheadImu IMU samples at the
+ * start; during the run up to half an IMU step, and before each outage of
+ * `outages_every` to its end: windows are laid from the filter start and an
+ * outage exists only when the data reach its end). Explicit outages are
+ * checked against the data's end when it is reached (an error then, after
+ * the run: nothing is written).
+ * Everything per epoch is kept in the result (run.epochs, estimate, truth,
+ * gnss, baro): memory grows with the run's length.
  * @throws navimpact::Error for a rawlog without IMU, without GT and without a
  *         GNSS fix at time zero, an outage outside the data, a missing model.
  */
 ReplayResult runReplay(const ReplayConfig& cfg);
+
+/**
+ * The same replay in bounded memory: each epoch goes to @p observer and is not
+ * kept (the result's run.epochs, estimate, truth, gnss and baro stay empty;
+ * run.outages keep their end epochs, the score is complete). Memory is the
+ * read-ahead, the outage summaries, the gate events and the GNSS innovations
+ * (one per fix), independent of the IMU rate and of the number of epochs.
+ */
+ReplayResult runReplay(const ReplayConfig& cfg, ReplayObserver& observer);
 
 }  // namespace navimpact::analysis

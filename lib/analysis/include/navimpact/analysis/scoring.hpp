@@ -99,4 +99,24 @@ double percentile(std::vector<double> v, double q);
  */
 RunScore scoreRun(const NavRunResult& run, double t_zero, double aided_from, const ReferenceInfo& ref);
 
+/// scoreRun() fed epoch by epoch, for a run whose epochs are not kept
+/// (NavRunner::keep_epochs false): the same numbers in the same order.
+class RunScorer {
+ public:
+  /// @param aided_from  as scoreRun().
+  explicit RunScorer(double aided_from) : aided_from_(aided_from) {}
+  /// One epoch, with the outages known so far (every outage containing it).
+  void add(const NavEpoch& e, const std::vector<Outage>& outages);
+  /// The score (outages from run.outages: OutageSummary::end and the drifts) with
+  /// the reference's uncertainty and content @p ref (known once it was all read).
+  /// @throws navimpact::Error as scoreRun().
+  RunScore finish(const NavRunResult& run, double t_zero, const ReferenceInfo& ref) const;
+
+ private:
+  double aided_from_;
+  std::size_t aided_epochs_ = 0;
+  double sh_ = 0.0, sv_ = 0.0, svel_ = 0.0;
+  Eigen::Vector3d satt_ = Eigen::Vector3d::Zero();
+};
+
 }  // namespace navimpact::analysis

@@ -94,6 +94,8 @@ void writeRawlog(const std::string& path, const Recording& data, const RawlogWri
  *         without a scenario origin or with only some of its velocity or
  *         attitude fields.
  */
+/// (This is rawlog::RawlogReader, reader.hpp, collecting every record; read a
+/// long rawlog with that reader to keep memory bounded.)
 Recording readRawlog(const std::string& path, const RawlogReadOptions& opt = {});
 
 }  // namespace navimpact::rawlog
