@@ -306,6 +306,7 @@ std::string describe(const Diagnosis& d) {
     for (const auto& f : c.findings) {
       s += " [" + c.name + " " + causeName(f.cause);
       for (const auto& kv : f.params) s += " " + kv.first + "=" + formatNumber(kv.second, 4);
+      if (!f.decided) s += " undecided vs " + f.runner_up;
       s += "]";
     }
   return s;

@@ -1221,6 +1221,12 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
                           formatNumber(c.half_width / rate, 3) + " s window contrast at " + formatNumber(c.z, 3) + " sd).";
           f.evidence = "likelihood ratio " + formatNumber(t.lr, 4) + " for a shift here against the best stochastic explanation without shifts, " +
                        ext0 + " (" + how + "; p = " + formatNumber(t.p_value, 3) + ")";
+          // Decided by the test (it rejected the best explanation without
+          // shifts at the Bonferroni level); the AIC margin for the record.
+          f.runner_up = causeName(Cause::RandomWalk);
+          f.runner_up_detail = "the best stochastic explanation without shifts, " + ext0 + ", a random walk allowed";
+          f.aic_margin = t.lr - 4.0;  // the shift's size and time
+          f.decided = true;
           f.action = "segment the record at t = " + formatNumber(tt, 6) +
                      " s (estimate the model on each part) or remove the step; a stationary filter state cannot represent a one-off jump";
           cd.findings.push_back(f);
@@ -1330,6 +1336,75 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
       if (isSlow(e.terms[i])) return true;
     return false;
   };
+  // Regressors of the block means: the mean, a trend when the model has a
+  // drift, and optionally a level shift at block boundary @p step.
+  auto blockRegressors = [&](bool trend, std::size_t step) {
+    Eigen::MatrixXd X(static_cast<Eigen::Index>(yb.size()), 1 + (trend ? 1 : 0) + (step > 0 ? 1 : 0));
+    for (std::size_t k = 0; k < yb.size(); ++k) {
+      const auto r = static_cast<Eigen::Index>(k);
+      X(r, 0) = 1.0;
+      if (trend) X(r, 1) = (static_cast<double>(k) + 0.5) / static_cast<double>(yb.size()) - 0.5;
+      if (step > 0) X(r, X.cols() - 1) = k >= step ? 1.0 : 0.0;
+    }
+    return X;
+  };
+  // AIC on the exact likelihood of the block means of an extension: only its
+  // new terms profiled (a drift's slope is the GLS trend), their parameters
+  // counted. NaN when the likelihood cannot be evaluated.
+  auto exactAic = [&](const Extension& e, double* loglik) {
+    Model mc = withoutSin(assemble(m0n, e.terms));
+    const Eigen::MatrixXd X = blockRegressors(mc.count(ProcessKind::DR) > 0, 0);
+    std::vector<int> own;
+    for (std::size_t q = e.terms.size() - e.added; q < e.terms.size(); ++q)
+      if (e.terms[q].kind != ProcessKind::DR) own.push_back(assembledIndex(m0n, e.terms, q));
+    if (own.empty()) own.push_back(-1);
+    try {
+      const double l = stochastic::profileBlockLogLikelihood(mc, yb, blk, X, own);
+      *loglik = l;
+      return -2.0 * l + penalty(e.terms, e.terms.size() - e.added);
+    } catch (const Error&) {
+      return kNaN;
+    }
+  };
+  // The best single level shift on top of @p terms (block boundaries in the
+  // middle 90 %, every 4th then refined): exact AIC with the shift's size and
+  // time as its two parameters; *t_s, *size where it sits.
+  auto bestShiftAic = [&](const std::vector<Candidate>& terms, double* t_s, double* size) {
+    const Model mb = withoutSin(assemble(m0n, terms));
+    const bool trend = mb.count(ProcessKind::DR) > 0;
+    const std::size_t nb = yb.size(), k0 = std::max<std::size_t>(1, nb / 20), k1 = nb - k0;
+    double best_l = -std::numeric_limits<double>::infinity();
+    std::size_t best_k = 0;
+    double best_size = kNaN;
+    auto at = [&](std::size_t k) {
+      try {
+        const auto r = stochastic::blockLogLikelihood(mb, yb, blk, blockRegressors(trend, k));
+        if (r.loglik > best_l) {
+          best_l = r.loglik;
+          best_k = k;
+          best_size = r.beta(r.beta.size() - 1);
+        }
+      } catch (const Error&) {
+      }
+    };
+    for (std::size_t k = k0; k <= k1; k += 4) at(k);
+    const std::size_t c = best_k;
+    for (std::size_t k = c > k0 + 3 ? c - 3 : k0; k <= std::min(k1, c + 3); ++k)
+      if (k != c) at(k);
+    if (best_k == 0) return kNaN;
+    *t_s = t0 + static_cast<double>(best_k * blk) / rate;
+    *size = best_size;
+    return -2.0 * best_l + 4.0;
+  };
+  auto causesOf = [&](const Extension& e) {
+    std::vector<std::string> c;
+    for (std::size_t q = e.terms.size() - e.added; q < e.terms.size(); ++q) c.push_back(causeName(causeOf(e.terms[q].kind)));
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+    std::string j;
+    for (const auto& x : c) j += (j.empty() ? "" : "+") + x;
+    return j;
+  };
   const WvTest wt = wvTest(full, p_thr);
   std::vector<Candidate> S;          // the terms found, backfitted on the whole record
   std::vector<std::size_t> found_at;  // S[i]'s finding in cd.findings
@@ -1351,6 +1426,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     // Slow explanations compared by the exact Gaussian likelihood of the block
     // means (the new terms' variances profiled, a drift's slope by GLS), AIC.
     std::string exact_evidence;
+    std::vector<std::pair<double, int>> ranked_exact;  // (exact AIC, extension) when the slow ones were ranked
     if (hasSlow(ext[best]) && yb.size() >= 16) {
       const auto key = fastPart(ext[best]);
       std::vector<std::pair<double, int>> ranked;
@@ -1360,24 +1436,11 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
       for (int i : pool) {
         const Extension& e = ext[i];
         if (!hasSlow(e) || fastPart(e) != key) continue;
-        Model mc = withoutSin(assemble(m0n, e.terms));
-        const bool trend = mc.count(ProcessKind::DR) > 0;
-        Eigen::MatrixXd X(static_cast<Eigen::Index>(yb.size()), trend ? 2 : 1);
-        for (std::size_t k = 0; k < yb.size(); ++k) {
-          X(static_cast<Eigen::Index>(k), 0) = 1.0;
-          if (trend) X(static_cast<Eigen::Index>(k), 1) = (static_cast<double>(k) + 0.5) / static_cast<double>(yb.size()) - 0.5;
-        }
-        // Only the new terms are profiled (a drift's slope is the GLS trend).
-        std::vector<int> own;
-        for (std::size_t q = e.terms.size() - e.added; q < e.terms.size(); ++q)
-          if (e.terms[q].kind != ProcessKind::DR) own.push_back(assembledIndex(m0n, e.terms, q));
-        if (own.empty()) own.push_back(-1);
-        try {
-          const double l = stochastic::profileBlockLogLikelihood(mc, yb, blk, X, own);
-          loglik[i] = l;
-          ranked.push_back({-2.0 * l + penalty(e.terms, e.terms.size() - e.added), i});
-        } catch (const Error&) {
-        }
+        double l = kNaN;
+        const double aic = exactAic(e, &l);
+        if (!std::isfinite(aic)) continue;
+        loglik[i] = l;
+        ranked.push_back({aic, i});
       }
       std::stable_sort(ranked.begin(), ranked.end());
       // The reference is the best explanation with the fewest terms whose
@@ -1417,6 +1480,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
           ranked = kept;
         }
       }
+      ranked_exact = ranked;
       if (ranked.size() >= 2) {
         const int wv_best = best;
         best = ranked[0].second;
@@ -1461,6 +1525,51 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
                               : ", both needed by the exact likelihood (nested likelihood ratio at 1 %)");
     }
     evidence += exact_evidence;
+    // The runner-up naming other causes, on the criterion that chose (the
+    // exact likelihood among the slow explanations, else the WV AIC), and a
+    // single level shift against a slow explanation (a shift near its
+    // detection limit that the shift test could not accept looks like a
+    // random walk): decided only when the winner is lower by at least 2 in
+    // AIC (below 2 both have substantial support; Burnham & Anderson 2002,
+    // §2.6).
+    std::string ru, ru_detail;
+    double ru_margin = kNaN;
+    {
+      const std::string mine = causesOf(win);
+      if (ranked_exact.size() >= 2 && ranked_exact[0].second == best) {
+        for (const auto& r : ranked_exact)
+          if (causesOf(ext[r.second]) != mine) {
+            ru = causesOf(ext[r.second]);
+            ru_detail = newTermsText(ext[r.second]) + " (exact likelihood of " + std::to_string(yb.size()) + " block means)";
+            ru_margin = r.first - ranked_exact[0].first;
+            break;
+          }
+      } else {
+        for (int i : order)
+          if (i != best && causesOf(ext[i]) != mine) {
+            ru = causesOf(ext[i]);
+            ru_detail = newTermsText(ext[i]) + " (WV deviance)";
+            ru_margin = ext[i].crit - win.crit;
+            break;
+          }
+      }
+      if (hasSlow(win) && yb.size() >= 16) {
+        double l_slow = kNaN, t_shift = kNaN, size_shift = kNaN;
+        double aic_slow = kNaN;
+        for (const auto& r : ranked_exact)
+          if (r.second == best) aic_slow = r.first;
+        if (!std::isfinite(aic_slow)) aic_slow = exactAic(win, &l_slow);
+        const double aic_shift = bestShiftAic(S, &t_shift, &size_shift);
+        if (std::isfinite(aic_slow) && std::isfinite(aic_shift) &&
+            (!std::isfinite(ru_margin) || aic_shift - aic_slow < ru_margin)) {
+          ru = causeName(Cause::LevelShift);
+          ru_detail = "a level shift of " + formatNumber(size_shift, 3) + " " + unit + " at t = " + formatNumber(t_shift, 6) +
+                      " s (exact likelihood of " + std::to_string(yb.size()) + " block means: AIC " +
+                      formatNumber(aic_shift, 7) + " against " + formatNumber(aic_slow, 7) + ")";
+          ru_margin = aic_shift - aic_slow;
+        }
+      }
+    }
     for (std::size_t q = win.terms.size() - win.added; q < win.terms.size(); ++q) {
       Finding nf;
       nf.channel = cd.name;
@@ -1468,6 +1577,10 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
       nf.threshold = p_thr;
       nf.p_value = std::min(1.0, pmin * J * sh.channels / 0.4);  // Bonferroni over scales and channels (WV share)
       nf.evidence = evidence;
+      nf.runner_up = ru;
+      nf.runner_up_detail = ru_detail;
+      nf.aic_margin = ru_margin;
+      nf.decided = ru.empty() || !(ru_margin < 2.0);
       cd.findings.push_back(nf);
       found_at.push_back(cd.findings.size() - 1);
     }
@@ -1491,6 +1604,10 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     nf.threshold = f.threshold;
     nf.p_value = f.p_value;
     nf.evidence = f.evidence;
+    nf.runner_up = f.runner_up;
+    nf.runner_up_detail = f.runner_up_detail;
+    nf.aic_margin = f.aic_margin;
+    nf.decided = f.decided;
     f = nf;
     added_params += S[i].params;
   }

@@ -46,6 +46,12 @@ json findingJson(const Finding& f) {
     j["intervals_95"] = iv;
   }
   if (!f.evidence.empty()) j["evidence"] = f.evidence;
+  j["decided"] = f.decided;
+  if (!f.runner_up.empty()) {
+    j["runner_up"] = f.runner_up;
+    j["runner_up_detail"] = f.runner_up_detail;
+    j["aic_margin"] = num(f.aic_margin);
+  }
   if (!f.harmonics_hz.empty()) j["harmonics_hz"] = f.harmonics_hz;
   if (f.event >= 0) j["event"] = f.event;
   return j;
@@ -256,7 +262,9 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
         int count = 0;
         for (std::size_t k = i; k < c.findings.size(); ++k) {
           const Finding& f = c.findings[k];
-          if (done[k] || f.cause != f0.cause || f.direction != f0.direction) continue;
+          if (done[k] || f.cause != f0.cause || f.direction != f0.direction || f.decided != f0.decided ||
+              f.runner_up != f0.runner_up)
+            continue;
           done[k] = true;
           ++count;
           pmin = std::min(pmin, f.p_value);
@@ -279,6 +287,7 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
         }
         if (count > 1) cause = std::to_string(count) + " × " + cause;
         if (f0.direction == "overstated") cause += " (overstated)";
+        if (!f0.decided) cause = "undecided between " + cause + " and " + f0.runner_up;
         if (!events.empty()) {
           cause += " [event";
           for (int e : events) cause += " " + std::to_string(e);
@@ -333,8 +342,19 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
     if (c.findings.empty() && c.notes.empty()) continue;
     r << "## " << c.name << "\n\n`" << modelText(c.model_before) << "` → `" << modelText(c.model_after) << "`\n\n";
     for (const auto& f : c.findings) {
-      r << "- **" << causeName(f.cause) << "**: " << f.explanation;
+      r << "- **" << (f.decided ? std::string(causeName(f.cause))
+                                : "undecided between " + std::string(causeName(f.cause)) + " and " + f.runner_up)
+        << "**: " << f.explanation;
       if (!f.evidence.empty()) r << " *Evidence:* " << f.evidence << ".";
+      if (!f.decided) {
+        r << " *Undecided:* the runner-up, " << f.runner_up_detail << ", ";
+        if (f.aic_margin >= 0)
+          r << "is only " << formatNumber(f.aic_margin, 3) << " above it in AIC (decided from a margin of 2).";
+        else
+          r << "is " << formatNumber(-f.aic_margin, 3) << " below it in AIC"
+            << (f.runner_up == "level_shift" ? ", but the level-shift test did not reject the record's stochastic explanation at its family-wise level."
+                                             : ".");
+      }
       r << " *What to do:* " << f.action << ".\n";
     }
     for (const auto& n : c.notes) r << "- Note: " << n << ".\n";
@@ -384,9 +404,11 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
        "- **Wavelet variance:** measured Haar WV of the cleaned record against the model's, chi-square CI "
        "(dof lowered to what "
     << d.options.simulations << " simulations of the model show, seed " << d.options.seed
-    << "), Bonferroni over scales; each process family (or a retuned term) fitted to the excess by the chi-square "
-       "deviance, chosen by AIC on the whole record (runner-up given as evidence); no term below one CI width, no "
-       "GM with T beyond a fifth of the record.\n"
+    << "), Bonferroni over scales; each process family (or a retuned term), and each pair fitted jointly, fitted "
+       "to the excess by the chi-square deviance, chosen by AIC on the whole record (runner-up given as evidence; "
+       "slow explanations ranked again on the exact likelihood of block means, and compared with a single level "
+       "shift there); no term below one CI width, no GM with T beyond a fifth of the record. A finding whose "
+       "runner-up naming another cause is within 2 in AIC is \"undecided between\" the two.\n"
        "- **Gain:** the first-half extension against the model on the held-out second half; one-sided paired z "
        "test over the scales of the per-scale deviance.\n"
        "- The family-wise level is split WV 40 %, lines 20 %, level shifts 20 %, outliers 20 %, each over the "

@@ -50,6 +50,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -102,6 +103,16 @@ struct Finding {
   std::vector<std::pair<std::string, std::pair<double, double>>> intervals;
   /// Why this cause and not the runner-up explanation (one sentence).
   std::string evidence;
+  /// The runner-up explanation: its cause(s) in the vocabulary of `cause`
+  /// ('+' between several; "" when none was compared), in words, and the
+  /// margin of the winner on the criterion that chose (AIC units; NaN when
+  /// the choice was a detector's test).
+  std::string runner_up;
+  std::string runner_up_detail;
+  double aic_margin = std::numeric_limits<double>::quiet_NaN();
+  /// false: the evidence between the finding and its runner-up is not
+  /// decisive (AIC margin below 2); the report says "undecided between".
+  bool decided = true;
   std::vector<double> harmonics_hz;  ///< sinusoid: harmonics of the line found with it [Hz]
   int event = -1;                    ///< index in Diagnosis::events (cross-channel), -1 if none
   double get(const std::string& key) const;             ///< params lookup (NaN if absent)
