@@ -55,7 +55,10 @@ set_tests_properties(cli_emulate_bad_gzip_level PROPERTIES WILL_FAIL TRUE)
 # Values beyond their documented physical range are refused at load, naming the key.
 foreach(_case "baro_sigma|imu: {errors: none}\nbaro: {sigma_m: 1e308}|key 'baro.sigma_m': must be in .0, 10000. m, got 1e.308"
               "lever_arm|imu: {errors: none}\ngnss: {lever_arm_B_m: [0, 1e308, 0]}|key 'gnss.lever_arm_B_m.1.': must be in .-100, 100. m"
-              "imu_rate|imu: {rate_hz: 1e7, errors: none}|key 'imu.rate_hz': must be in .1, 10000. Hz, got 1e.07")
+              "imu_rate|imu: {rate_hz: 1e7, errors: none}|key 'imu.rate_hz': must be in .1, 10000. Hz, got 1e.07"
+              "knot_step_tiny|imu: {errors: none}\nsmoothing: {knot_step_s: 1e-308}|key 'smoothing.knot_step_s': cutoff 1 Hz times knot step 1e-308 s is 1e-308, below 0.0002"
+              "cutoff_tiny|imu: {errors: none}\nsmoothing: {position_cutoff_hz: 1e-308}|key 'smoothing.position_cutoff_hz': cutoff 1e-308 Hz"
+              "knots_finer_than_samples|imu: {errors: none}\nsmoothing: {knot_step_s: 0.0001, position_cutoff_hz: 2, attitude_cutoff_hz: 2}|uav_flight_260s.csv.gz: smoothing spline: knot step 0.0001 s gives 300000 knot intervals for 3001 samples .at most 64 per sample")
   string(REPLACE "|" ";" _p "${_case}")
   list(GET _p 0 _n)
   list(GET _p 1 _body)

@@ -33,3 +33,10 @@ navimpact_cli_check(cli_replay_outages_every CHECK run_json
 navimpact_cli_fail(cli_replay_outages_every_bad
   ARGS replay --rawlog ${_rlog} --outages-every 15:40 --out ${_rdir}/everybad
   REGEX "PERIOD > DURATION" NOOUT ${_rdir}/everybad)
+
+# A gate below the chi-square median would reject most innovations of a
+# consistent filter: refused at load, naming the key.
+file(WRITE ${_rdir}/gate_tiny.yaml "rawlog: ${_rlog}\nfilter: {gate_probability: 1e-308}\n")
+navimpact_cli_fail(cli_replay_gate_below_median
+  ARGS replay --config ${_rdir}/gate_tiny.yaml --out ${_rdir}/gate_tiny
+  REGEX "gate_tiny.yaml: key 'filter.gate_probability': must be 0 \\(gate off\\) or in .0.5, 1." NOOUT ${_rdir}/gate_tiny)

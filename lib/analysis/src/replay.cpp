@@ -93,7 +93,12 @@ void ReplayConfig::loadFrom(const ConfigNode& root) {
     f->read("max_imu_gap_s", c.max_imu_gap_s, limits::Range{0.0, kMaxImuGapS, false, "s"});
     f->read("propagate_every", c.propagate_every, 1, limits::kMaxPropagateEvery);
     f->read("use_gnss_velocity", c.use_gnss_velocity);
-    f->read("gate_probability", c.gate_probability, limits::Range{0.0, 1.0, false, "(probability; 0 = gate off)"});
+    if (f->read("gate_probability", c.gate_probability, limits::Range{0.0, 1.0, false, "(probability; 0 = gate off)"}) &&
+        !(c.gate_probability == 0.0 ||
+          (c.gate_probability >= filter::kMinGateProbability && c.gate_probability < 1.0)))
+      throw f->error("gate_probability", "must be 0 (gate off) or in [" + formatNumber(filter::kMinGateProbability, 3) +
+                                             ", 1) (a gate below the median rejects most consistent innovations), got " +
+                                             formatNumber(c.gate_probability, 9));
     f->read("gate_readmit_after", c.gate_readmit_after, 0, 1000);
   }
   if (const auto p = root.optMap("initial_sigma")) {

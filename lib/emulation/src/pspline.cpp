@@ -5,6 +5,7 @@
 #include <string>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::emulation {
 
@@ -58,16 +59,28 @@ double horner(const Poly& c, double u) {
 
 }  // namespace
 
+std::string checkSmoothing(double cutoff_hz, double knot_step_s) {
+  if (!(cutoff_hz > 0.0) || !(knot_step_s > 0.0)) return "cutoff_hz and knot_step_s must be > 0";
+  const double fh = cutoff_hz * knot_step_s;
+  if (fh > kMaxCutoffTimesKnotStep)
+    return "knot step " + formatNumber(knot_step_s, 6) + " s cannot resolve the cutoff " + formatNumber(cutoff_hz, 6) +
+           " Hz (need knot_step_s <= 1/(4 cutoff_hz))";
+  if (fh < kMinCutoffTimesKnotStep)
+    return "cutoff " + formatNumber(cutoff_hz, 6) + " Hz times knot step " + formatNumber(knot_step_s, 6) + " s is " +
+           formatNumber(fh, 3) + ", below " + formatNumber(kMinCutoffTimesKnotStep, 3) +
+           ": the penalty (lambda ~ (2 pi f_c h)^(-2d)) makes the normal equations numerically singular; "
+           "raise the cutoff or the knot step";
+  return {};
+}
+
 PSpline::PSpline(const std::vector<double>& t, const std::vector<std::vector<double>>& channels,
                  const PSplineOptions& opt) {
   const std::size_t n = t.size();
   if (n < 8) throw Error("smoothing spline: needs at least 8 samples, got " + std::to_string(n));
   if (!(opt.cutoff_hz > 0.0) || !(opt.knot_step_s > 0.0))
     throw Error("smoothing spline: cutoff_hz and knot_step_s must be > 0");
-  if (opt.knot_step_s * opt.cutoff_hz > 0.25)
-    throw Error("smoothing spline: knot step " + std::to_string(opt.knot_step_s) +
-                " s cannot resolve the cutoff " + std::to_string(opt.cutoff_hz) +
-                " Hz (need knot_step_s <= 1/(4 cutoff_hz))");
+  const std::string why = checkSmoothing(opt.cutoff_hz, opt.knot_step_s);
+  if (!why.empty()) throw Error("smoothing spline: " + why);
   if (opt.penalty_order < 1 || opt.penalty_order > 4)
     throw Error("smoothing spline: penalty_order must be 1..4");
   nch_ = channels.size();
@@ -77,7 +90,15 @@ PSpline::PSpline(const std::vector<double>& t, const std::vector<std::vector<dou
   a_ = t.front();
   h_ = opt.knot_step_s;
   const double span = t.back() - t.front();
-  nseg_ = static_cast<std::size_t>(std::max(1.0, std::ceil(span / h_ - 1e-9)));
+  // Bounded memory whatever the knot step (about 350 bytes per knot interval
+  // measured): knots far finer than the samples add nothing but memory.
+  const double segments = std::max(1.0, std::ceil(span / h_ - 1e-9));
+  if (!(segments <= kMaxKnotIntervalsPerSample * static_cast<double>(n) && segments <= kMaxKnotIntervals))
+    throw Error("smoothing spline: knot step " + formatNumber(h_, 6) + " s gives " + formatNumber(segments, 6) +
+                " knot intervals for " + std::to_string(n) + " samples (at most " +
+                formatNumber(kMaxKnotIntervalsPerSample, 3) + " per sample and " + formatNumber(kMaxKnotIntervals, 3) +
+                " in all: use a larger knot step)");
+  nseg_ = static_cast<std::size_t>(segments);
   const std::size_t K = nseg_ + P;  // number of coefficients
   const auto& basis = localBasis();
 

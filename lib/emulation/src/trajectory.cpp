@@ -154,8 +154,12 @@ SmoothTrajectory::SmoothTrajectory(const SampledTrajectory& s, const SmoothingOp
       p[k][i] = s.p_L[i][k];
       a[k][i] = s.rpy[i][k];
     }
-  pos_ = PSpline(s.t, p, {opt.position_cutoff_hz, opt.knot_step_s, opt.penalty_order});
-  att_ = PSpline(s.t, a, {opt.attitude_cutoff_hz, opt.knot_step_s, opt.penalty_order});
+  try {
+    pos_ = PSpline(s.t, p, {opt.position_cutoff_hz, opt.knot_step_s, opt.penalty_order});
+    att_ = PSpline(s.t, a, {opt.attitude_cutoff_hz, opt.knot_step_s, opt.penalty_order});
+  } catch (const Error& e) {  // name the data the smoothing failed on (its keys: `smoothing:`)
+    throw Error((s.source.empty() ? std::string("trajectory") : s.source) + ": " + e.what() + " (keys smoothing.*)");
+  }
   t0_ = s.t.front();
   t1_ = s.t.back();
   r0_E_ = earth::geodeticToEcef(origin_);
@@ -260,6 +264,11 @@ void SmoothingOptions::loadFrom(const ConfigNode& n) {
   n.read("attitude_cutoff_hz", attitude_cutoff_hz, limits::kCutoffHz);
   n.read("knot_step_s", knot_step_s, limits::kDurationS);
   n.read("penalty_order", penalty_order, 1, 4);
+  for (const auto& [key, f] : {std::pair<const char*, double>{"position_cutoff_hz", position_cutoff_hz},
+                               std::pair<const char*, double>{"attitude_cutoff_hz", attitude_cutoff_hz}}) {
+    const std::string why = checkSmoothing(f, knot_step_s);
+    if (!why.empty()) throw n.error(n.has("knot_step_s") && !n.has(key) ? "knot_step_s" : key, why);
+  }
 }
 
 }  // namespace navimpact::emulation

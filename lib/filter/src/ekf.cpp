@@ -104,9 +104,10 @@ ErrorStateEkf::ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
     : cfg_(cfg), mech_(x0, cfg.mechanization), cache_(std::make_shared<Cache>()) {
   if (cfg.propagate_every < 1)
     throw Error("propagate_every must be >= 1, got " + std::to_string(cfg.propagate_every));
-  if (!(cfg.gate_probability >= 0.0 && cfg.gate_probability < 1.0))
-    throw Error("gate_probability must be in [0, 1) (0 = gate off), got " +
-                formatNumber(cfg.gate_probability, 9));
+  if (!(cfg.gate_probability == 0.0 ||
+        (cfg.gate_probability >= kMinGateProbability && cfg.gate_probability < 1.0)))
+    throw Error("gate_probability must be 0 (gate off) or in [" + formatNumber(kMinGateProbability, 3) +
+                ", 1), got " + formatNumber(cfg.gate_probability, 9));
   if (cfg.gate_readmit_after < 0 || cfg.gate_readmit_after > 1000)
     throw Error("gate_readmit_after must be in 0..1000 (0 = never), got " + std::to_string(cfg.gate_readmit_after));
   if (!P0_nav.allFinite() || (P0_nav - P0_nav.transpose()).cwiseAbs().maxCoeff() >

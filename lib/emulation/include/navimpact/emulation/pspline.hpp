@@ -22,12 +22,29 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <cstddef>
 #include <vector>
 
 namespace navimpact::emulation {
 
 /// Options of a P-spline fit.
+/// Bounds of cutoff_hz * knot_step_s: above 1/4 the knots cannot resolve the
+/// cutoff; below 2e-4 the penalty weight lambda (about (2 pi f_c h)^(-2d) times
+/// the samples per knot) makes the banded normal equations numerically
+/// singular (measured: 1.5e-4 still solves on the bundled UAV trajectory with
+/// d = 3, 5e-5 does not).
+inline constexpr double kMaxCutoffTimesKnotStep = 0.25;
+inline constexpr double kMinCutoffTimesKnotStep = 2.0e-4;
+
+/// Most knot intervals of one spline, per sample and in all (about 350 bytes
+/// each: 5e6 is about 2 GB, the default memory budget).
+inline constexpr double kMaxKnotIntervalsPerSample = 64.0;
+inline constexpr double kMaxKnotIntervals = 5.0e6;
+
+/// Empty when the cutoff [Hz] and knot step [s] can be used together, else why not.
+std::string checkSmoothing(double cutoff_hz, double knot_step_s);
+
 struct PSplineOptions {
   double cutoff_hz = 1.0;    ///< -6 dB frequency of the smoother [Hz], > 0
   double knot_step_s = 0.05; ///< knot spacing h [s], > 0; must resolve f_c (h <= 1/(4 f_c))

@@ -49,6 +49,9 @@ enum class Discretization {
 /// "series" or "vanloan"; throws navimpact::Error naming the accepted values.
 Discretization parseDiscretization(const std::string& s);
 
+/// Smallest non-zero gate probability of EkfConfig::gate_probability.
+inline constexpr double kMinGateProbability = 0.5;
+
 struct EkfConfig {
   Discretization discretization = Discretization::Series;
   /// Propagate the covariance every k IMU samples (k >= 1). predict() keeps
@@ -65,7 +68,8 @@ struct EkfConfig {
   /// tests/filter/test_consistency.cpp (LowerRate.*).
   int propagate_every = 1;
   /// Chi-square innovation gate: reject when NIS > quantile(gate_probability, m).
-  /// 0 = off (default); else in (0, 1), e.g. 0.999.
+  /// 0 = off (default); else in [kMinGateProbability, 1), e.g. 0.999 (a gate
+  /// below the median rejects most innovations of a consistent filter).
   double gate_probability = 0.0;
   /// Re-admission after a lock-out: once this many gated updates in a row were
   /// rejected, the next one that fails the gate is applied after scaling P by
