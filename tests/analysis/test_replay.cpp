@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -372,4 +373,67 @@ TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) 
       }
     }
   }
+}
+
+// A run longer than the figures draw (90,001 epochs > 40,000): every row is in
+// solution.csv, the figures are written from the decimated epochs (the whole
+// run and each outage's own), and the in-memory and streamed summaries agree.
+TEST(Replay, ALongRunWritesEveryRowAndFiguresFromBoundedSeries) {
+  an::ReplayResult r;
+  r.model_source = "test";
+  r.imu_rate_hz = 200.0;
+  r.run.has_truth = true;
+  const std::size_t n = 90001;
+  r.cfg.outages.push_back(navimpact::Outage::fromStartDuration(1000.0, 30.0));
+  r.cfg.outages.push_back(navimpact::Outage::fromStartDuration(8000.0, 60.0));
+  for (const auto& o : r.cfg.outages) {
+    an::OutageSummary s;
+    s.window = o;
+    r.run.outages.push_back(s);
+  }
+  std::mt19937_64 rng(20261125);
+  std::normal_distribution<double> N01;
+  for (std::size_t k = 0; k < n; ++k) {
+    navimpact::ins::NavState x;
+    x.t = 0.1 * static_cast<double>(k);
+    x.lat = 0.8 + 1e-7 * std::sin(1e-3 * x.t);
+    x.lon = 0.1 + 1e-7 * std::cos(1e-3 * x.t);
+    x.h = 400.0;
+    x.v_N = Eigen::Vector3d(1.0, 0.5, 0.0);
+    x.q_BtoN = Eigen::Quaterniond(Eigen::AngleAxisd(1e-4 * x.t, Eigen::Vector3d::UnitZ()));
+    an::NavEpoch e;
+    e.t = x.t;
+    for (int i = 0; i < 9; ++i) {
+      e.sigma[i] = 0.5 + 0.1 * i;
+      e.err[i] = e.sigma[i] * N01(rng);
+    }
+    navimpact::ins::NavState truth = x;
+    truth.lat -= e.err[0] / 6.4e6;
+    e.est = x;
+    e.P_pos = Eigen::Vector3d(e.sigma[0], e.sigma[1], e.sigma[2]).cwiseAbs2().asDiagonal();
+    e.nees = {1.0, 2.0, 3.0, 4.0};
+    for (auto& o : r.run.outages)
+      if (e.t > o.window.start_s && e.t <= o.window.end_s + 1e-9) {
+        o.end_epoch = static_cast<int>(k);
+        o.end = e;
+      }
+    r.run.epochs.push_back(e);
+    r.estimate.push_back(x);
+    r.truth.push_back(truth);
+  }
+  const auto dir = navimpact::test::tempDir() / "long";
+  navimpact::OutputSet out(dir);
+  navimpact::report::writeReplayOutputs(r, out);
+  out.commit();
+  std::ifstream csv(dir / "solution.csv");
+  std::size_t rows = 0;
+  for (std::string line; std::getline(csv, line);) ++rows;
+  EXPECT_EQ(rows, n + 1);
+  for (const char* f : {"errors_full.png", "trajectory.png", "errors_outage_1.png", "errors_outage_2.png", "summary.json"})
+    EXPECT_GT(std::filesystem::file_size(dir / f), 1000u) << f;
+  std::ostringstream streamed;
+  navimpact::report::ReplayWriter w(streamed);
+  w.feed(r);
+  EXPECT_EQ(w.summary(r), navimpact::report::summaryJson(r));
+  EXPECT_EQ(streamed.str(), navimpact::report::solutionCsv(r));
 }

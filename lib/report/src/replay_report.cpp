@@ -272,7 +272,8 @@ plot::Figure errorsFigure(const ReplayResult& r, const std::vector<FigurePoint>&
     if (i % 3 == 0) ax.ylabel = units[i / 3];
     if (i >= 6) ax.xlabel = "time [s]";
     ax.xlim = std::make_pair(x0, x1);
-    for (const auto& o : r.cfg.outages) ax.spans.push_back({"GNSS outage", o.start_s, o.end_s, {128, 128, 128}, 0.18});
+    for (const auto& o : r.cfg.outages)  // one legend entry for all of them
+      ax.spans.push_back({ax.spans.empty() ? "GNSS outage" : "", o.start_s, o.end_s, {128, 128, 128}, 0.18});
     std::vector<double> lo(n), hi(n), err(n);
     for (std::size_t k = 0; k < n; ++k) {
       lo[k] = -pts[k].sig[i];
@@ -632,7 +633,7 @@ void ReplayWriter::finish(const ReplayResult& r) {
   if (r.score && !r.score->outages.empty()) writeOutageEndFigure(*r.score, *out_);
   const double tEnd = pts.empty() ? 1.0 : pts.back().t;
   const std::string every =
-      st.all.stride() > 1 ? " (every " + std::to_string(st.all.stride()) + "th epoch drawn)" : std::string();
+      st.all.stride() > 1 ? " (one epoch in " + std::to_string(st.all.stride()) + " drawn)" : std::string();
   plot::savePng(errorsFigure(r, pts, 0.0, tEnd,
                              (r.run.has_truth ? "Navigation errors (estimate − truth), filter model: "
                                               : "Predicted ±1σ (no ground truth in the rawlog), filter model: ") +
