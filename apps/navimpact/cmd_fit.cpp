@@ -86,8 +86,8 @@ navimpact::cli::Registrar reg({
                      "GMWM weights: r (default, the R package's 1/(CI_hi-CI_lo)^2), model (iterated "
                      "model-based diagonal) or efficient (inverse of the full WV covariance)");
       auto* robust = app.add_flag("--robust", o->fit.robust,
-                   "robust GMWM: fit the robust WV (Tukey biweight M-scale, Guerrier, Molinari & "
-                   "Victoria-Feser 2014) with its own CI and weights; for records with outliers");
+                   "robust GMWM: replace isolated spikes, then fit the robust WV (Tukey biweight M-scale, "
+                   "Guerrier, Molinari & Victoria-Feser 2014) with its own CI and weights; for records with outliers");
       app.add_option("--eff", o->fit.eff, "--robust: efficiency of the robust WV at the Gaussian, in (0, 1)")
           ->capture_default_str()
           ->needs(robust);

@@ -145,8 +145,13 @@ RecordingFit fitRecording(const ImuSeries& s, const RecordingFitOptions& opt,
     c.name = chans[i]->name;
     c.quantity = chans[i]->quantity;
     try {
-      c.wv = opt.robust ? robustWaveletVariance(chans[i]->x.data(), chans[i]->x.size(), s.rate_hz, opt.eff)
-                        : waveletVariance(chans[i]->x.data(), chans[i]->x.size(), s.rate_hz);
+      if (opt.robust) {
+        std::vector<double> x = chans[i]->x;
+        c.despiked = despike(x);
+        c.wv = robustWaveletVariance(x.data(), x.size(), s.rate_hz, opt.eff);
+      } else {
+        c.wv = waveletVariance(chans[i]->x.data(), chans[i]->x.size(), s.rate_hz);
+      }
     } catch (const Error& e) {
       throw Error(s.source + ": channel " + c.name + ": " + e.what());
     }

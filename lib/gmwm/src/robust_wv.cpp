@@ -13,6 +13,7 @@
 // The Gaussian moments are computed by quadrature instead of the package's
 // closed-form polynomial expansion, which cancels catastrophically for small c.
 #include <algorithm>
+#include <boost/math/distributions/normal.hpp>
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <boost/math/tools/roots.hpp>
 #include <cmath>
@@ -159,6 +160,41 @@ double robustScale(const double* w, std::size_t m, double c, double a, bool* mad
 }
 
 }  // namespace detail
+
+std::size_t despike(std::vector<double>& x, double alpha) {
+  if (!(alpha > 0.0 && alpha < 1.0))
+    throw Error("despike: alpha must be in (0, 1), got " + std::to_string(alpha));
+  const std::size_t n = x.size();
+  if (n < 8) return 0;
+  auto d = [&](std::size_t k) { return x[k] - 0.5 * (x[k - 1] + x[k + 1]); };
+  std::vector<double> v(n - 2);
+  for (std::size_t k = 1; k + 1 < n; ++k) v[k - 1] = d(k);
+  auto median = [](std::vector<double>& a) {
+    std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+    return a[a.size() / 2];
+  };
+  const double med = median(v);
+  for (double& e : v) e = std::fabs(e - med);
+  const double scale = 1.482602218505602 * median(v);
+  if (!(scale > 0.0)) return 0;
+  const double z = boost::math::quantile(boost::math::complement(boost::math::normal(), 0.5 * alpha / static_cast<double>(n - 2)));
+  const double thr = z * scale;
+  std::size_t replaced = 0;
+  std::vector<std::size_t> hit;
+  for (int pass = 0; pass < 1000; ++pass) {
+    hit.clear();
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+      const double a = std::fabs(d(k) - med);
+      if (!(a > thr)) continue;
+      const double l = k >= 2 ? std::fabs(d(k - 1) - med) : 0.0, r = k + 2 < n ? std::fabs(d(k + 1) - med) : 0.0;
+      if (a >= l && a >= r) hit.push_back(k);
+    }
+    if (hit.empty()) break;
+    for (std::size_t k : hit) x[k] = 0.5 * (x[k - 1] + x[k + 1]);
+    replaced += hit.size();
+  }
+  return replaced;
+}
 
 WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rate_hz, double eff,
                                       double alpha) {

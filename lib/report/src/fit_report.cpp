@@ -103,7 +103,9 @@ std::string fitJson(const gm::RecordingFit& f, const std::string& input_json) {
   j["seed"] = f.options.seed;
   j["weights"] = f.options.weights;
   j["estimator"] = f.options.robust
-                       ? json{{"wv", "robust (Tukey biweight M-scale of the wavelet coefficients)"},
+                       ? json{{"wv", "robust (Tukey biweight M-scale of the wavelet coefficients) of the record with "
+                                     "its isolated spikes replaced (second difference beyond the Bonferroni 1 % "
+                                     "threshold of its MAD scale; channels[].despiked_samples)"},
                               {"eff", f.options.eff},
                               {"reference", "Guerrier, Molinari & Victoria-Feser (2014), robust GMWM"}}
                        : json{{"wv", "classical (mean of squares)"}};
@@ -123,6 +125,7 @@ std::string fitJson(const gm::RecordingFit& f, const std::string& input_json) {
     cj["name"] = c.name;
     cj["unit"] = units::siUnit(c.quantity);
     cj["model"] = st::formatTerms(c.fit.model.terms, 17);
+    if (f.options.robust) cj["despiked_samples"] = c.despiked;
     cj["objective"] = c.fit.objective;
     cj["weights"] = f.options.weights;
     cj["objective_r"] = c.fit.objective_fast;  // R's objective of this model

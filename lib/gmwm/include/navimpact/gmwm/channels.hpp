@@ -55,7 +55,8 @@ struct RecordingFitOptions {
   std::string weights = "r";          ///< "r" (the R package's), "model" or "efficient"
   std::string intervals = "profile";  ///< 95 % intervals without bootstrap: "profile" or "asymptotic"
   /// Robust GMWM (Guerrier, Molinari & Victoria-Feser 2014): fit the robust
-  /// WV (Tukey biweight M-scale at efficiency eff) with its own CI and weights.
+  /// WV (Tukey biweight M-scale at efficiency eff) with its own CI and weights,
+  /// of the record with its isolated spikes replaced first (despike()).
   bool robust = false;
   double eff = 0.6;                   ///< robust: efficiency of the robust WV, in (0, 1)
   int bootstrap = 0;                  ///< parametric bootstrap replicates, >= 0
@@ -74,6 +75,7 @@ struct ChannelFit {
   std::string name;                  ///< canonical channel name
   units::Quantity quantity{};
   WaveletVariance wv;                ///< the empirical WV the model was fitted to
+  std::size_t despiked = 0;          ///< robust: isolated spikes replaced before the robust WV (despike())
   FitResult fit;
   std::vector<bool> negligible;      ///< per term of fit.model (negligibleTerms)
   /// Scales (indices into wv) where the model WV lies outside the WV's 95 % CI (scalesOutsideCi).

@@ -65,6 +65,23 @@ WaveletVariance waveletVariance(const double* x, std::size_t n, double rate_hz,
 WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rate_hz,
                                       double eff = 0.6, double alpha = 0.05);
 
+/**
+ * Replace isolated spikes in place, before a robust WV: the second difference
+ * d_k = x_k - (x_{k-1} + x_{k+1}) / 2 against its robust scale (1.4826 x the
+ * median absolute deviation, taken once), Bonferroni over the n - 2 samples
+ * at @p alpha (two-sided); a sample whose |d - median d| exceeds it and is a
+ * local maximum of |d| is replaced by the mean of its neighbours, repeated
+ * until none exceeds (a burst of spikes goes sample by sample).
+ *
+ * Why: a spike of amplitude A touches tau coefficients at scale tau with
+ * A / tau each, so the biweight down-weights it only at the finest scales
+ * (tau <~ (A / sigma)^2 / c^2); beyond, its variance enters the robust WV like
+ * white noise that starts at a middle scale, which a GM takes up with a much
+ * shorter T. Gaussian data keep every sample with probability >= 1 - alpha.
+ * @return the number of samples replaced.
+ */
+std::size_t despike(std::vector<double>& x, double alpha = 0.01);
+
 /// Chi-square CI of a WV estimate with eta degrees of freedom.
 void wvConfidenceInterval(double wv, double eta, double alpha, double& low, double& high);
 
