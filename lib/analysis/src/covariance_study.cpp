@@ -233,6 +233,9 @@ CovarianceStudyResult runAlong(const CovarianceStudyConfig& cfg, long n, const N
       } catch (const Error& e) {  // say which model of which set (the filter knows neither)
         throw Error(cfg.source + ": model set " + set.name + ", model " + name + ": " + e.what());
       }
+      run.pd_repairs = ekf.pdRepairs();
+      run.pd_worst_eigenvalue = ekf.pdWorstRepaired();
+      run.pd_first_repair_s = ekf.pdFirstRepairTime() - x0.t;
       res.runs.push_back(std::move(run));
       if (progress) progress(++done, total);
     }

@@ -4,6 +4,7 @@
 #include "navimpact/filter/model_entry.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -125,6 +126,16 @@ ErrorStateEkf::ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
   D_acc_ = MatrixXd::Identity(m, m);
   Q_acc_ = MatrixXd::Zero(N, N);
   last_.t = x0.t;
+  // variance floors of the positive-definiteness check (PdCheck)
+  floor_.resize(N);
+  floor_.segment<3>(kPos).setConstant(PdCheck::position_floor_m2);
+  floor_.segment<3>(kVel).setConstant(PdCheck::velocity_floor_m2ps2);
+  floor_.segment<3>(kAtt).setConstant(PdCheck::attitude_floor_rad2);
+  VectorXd natural = P_.diagonal().tail(m);
+  for (const ProcessBlock& b : layout_.blocks())
+    for (int j = 0; j < b.ss.n; ++j)
+      natural(b.offset - kNav + j) = std::max(natural(b.offset - kNav + j), b.ss.Qc(j, j) * 1.0 /* s */);
+  for (int i = 0; i < m; ++i) floor_(kNav + i) = std::max(PdCheck::imu_floor_relative * natural(i), 1e-300);
 }
 
 Eigen::Matrix<double, 6, 1> ErrorStateEkf::sensorErrors() const {
@@ -523,6 +534,44 @@ void ErrorStateEkf::checkP(const char* where) const {
   }
 }
 
+void ErrorStateEkf::checkPositiveDefinite(const char* where) {
+  // PdCheck (ekf.hpp): the correlation scale with each variance floored.
+  const int N = size();
+  Cache& c = *cache_;
+  VectorXd& inv = c.inv;
+  inv.resize(N);
+  for (int i = 0; i < N; ++i) inv(i) = 1.0 / std::sqrt(std::max(P_(i, i), floor_(i)));
+  MatrixXd& Pc = c.Pc;
+  Pc = inv.asDiagonal() * P_ * inv.asDiagonal();
+  if (!Pc.allFinite())
+    throw Error("filter covariance is not finite at t = " + formatNumber(state().t, 9) + " s after " + where);
+  Pc.diagonal().array() += PdCheck::tolerance;
+  c.llt.compute(Pc);
+  if (c.llt.info() == Eigen::Success) return;
+  Pc.diagonal().array() -= PdCheck::tolerance;
+  const Eigen::SelfAdjointEigenSolver<MatrixXd> es(Pc);
+  const double lambda = es.eigenvalues()(0);
+  if (es.info() != Eigen::Success || !(lambda >= -PdCheck::repair_limit)) {
+    Eigen::Index k = 0;
+    es.eigenvectors().col(0).cwiseAbs().maxCoeff(&k);
+    throw Error("filter covariance is not positive definite at t = " + formatNumber(state().t, 9) + " s after " +
+                where + " (eigenvalue " + formatNumber(lambda, 3) + " on the correlation scale, mostly state " +
+                layout_.names()[k] + "; rounding is repaired down to -" + formatNumber(PdCheck::repair_limit, 3) + ")" +
+                (cfg_.discretization == Discretization::Series
+                     ? "; the series discretization is not positive definite over long IMU intervals: "
+                       "filter.discretization vanloan is exact"
+                     : ""));
+  }
+  // the eigenvalue floor: negative eigenvalues set to zero, P rebuilt
+  const VectorXd l = es.eigenvalues().cwiseMax(0.0);
+  Pc.noalias() = es.eigenvectors() * l.asDiagonal() * es.eigenvectors().transpose();
+  const VectorXd d = inv.cwiseInverse();
+  P_ = d.asDiagonal() * Pc * d.asDiagonal();
+  P_ = (0.5 * (P_ + P_.transpose())).eval();
+  if (pd_repairs_++ == 0) pd_first_t_ = state().t;
+  pd_worst_ = std::min(pd_worst_, lambda);
+}
+
 void ErrorStateEkf::predict(const ins::ImuSample& raw) {
   if (!(raw.dt > 0.0) || !std::isfinite(raw.dt))
     throw Error("IMU sample at t = " + formatNumber(raw.t, 9) + " s has non-positive interval dt");
@@ -791,7 +840,6 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
   auto Pl = P_.selfadjointView<Eigen::Lower>();
   for (int j = 0; j < mz; ++j) Pl.rankUpdate(K.col(j), PHt.col(j), -1.0);
   Pl.rankUpdate(KL, 1.0);
-  const int N = size();
   P_.triangularView<Eigen::StrictlyUpper>() = P_.transpose();
   if (feedback) {
     const VectorXd dx = K * dz;  // estimated error (estimate minus truth)
@@ -800,19 +848,7 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
     c.nominal_valid = false;
   }
   checkP("update");
-  // Positive (semi-)definiteness on the correlation scale, so that states with
-  // tiny variances (1e-14) are judged as strictly as the metre-level ones:
-  // Cholesky of the correlation matrix + 1e-9 I must succeed (eigenvalues > -1e-9).
-  VectorXd& inv = c.inv;
-  inv.resize(N);
-  for (int i = 0; i < N; ++i) inv(i) = P_(i, i) > 0.0 ? 1.0 / std::sqrt(P_(i, i)) : 1.0;
-  MatrixXd& Pc = c.Pc;
-  Pc = inv.asDiagonal() * P_ * inv.asDiagonal();
-  Pc.diagonal().array() += 1e-9;
-  c.llt.compute(Pc);
-  if (c.llt.info() != Eigen::Success || !Pc.allFinite())
-    throw Error("filter covariance is not positive definite at t = " + formatNumber(res.t, 9) +
-                " s after update");
+  checkPositiveDefinite("update");
   last_ = res;
   return res;
 }

@@ -59,6 +59,12 @@ void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStud
       jr["model"] = r.model;
       jr["model_text"] = r.model_text;
       jr["filter_states"] = r.states;
+      // the eigenvalue floor of the positive-definiteness check (filter::PdCheck)
+      jr["covariance_repairs"] = r.pd_repairs;
+      if (r.pd_repairs > 0) {
+        jr["covariance_repair_worst_eigenvalue"] = r.pd_worst_eigenvalue;
+        jr["covariance_first_repair_s"] = r.pd_first_repair_s;
+      }
       jr["at"] = nlohmann::json::array();
       for (double ts : cfg.summary_times_s) {
         const std::size_t i = nearest(r.t, ts);
@@ -123,6 +129,14 @@ std::string covarianceSummary(const CovarianceStudyResult& res) {
                   r.model.c_str(), r.t.back(), s[0], s[3], s[6] / units::kDeg, s[8] / units::kDeg);
     out += b;
   }
+  for (const auto& r : res.runs)
+    if (r.pd_repairs > 0) {
+      std::snprintf(b, sizeof b,
+                    "note: %s / %s: covariance repaired %d time(s) by the eigenvalue floor (rounding; worst eigenvalue "
+                    "%.3g on the correlation scale, first at t = %.1f s)\n",
+                    r.model_set.c_str(), r.model.c_str(), r.pd_repairs, r.pd_worst_eigenvalue, r.pd_first_repair_s);
+      out += b;
+    }
   return out;
 }
 

@@ -26,6 +26,7 @@
 
 #include <array>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,12 @@ struct CovarianceRun {
   std::string model_text;            ///< the models of the six axes, for the record
   int states = 0;                    ///< filter state dimension
   std::vector<std::string> notes;    ///< how the model entered the filter (filter::layoutFor)
+  /// Repairs of the covariance by the eigenvalue floor (filter::PdCheck): how
+  /// many, the most negative eigenvalue repaired (correlation scale) and the
+  /// time of the first (NaN if none).
+  int pd_repairs = 0;
+  double pd_worst_eigenvalue = 0.0;
+  double pd_first_repair_s = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> t;             ///< [s]
   std::vector<std::array<double, 9>> sigma;
 };

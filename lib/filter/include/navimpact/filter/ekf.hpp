@@ -31,6 +31,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -51,6 +52,38 @@ Discretization parseDiscretization(const std::string& s);
 
 /// Smallest non-zero gate probability of EkfConfig::gate_probability.
 inline constexpr double kMinGateProbability = 0.5;
+
+/**
+ * Positive definiteness of the covariance, checked after every update (and so
+ * before every output of a run with updates). P is judged on the correlation
+ * scale, Pc = D^-1/2 P D^-1/2 with D_ii = max(P_ii, floor_i), so that states
+ * with small variances are judged as strictly as the metre-level ones while a
+ * state known far better than anything navigation resolves (a vertical
+ * channel held by a 1 mm barometer; a state decoupled from every noise)
+ * does not turn rounding into "correlations" above 1. The floor is the
+ * resolution below which a state counts as known: (1 um)^2 for positions,
+ * (1 um/s)^2 for velocities, (1 nrad)^2 for attitude, and 1e-12 times the
+ * natural variance of an IMU-error or extra state (its initial variance, or
+ * its driving noise Qc over 1 s when that is larger).
+ *  - smallest eigenvalue of Pc >= -tolerance: accepted (rounding);
+ *  - in [-repair_limit, -tolerance): the eigenvalue floor: the negative
+ *    eigenvalues of Pc are set to zero and P rebuilt (symmetric, positive
+ *    semi-definite; a change of at most repair_limit relative to each
+ *    variance). Long runs need it: after 46 h of static propagation with
+ *    model acc_model1 the position and attitude errors are correlated to
+ *    1 - 1e-10 and rounding leaves an eigenvalue of -1e-9. Every repair is
+ *    counted (ErrorStateEkf::pdRepairs) and reported by the runs;
+ *  - below -repair_limit: navimpact::Error naming the time, the step and the
+ *    state that weighs most in the offending eigenvector (no silent answer).
+ */
+struct PdCheck {
+  static constexpr double tolerance = 1e-9;
+  static constexpr double repair_limit = 1e-6;
+  static constexpr double position_floor_m2 = 1e-12;
+  static constexpr double velocity_floor_m2ps2 = 1e-12;
+  static constexpr double attitude_floor_rad2 = 1e-18;
+  static constexpr double imu_floor_relative = 1e-12;
+};
 
 struct EkfConfig {
   Discretization discretization = Discretization::Series;
@@ -258,6 +291,14 @@ class ErrorStateEkf {
   int size() const { return layout_.size(); }
   const UpdateResult& lastUpdate() const { return last_; }
   int rejections() const { return rejections_; }
+  /// Repairs of P by the eigenvalue floor (see PdCheck) since construction,
+  /// the most negative eigenvalue repaired (correlation scale; 0 if none) and
+  /// the filter time of the first repair (NaN if none).
+  int pdRepairs() const { return pd_repairs_; }
+  double pdWorstRepaired() const { return pd_worst_; }
+  double pdFirstRepairTime() const { return pd_first_t_; }
+  /// Variance floor of each state (the resolution below which it counts as known; PdCheck).
+  const Eigen::VectorXd& varianceFloor() const { return floor_; }
   const EkfConfig& config() const { return cfg_; }
   /// Overwrite the IMU-error and extra-state estimates (size imuSize(); tests, warm
   /// starts); P is unchanged. @throws navimpact::Error on a size mismatch or a non-finite value.
@@ -302,6 +343,8 @@ class ErrorStateEkf {
   void propagate(const Matrix9d& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& D,
                  const Eigen::MatrixXd& Q);
   void checkP(const char* where) const;
+  /// The positive-definiteness check of PdCheck on P, repairing it within the floor.
+  void checkPositiveDefinite(const char* where);
 
   EkfConfig cfg_;
   StateLayout layout_;
@@ -325,6 +368,9 @@ class ErrorStateEkf {
   UpdateResult last_;
   int rejections_ = 0;
   int consecutive_rejections_ = 0;  ///< gated rejections since the last applied update
+  Eigen::VectorXd floor_;           ///< variance floor per state (PdCheck)
+  int pd_repairs_ = 0;
+  double pd_worst_ = 0.0, pd_first_t_ = std::numeric_limits<double>::quiet_NaN();
   // cache for covariance-only propagation along a constant nominal
   struct Cache;
   std::shared_ptr<Cache> cache_;
