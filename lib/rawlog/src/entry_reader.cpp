@@ -1,8 +1,11 @@
 #include "entry_reader.hpp"
 
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/obs/registerAllClasses.h>
 
 #include <algorithm>
+#include <cstring>
 #include <new>
 #include <stdexcept>
 
@@ -34,6 +37,24 @@ std::size_t EntryReader::allocationCap() const {
   return static_cast<std::size_t>(std::max<std::uint64_t>(kFloor, in_.statedSize()));
 }
 
+namespace {
+/// MRPT reads each presence flag of a CObservationIMU as one raw byte into a
+/// bool; a byte other than 0 or 1 is no bool (using it is undefined
+/// behaviour; found by fuzzing): "" or what is wrong.
+std::string badImuFlags(const mrpt::serialization::CSerializable* obj) {
+  const auto* m = dynamic_cast<const mrpt::obs::CObservationIMU*>(obj);
+  if (!m) return {};
+  for (std::size_t i = 0; i < m->dataIsPresent.size(); ++i) {
+    unsigned char b = 0;
+    std::memcpy(&b, &m->dataIsPresent[i], 1);
+    if (b > 1)
+      return "CObservationIMU presence flag " + std::to_string(i) + " is byte " + std::to_string(b) +
+             ", not 0 or 1 (malformed entry)";
+  }
+  return {};
+}
+}  // namespace
+
 void EntryReader::fail(const std::string& what) const {
   throw Error(in_.path() + ": entry " + std::to_string(entry_) + ": " + what);
 }
@@ -62,6 +83,10 @@ mrpt::serialization::CSerializable::Ptr EntryReader::next() {
     AllocationLimit limit(allocationCap());
     auto obj = arch_.ReadObject();
     if (!obj) fail("empty object (malformed entry)");
+    if (const auto m = badImuFlags(obj.get()); !m.empty()) fail(m);
+    if (const auto* sf = dynamic_cast<const mrpt::obs::CSensoryFrame*>(obj.get()))
+      for (const auto& o : *sf)
+        if (const auto m = badImuFlags(o.get()); !m.empty()) fail(m);
     return obj;
   } catch (const mrpt::serialization::CExceptionEOF&) {
     if (stream_.error) fail(streamError());
