@@ -96,7 +96,7 @@ int run(const Opts& o) {
      << table;
   out.writeText("power.md", md.str());
   out.writeText("power.json", navimpact::report::powerJson(r));
-  out.writeText("timing.json", navimpact::report::powerTimingJson(r));
+  navimpact::report::writePowerTiming(r, out);
   out.commit();
   std::cout << table << "cost: " << r.cpu_s << " s CPU, " << r.wall_s << " s wall\n"
             << "wrote " << (std::filesystem::path(o.out) / "power.md").string() << " and power.json\n";

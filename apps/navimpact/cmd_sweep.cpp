@@ -12,8 +12,6 @@
 #include <sstream>
 #include <thread>
 
-#include <nlohmann/json.hpp>
-
 #include "cli_common.hpp"
 #include "navimpact/analysis/sweep.hpp"
 #include "navimpact/core/error.hpp"
@@ -50,14 +48,6 @@ struct MergeOpts {
   std::string out;
   bool overwrite = false;
 };
-
-std::string timingJson(double wall_s, const an::SweepResults& r) {
-  nlohmann::json t;
-  t["wall_s"] = wall_s;
-  t["filter_steps"] = r.filter_steps;
-  t["us_per_filter_step"] = r.us_per_filter_step;
-  return t.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-}
 
 void printSummary(const an::SweepResults& r, const std::string& dir) {
   std::cout << "sweep: " << r.meta.columns.size() << " column(s) x " << r.meta.durations_s.size()
@@ -114,12 +104,13 @@ int runSweepCmd(const SweepOpts& o) {
   if (shard.whole()) {
     const an::SweepResults res = an::judgeSweep(runs);
     navimpact::report::writeSweepOutputs(res, *out);
-    out->writeText("timing.json",
-                   timingJson(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), res));
+    navimpact::report::writeSweepTiming(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                                        res, *out);
     out->commit();
     printSummary(res, o.out);
   } else {
     an::writeSweepShard(runs, navimpact::cli::buildId(), *out);
+    navimpact::report::writeSweepShardTiming(runs, *out);
     out->commit();
     std::cout << "sweep shard " << shard.k << "/" << shard.n << ": " << runs.run_indices.size() << " of "
               << cfg.study.runs << " runs x " << runs.meta.columns.size() << " column(s) written to " << o.out
@@ -258,8 +249,8 @@ int runMergeCmd(const MergeOpts& o) {
   const an::SweepRuns runs = an::mergeSweepShards(o.dirs, navimpact::cli::buildId());
   const an::SweepResults res = an::judgeSweep(runs);
   navimpact::report::writeSweepOutputs(res, out);
-  out.writeText("timing.json",
-                timingJson(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), res));
+  navimpact::report::writeSweepTiming(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), res,
+                                      out);
   out.commit();
   printSummary(res, o.out);
   return 0;

@@ -358,10 +358,6 @@ void writeSweepShard(const SweepRuns& r, const std::string& build_id, OutputSet&
   j["run_indices"] = r.run_indices;
   j["byte_order"] = "native little-endian IEEE-754 doubles";
   out.writeText("sweep_shard.json", j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
-  json t;
-  t["filter_steps"] = r.filter_steps;
-  t["filter_wall_s"] = r.filter_wall_s;
-  out.writeText("timing.json", t.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   const std::string bin = (out.dir() / "sweep_runs.bin").string();
   std::ofstream f(out.stage("sweep_runs.bin"), std::ios::binary);
   f.write(kMagic, 8);

@@ -10,6 +10,7 @@
 #include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
 #include "navimpact/report/diagnosis_report.hpp"
+#include "navimpact/report/timing.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
@@ -615,8 +616,7 @@ std::size_t writeDiagnosisOutputs(const Diagnosis& d, const std::string& input_j
   out.writeText("report.md", diagnosisReport(d, figs));
   out.writeText("model_extended.yaml", stochastic::toYaml(d.model_after, model_comment));
   if (d.navigation) {  // wall-clock figures apart, so that two identical runs give identical result files
-    const nlohmann::json t = {{"navigation_wall_s", d.navigation->wall_s}};
-    out.writeText("timing.json", t.dump(1) + "\n");
+    writeTiming(out, {{"navigation_wall_s", d.navigation->wall_s}});
   }
   return figs.size();
 }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "navimpact/core/format.hpp"
+#include "navimpact/report/timing.hpp"
 
 namespace navimpact::report {
 
@@ -60,9 +61,6 @@ std::string powerJson(const PowerResult& r) {
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
-std::string powerTimingJson(const PowerResult& r) {
-  const nlohmann::json j = {{"cpu_s", r.cpu_s}, {"wall_s", r.wall_s}};
-  return j.dump(1) + "\n";
-}
+void writePowerTiming(const PowerResult& r, OutputSet& out) { writeTiming(out, {{"cpu_s", r.cpu_s}, {"wall_s", r.wall_s}}); }
 
 }  // namespace navimpact::report

@@ -15,6 +15,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
+#include "navimpact/report/timing.hpp"
 
 namespace navimpact::report {
 
@@ -625,8 +626,7 @@ void ReplayWriter::finish(const ReplayResult& r) {
   st.file.close();
   out_->writeText("summary.json", summaryFrom(r, st));
   // wall-clock figures apart, so that two identical runs give identical result files
-  const nlohmann::json t = {{"replay_wall_s", r.run.wall_s}, {"rawlog_read_wall_s", r.read_s}};
-  out_->writeText("timing.json", t.dump(1) + "\n");
+  writeTiming(*out_, {{"replay_wall_s", r.run.wall_s}, {"rawlog_read_wall_s", r.read_s}});
   // figures
   const std::vector<FigurePoint> pts = st.all.points();
   writeTrajectoryFigure(r, pts, st.o0, *out_);

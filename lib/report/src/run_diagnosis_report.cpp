@@ -9,6 +9,7 @@
 
 #include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
+#include "navimpact/report/timing.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 
 namespace navimpact::report {
@@ -240,7 +241,7 @@ std::string runDiagnosisSummary(const RunDiagnosis& d) {
 std::size_t writeRunDiagnosisOutputs(const RunDiagnosis& d, const std::string& input_json, OutputSet& out) {
   out.writeText("run_diagnosis.json", runDiagnosisJson(d, input_json));
   out.writeText("report.md", runDiagnosisMarkdown(d));
-  out.writeText("timing.json", nlohmann::json{{"wall_s", d.wall_s}}.dump(1) + "\n");  // wall clock kept apart
+  writeTiming(out, {{"wall_s", d.wall_s}});  // wall clock kept apart
   if (d.best >= 0) {
     const auto& b = d.causes[static_cast<std::size_t>(d.best)];
     out.writeText("model_extended.yaml",

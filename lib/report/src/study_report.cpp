@@ -13,6 +13,7 @@
 #include "navimpact/core/units.hpp"
 #include "navimpact/plot/figure.hpp"
 #include "navimpact/report/study_report.hpp"
+#include "navimpact/report/timing.hpp"
 
 namespace navimpact::report {
 
@@ -606,7 +607,7 @@ void writeStudyOutputs(const StudyResults& r, OutputSet& out) {
                       {"wall_s_per_run", A.wall_s / v.R},
                       {"us_per_step", A.steps > 0 ? 1e6 * A.wall_s / A.steps : 0.0}});
     }
-    out.writeText("timing.json", json{{"cost", cost}}.dump(1) + "\n");
+    writeTiming(out, json{{"cost", cost}});
   }
   out.writeText("timeseries.csv", timeseriesCsv(v));
   std::vector<std::string> figs;

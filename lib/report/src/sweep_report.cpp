@@ -11,6 +11,7 @@
 
 #include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
+#include "navimpact/report/timing.hpp"
 
 namespace navimpact::report {
 
@@ -328,6 +329,14 @@ void writeSweepOutputs(const SweepResults& r, OutputSet& out) {
     drawMap(r, c, out.stage(maps.back()).string());
   }
   out.writeText("report.md", reportMd(r, maps));
+}
+
+void writeSweepTiming(double wall_s, const SweepResults& r, OutputSet& out) {
+  writeTiming(out, {{"wall_s", wall_s}, {"filter_steps", r.filter_steps}, {"us_per_filter_step", r.us_per_filter_step}});
+}
+
+void writeSweepShardTiming(const SweepRuns& r, OutputSet& out) {
+  writeTiming(out, {{"filter_steps", r.filter_steps}, {"filter_wall_s", r.filter_wall_s}});
 }
 
 }  // namespace navimpact::report

@@ -162,7 +162,9 @@ SweepRuns runSweep(const std::shared_ptr<const SweepPlan>& plan, const Shard& sh
 
 /**
  * Write a shard: sweep_shard.json (meta, shard, run indices, @p build_id) and
- * sweep_runs.bin (the values, native little-endian doubles).
+ * sweep_runs.bin (the values, native little-endian doubles). Its cost figures
+ * (filter_steps, filter_wall_s) go to timing.json beside them
+ * (report::writeSweepShardTiming); mergeSweepShards adds them up where present.
  */
 void writeSweepShard(const SweepRuns& r, const std::string& build_id, OutputSet& out);
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "navimpact/analysis/diagnose_power.hpp"
+#include "navimpact/core/output.hpp"
 
 namespace navimpact::report {
 
@@ -16,7 +17,7 @@ std::string powerTable(const analysis::power::PowerResult& r);
 
 /// power.json text.
 std::string powerJson(const analysis::power::PowerResult& r);
-/// timing.json: the sweep's CPU and wall time, kept apart from the results (identical runs, identical power.json).
-std::string powerTimingJson(const analysis::power::PowerResult& r);
+/// timing.json (report/timing.hpp): the CPU and wall time, kept apart from the results (identical runs, identical power.json).
+void writePowerTiming(const analysis::power::PowerResult& r, OutputSet& out);
 
 }  // namespace navimpact::report

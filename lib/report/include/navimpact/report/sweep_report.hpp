@@ -3,7 +3,7 @@
  * @brief What `navimpact sweep` / `sweep-merge` write: sweep.json, report.md
  *        and one heat map per column (map_<k>.png), from analysis::SweepResults.
  *        No timings: identical inputs give byte-identical files (the cost
- *        figures go to timing.json, written by the command).
+ *        figures go to timing.json, writeSweepTiming / writeSweepShardTiming).
  */
 #pragma once
 
@@ -19,5 +19,11 @@ std::string sweepJson(const analysis::SweepResults& r);
 
 /// Write sweep.json, report.md and map_<k>.png (k = column number from 1).
 void writeSweepOutputs(const analysis::SweepResults& r, OutputSet& out);
+
+/// timing.json of a sweep or sweep-merge: @p wall_s of the command, the filter steps and their cost.
+void writeSweepTiming(double wall_s, const analysis::SweepResults& r, OutputSet& out);
+
+/// timing.json of a shard: its filter steps and filter wall time (sweep-merge adds them up).
+void writeSweepShardTiming(const analysis::SweepRuns& r, OutputSet& out);
 
 }  // namespace navimpact::report
