@@ -92,6 +92,39 @@ TEST(Config, DuplicateKeysAreErrorsEvenWhereNothingReadsThem) {
   EXPECT_NE(complex.find("cfg.yaml:1:3: key '?': a key must be a plain name"), std::string::npos) << complex;
 }
 
+TEST(Config, AliasesAreReadAsTheirValueAndMergeKeysAreRefused) {
+  // One rule: an alias (*NAME) stands for its whole value and is checked like
+  // it; a merge key (<<: *NAME) is refused, so no key can come both from a
+  // merge and directly (yaml-cpp would not merge it, and which one wins would
+  // be a second rule).
+  const ConfigNode c = doc("base: &b {rate_hz: 5, sigma_m: 2}\ngnss: *b\n");
+  double rate = 0;
+  EXPECT_TRUE(c.map("gnss").read("rate_hz", rate, limits::kImuRateHz));
+  EXPECT_EQ(rate, 5.0);
+  EXPECT_EQ(errorOf([] { doc("base: &b {rate_hz: 5}\ngnss:\n  <<: *b\n  rate_hz: 1\n"); }),
+            "cfg.yaml: key 'gnss.<<': merge keys (<<: *NAME) are not supported: write the keys out "
+            "(a whole value may be an alias *NAME)");
+  EXPECT_EQ(errorOf([] { doc("a: &b {x: 1}\nc: [{<<: *b}]\n"); }).rfind("cfg.yaml: key 'c[0].<<': merge keys", 0), 0u);
+  // a duplicate inside an anchored map is reported where the map is written
+  EXPECT_EQ(errorOf([] { doc("base: &b {x: 1, x: 2}\n"); }), "cfg.yaml: key 'base.x': duplicate key (line 1; first at line 1)");
+}
+
+TEST(Config, NestedAliasesCannotExpandWithoutBound) {
+  // Ten levels of ten aliases stand for 10^10 nodes in about 400 bytes
+  // ("billion laughs"): refused after a bounded walk, naming the file.
+  std::string text = "l0: &l0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int i = 1; i <= 10; ++i) {
+    text += "l" + std::to_string(i) + ": &l" + std::to_string(i) + " [";
+    for (int j = 0; j < 10; ++j) text += (j ? ", *l" : "*l") + std::to_string(i - 1);
+    text += "]\n";
+  }
+  const std::string e = errorOf([&] { doc(text); });
+  EXPECT_EQ(e.rfind("cfg.yaml: aliases (*NAME) expand the document to more than 1000000 nodes", 0), 0u) << e;
+  // aliases nested a little are read
+  std::string small = "l0: &l0 [1, 2]\nl1: &l1 [*l0, *l0]\nl2: [*l1, *l1, *l1]\n";
+  EXPECT_EQ(errorOf([&] { doc(small); }), "(no error)");
+}
+
 TEST(Config, WrongTypeSaysWhatWasExpectedAndWhatCame) {
   const ConfigNode c = doc("flag: perhaps\nn: [1, 2]\nseed: -5\nv: [1, 2]\nmode: fast\nk: 2.5\n"
                            "text: {a: 1}\nsigma_m: two\nlong: " + std::string(300, 'x') + "\n");

@@ -43,8 +43,20 @@ std::string joinNames(const std::vector<std::string>& v) {
   return s;
 }
 
-/// Every map of the tree: keys are plain names and appear once.
-void checkKeys(const YAML::Node& n, const std::string& file, const std::string& path) {
+/// Nodes the key check may visit beyond the text's length: aliases (*NAME) are
+/// followed, and a few hundred bytes of nested aliases can stand for billions
+/// of nodes; without aliases a document has fewer nodes than bytes.
+constexpr std::size_t kMaxAliasNodes = 1000000;
+
+/// Every map of the tree: keys are plain names and appear once; no merge key
+/// (yaml-cpp does not merge `<<: *NAME`, and a key given both by a merge and
+/// directly would need a precedence rule). An alias is checked like the value
+/// it stands for, within @p budget nodes in all.
+void checkKeys(const YAML::Node& n, const std::string& file, const std::string& path, std::size_t& budget) {
+  if (budget == 0)
+    throw Error(file + ": aliases (*NAME) expand the document to more than " + std::to_string(kMaxAliasNodes) +
+                " nodes beyond its size (nested aliases?)");
+  --budget;
   if (n.IsMap()) {
     std::map<std::string, int> seen;
     for (const auto& kv : n) {
@@ -53,14 +65,17 @@ void checkKeys(const YAML::Node& n, const std::string& file, const std::string& 
         throw Error(file + ":" + std::to_string(line) + ":" + std::to_string(kv.first.Mark().column + 1) + ": key '" +
                     join(path, "?") + "': a key must be a plain name, not a list or a map");
       const std::string k = kv.first.Scalar();
+      if (k == "<<")
+        throw keyError(file, join(path, k),
+                       "merge keys (<<: *NAME) are not supported: write the keys out (a whole value may be an alias *NAME)");
       const auto [it, fresh] = seen.emplace(k, line);
       if (!fresh)
         throw keyError(file, join(path, k),
                        "duplicate key (line " + std::to_string(line) + "; first at line " + std::to_string(it->second) + ")");
-      checkKeys(kv.second, file, join(path, k));
+      checkKeys(kv.second, file, join(path, k), budget);
     }
   } else if (n.IsSequence()) {
-    for (std::size_t i = 0; i < n.size(); ++i) checkKeys(n[i], file, path + "[" + std::to_string(i) + "]");
+    for (std::size_t i = 0; i < n.size(); ++i) checkKeys(n[i], file, path + "[" + std::to_string(i) + "]", budget);
   }
 }
 
@@ -108,7 +123,8 @@ ConfigNode ConfigNode::parse(const std::string& text, const std::string& file) {
   }
   if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) throw Error(file + ": expected a map of keys at the top level, got " + got(root));
-  checkKeys(root, file, "");
+  std::size_t budget = kMaxAliasNodes + text.size();
+  checkKeys(root, file, "", budget);
   auto doc = std::make_shared<Doc>();
   doc->file = file;
   doc->dir = fs::path(file).parent_path();
