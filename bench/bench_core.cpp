@@ -4,9 +4,10 @@
 #include <filesystem>
 
 #include "navimpact/core/csv_reader.hpp"
+#include "bench_support.hpp"
 
 static void BM_ReadStaticCsvGz(benchmark::State& state) {
-  const std::string path = std::string(NAVIMPACT_SHARED_DIR) + "/data/imu_static/adis16405_static_1.csv.gz";
+  const std::string path = navimpact::bench::sharedPath("data/imu_static/adis16405_static_1.csv.gz");
   if (!std::filesystem::exists(path)) {
     state.SkipWithError("shared data not found");
     return;

@@ -16,6 +16,7 @@
 #include "navimpact/gmwm/estimator.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 #include "navimpact/stochastic/simulate.hpp"
+#include "bench_support.hpp"
 
 namespace na = navimpact::analysis;
 namespace ns = navimpact::stochastic;
@@ -58,7 +59,7 @@ void BM_DiagnoseSimulated(benchmark::State& st) {
 }
 
 std::string adisPath() {
-  return std::string(NAVIMPACT_SHARED_DIR) + "/data/imu_static/adis16405_static_1.csv.gz";
+  return navimpact::bench::sharedPath("data/imu_static/adis16405_static_1.csv.gz");
 }
 
 navimpact::ImuSeries loadAdis() {
@@ -93,7 +94,7 @@ void BM_DiagnoseAdis(benchmark::State& st, bool nav) {
   if (nav) {
     na::NavGainOptions no;
     no.trajectory.file =
-        std::string(NAVIMPACT_SHARED_DIR) + "/data/trajectories/uav_flight_600s_ellipsoidal.csv";
+        navimpact::bench::sharedPath("data/trajectories/uav_flight_600s_ellipsoidal.csv");
     no.outages = {{200.0, 260.0}};
     no.threads = 2;
     plan = na::prepareNavGain(no, data.rate_hz, data.size());

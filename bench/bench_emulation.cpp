@@ -11,14 +11,15 @@
 #include "navimpact/emulation/scenario.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/stochastic/model_file.hpp"
+#include "bench_support.hpp"
 
 namespace {
 
 namespace emu = navimpact::emulation;
 namespace fs = std::filesystem;
 
-const std::string kTraj = std::string(NAVIMPACT_SHARED_DIR) + "/data/trajectories/uav_flight_600s_ellipsoidal.csv";
-const std::string kModel = std::string(NAVIMPACT_SOURCE_DIR) + "/config/models/navchip_table1.yaml:ref";
+const std::string kTraj = navimpact::bench::sharedPath("data/trajectories/uav_flight_600s_ellipsoidal.csv");
+const std::string kModel = navimpact::bench::sourcePath("config/models/navchip_table1.yaml:ref");
 
 emu::EmulationConfig config() {
   emu::EmulationConfig c;

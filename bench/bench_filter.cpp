@@ -4,11 +4,12 @@
 #include "navimpact/analysis/covariance_study.hpp"
 #include "navimpact/filter/ekf.hpp"
 #include "navimpact/stochastic/model_file.hpp"
+#include "bench_support.hpp"
 
 using namespace navimpact;
 
 namespace {
-const std::string kModels = std::string(NAVIMPACT_SOURCE_DIR) + "/config/models/navchip_table1.yaml";
+const std::string kModels = navimpact::bench::sourcePath("config/models/navchip_table1.yaml");
 
 ins::NavState benchState() {
   ins::NavState x;
@@ -102,7 +103,7 @@ BENCHMARK(BM_BaroUpdateRef)->Unit(benchmark::kMicrosecond);
 /// The full static covariance study: 8 models, 60 s at 200 Hz, baro at 10 Hz (no file output).
 static void BM_CovarianceStudy(benchmark::State& st) {
   const analysis::CovarianceStudyConfig cfg = analysis::loadCovarianceStudyConfig(
-      std::string(NAVIMPACT_SOURCE_DIR) + "/config/paper/covariance_static.yaml");
+      navimpact::bench::sourcePath("config/paper/covariance_static.yaml"));
   for (auto _ : st) {
     const analysis::CovarianceStudyResult r = analysis::runCovarianceStudy(cfg);
     benchmark::DoNotOptimize(r.runs.data());

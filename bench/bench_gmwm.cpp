@@ -11,6 +11,7 @@
 #include "navimpact/gmwm/wavelet_variance.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
+#include "bench_support.hpp"
 
 namespace {
 
@@ -38,7 +39,7 @@ const gm::WaveletVariance& simulatedWv() {
 /// WV of acc_x of the first ADIS16405 acquisition (10^6 samples), or nullptr.
 const gm::WaveletVariance* adisWv() {
   static std::unique_ptr<gm::WaveletVariance> wv = []() -> std::unique_ptr<gm::WaveletVariance> {
-    const std::string path = std::string(NAVIMPACT_SHARED_DIR) + "/data/imu_static/adis16405_static_1.csv.gz";
+    const std::string path = navimpact::bench::sharedPath("data/imu_static/adis16405_static_1.csv.gz");
     if (!std::filesystem::exists(path)) return nullptr;
     navimpact::CsvImuOptions o;
     o.rate_hz = 100;

@@ -8,12 +8,14 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 
 #include "navimpact/analysis/nav_run.hpp"
 #include "navimpact/analysis/scoring.hpp"
 #include "navimpact/core/earth.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/stochastic/model_file.hpp"
+#include "bench_support.hpp"
 
 namespace an = navimpact::analysis;
 using namespace navimpact;
@@ -22,11 +24,12 @@ namespace {
 
 std::string benchRawlog() {
   if (const char* e = std::getenv("NAVIMPACT_BENCH_RAWLOG")) return e;
-  return std::string(NAVIMPACT_SOURCE_DIR) + "/datasets/uav_flight_260s_ref.rawlog";
+  return bench::sourcePath("datasets/uav_flight_260s_ref.rawlog");
 }
 
-/// Inputs of runNav as the replay builds them (GT at every epoch as truth).
+/// Inputs of runNav as the replay builds them (GT at every epoch as truth), and the Ref model.
 struct Prepared {
+  stochastic::ImuModel model;
   std::vector<ins::ImuSample> imu;
   Recording d;
   an::TruthSeries truth;
@@ -45,6 +48,7 @@ struct Prepared {
 
 Prepared prepare(const std::string& path) {
   Prepared p;
+  p.model = stochastic::loadImuModel(bench::sourcePath("config/models/navchip_table1.yaml:ref"));
   p.d = rawlog::readRawlog(path);
   const double dt = p.d.imu[1].t - p.d.imu[0].t;
   double prev = p.d.imu.front().t - dt;
@@ -60,6 +64,16 @@ Prepared prepare(const std::string& path) {
   p.x0 = p.truth.x.front();
   p.x0.t = p.d.imu.front().t - dt;
   return p;
+}
+
+/// The prepared benchmark rawlog, or nothing (and the benchmark skipped) when it is absent.
+std::optional<Prepared> prepareOrSkip(benchmark::State& st) {
+  const std::string path = benchRawlog();
+  if (!std::filesystem::exists(path)) {
+    st.SkipWithError(("no rawlog " + path).c_str());
+    return std::nullopt;
+  }
+  return prepare(path);
 }
 
 }  // namespace
@@ -84,21 +98,16 @@ BENCHMARK(BM_ReplayRead)->Unit(benchmark::kMillisecond);
 /// The navigation loop of the replay on data already in memory, Ref model,
 /// covariance every k samples (argument), GNSS 1 Hz, baro 10 Hz, GT 10 Hz epochs.
 static void BM_ReplayFilter(benchmark::State& st) {
-  const std::string path = benchRawlog();
-  if (!std::filesystem::exists(path)) {
-    st.SkipWithError(("no rawlog " + path).c_str());
-    return;
-  }
-  const Prepared p = prepare(path);
-  const stochastic::ImuModel m =
-      stochastic::loadImuModel(std::string(NAVIMPACT_SOURCE_DIR) + "/config/models/navchip_table1.yaml:ref");
+  const std::optional<Prepared> prepared = prepareOrSkip(st);
+  if (!prepared) return;
+  const Prepared& p = *prepared;
   const an::NavRunInput in = p.input();
   an::NavRunOptions opt;
   opt.ekf.propagate_every = static_cast<int>(st.range(0));
   opt.outages = {{p.x0.t + 200.0, p.x0.t + 260.0}};
   double steps = 0;
   for (auto _ : st) {
-    const an::NavRunResult r = an::runNav(in, m, opt);
+    const an::NavRunResult r = an::runNav(in, p.model, opt);
     steps += static_cast<double>(r.steps);
     benchmark::DoNotOptimize(r.epochs.data());
   }
@@ -113,14 +122,9 @@ BENCHMARK(BM_ReplayFilter)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
 /// run scored against GT (aided RMS, per-outage NEES, distribution);
 /// covariance every 10 samples. Target: x_realtime >= 500 at 200 Hz.
 static void BM_ReplayScored(benchmark::State& st) {
-  const std::string path = benchRawlog();
-  if (!std::filesystem::exists(path)) {
-    st.SkipWithError(("no rawlog " + path).c_str());
-    return;
-  }
-  const Prepared p = prepare(path);
-  const stochastic::ImuModel m =
-      stochastic::loadImuModel(std::string(NAVIMPACT_SOURCE_DIR) + "/config/models/navchip_table1.yaml:ref");
+  const std::optional<Prepared> prepared = prepareOrSkip(st);
+  if (!prepared) return;
+  const Prepared& p = *prepared;
   const an::NavRunInput in = p.input();
   an::NavRunOptions opt;
   opt.ekf.propagate_every = 10;
@@ -128,7 +132,7 @@ static void BM_ReplayScored(benchmark::State& st) {
   double steps = 0;
   std::size_t scored = 0;
   for (auto _ : st) {
-    const an::NavRunResult r = an::runNav(in, m, opt);
+    const an::NavRunResult r = an::runNav(in, p.model, opt);
     const an::RunScore s = an::scoreRun(r, p.x0.t, p.x0.t, an::ReferenceInfo{});
     steps += static_cast<double>(r.steps);
     scored = s.outages.size();

@@ -12,6 +12,7 @@
 #include "navimpact/analysis/run_diagnosis.hpp"
 #include "navimpact/emulation/scenario.hpp"
 #include "navimpact/rawlog/writer.hpp"
+#include "bench_support.hpp"
 
 namespace an = navimpact::analysis;
 namespace emu = navimpact::emulation;
@@ -30,7 +31,7 @@ std::string runRawlog() {
   static TempRawlog tmp;
   std::string& path = tmp.path;
   if (!path.empty()) return path;
-  const std::string cfgFile = std::string(NAVIMPACT_SOURCE_DIR) + "/config/emulation/lemniscate_600s.yaml";
+  const std::string cfgFile = navimpact::bench::sourcePath("config/emulation/lemniscate_600s.yaml");
   emu::EmulationConfig c = emu::loadEmulationConfig(cfgFile);
   if (!std::filesystem::exists(c.trajectory.file)) return "";
   path = (std::filesystem::temp_directory_path() / ("navimpact_bench_run_" + std::to_string(::getpid()) + ".rawlog"))
@@ -49,7 +50,7 @@ static void BM_RunDiagnosis600s(benchmark::State& st) {
   }
   an::RunDiagnosisOptions o;
   o.replay.rawlog = path;
-  o.replay.model_spec = std::string(NAVIMPACT_SOURCE_DIR) + "/config/models/navchip_table1.yaml:ref";
+  o.replay.model_spec = navimpact::bench::sourcePath("config/models/navchip_table1.yaml:ref");
   o.durations_s = {10.0};
   o.reconverge_s = 10.0;
   o.realisations = 50;

@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include "navimpact/analysis/study.hpp"
+#include "bench_support.hpp"
 
 namespace an = navimpact::analysis;
 
@@ -12,14 +13,13 @@ namespace {
 
 std::shared_ptr<const an::StudyPlan> makePlan(const std::string& model, int every) {
   an::StudyConfig cfg;
-  const std::string src = NAVIMPACT_SOURCE_DIR;
-  cfg.trajectory.file = src + "/datasets/uav_flight_260s.csv.gz";
+  cfg.trajectory.file = navimpact::bench::sourcePath("datasets/uav_flight_260s.csv.gz");
   cfg.trajectory.end_s = 60.0;
   cfg.imu_rate_hz = 200.0;
-  cfg.truth.model = src + "/config/models/navchip_table1.yaml:ref";
+  cfg.truth.model = navimpact::bench::sourcePath("config/models/navchip_table1.yaml:ref");
   an::CandidateSpec c;
   c.label = model;
-  c.model = src + "/config/models/navchip_table1.yaml:" + model;
+  c.model = navimpact::bench::sourcePath("config/models/navchip_table1.yaml:" + model);
   cfg.candidates = {c};
   cfg.sets = {{"all", "all", {model}, model, model}};
   cfg.outages = {{30.0, 50.0}};
@@ -54,7 +54,7 @@ BENCHMARK_CAPTURE(BM_StudyFilterStep, gyro_wn, std::string("gyro_model1"))
 /// the machine is loaded; compare the CPU time per iteration).
 static void BM_StudyOneRunPaper(benchmark::State& st) {
   an::StudyConfig cfg =
-      an::loadStudyConfig(std::string(NAVIMPACT_SOURCE_DIR) + "/config/paper/study_navchip_uav.yaml");
+      an::loadStudyConfig(navimpact::bench::sourcePath("config/paper/study_navchip_uav.yaml"));
   cfg.runs = 1;
   cfg.threads = 1;
   if (st.range(0) > 0) cfg.ekf.propagate_every = static_cast<int>(st.range(0));

@@ -7,13 +7,14 @@
 
 #include "navimpact/core/csv_reader.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
+#include "bench_support.hpp"
 
 namespace {
 
 const navimpact::ImuSeries* staticSeries() {
   static std::unique_ptr<navimpact::ImuSeries> s = []() -> std::unique_ptr<navimpact::ImuSeries> {
     const std::string path =
-        std::string(NAVIMPACT_SHARED_DIR) + "/data/imu_static/adis16405_static_1.csv.gz";
+        navimpact::bench::sharedPath("data/imu_static/adis16405_static_1.csv.gz");
     if (!std::filesystem::exists(path)) return nullptr;
     navimpact::CsvImuOptions o;
     o.rate_hz = 100;

@@ -62,6 +62,9 @@ TEST(CovarianceReport, WritesAllOutputsOrNothing) {
   for (std::size_t k = 0; k < r.runs.size(); ++k) {
     const auto& run = r.runs[k];
     EXPECT_EQ(j["runs"][k]["filter_states"].get<int>(), run.states);
+    // how the model entered the filter, where it was changed
+    EXPECT_EQ(j["runs"][k].contains("notes"), !run.notes.empty());
+    if (!run.notes.empty()) EXPECT_EQ(j["runs"][k]["notes"].get<std::vector<std::string>>(), run.notes);
     ASSERT_EQ(j["runs"][k]["at"].size(), cfg.summary_times_s.size());
     for (std::size_t q = 0; q < cfg.summary_times_s.size(); ++q) {
       const double ts = cfg.summary_times_s[q];
@@ -76,4 +79,28 @@ TEST(CovarianceReport, WritesAllOutputsOrNothing) {
     }
   }
   EXPECT_NE(report::covarianceSummary(r).find(r.runs.back().model), std::string::npos);
+}
+
+TEST(CovarianceReport, TheSummaryListsHowEachModelEnteredTheFilter) {
+  // A Gauss-Markov term with T below the covariance propagation interval
+  // enters the filter as white noise (filter::layoutFor): the console summary says so.
+  const auto dir = test::tempDir();
+  const std::string models = (dir / "m.yaml").string(), cfgFile = (dir / "cov.yaml").string();
+  std::ofstream(models) << "rate_hz: 200\nmodels:\n  short_gm:\n    gyroscope: \"WN(sigma=1e-3) + GM(sigma=1e-4, T=0.01)\"\n"
+                           "  plain:\n    gyroscope: \"WN(sigma=1e-3)\"\n";
+  std::ofstream(cfgFile) << "model_file: m.yaml\nduration_s: 2\nimu_rate_hz: 200\noutput_rate_hz: 1\n"
+                            "summary_times_s: [1, 2]\n"
+                            "static_state: {lat_deg: 46.52, lon_deg: 6.57, h_m: 400, roll_deg: 0, pitch_deg: 0, yaw_deg: 0}\n"
+                            "initial_sigma: {position_m: 0, velocity_mps: 0, attitude_deg: 0}\n"
+                            "baro: {rate_hz: 10, sigma_m: 0.001}\n"
+                            "filter: {discretization: series, propagate_every: 10}\n"
+                            "model_sets:\n  - {name: gyro, title: short GM, models: [short_gm, plain]}\n";
+  const analysis::CovarianceStudyConfig cfg = analysis::loadCovarianceStudyConfig(cfgFile);
+  const analysis::CovarianceStudyResult r = analysis::runCovarianceStudy(cfg);
+  ASSERT_EQ(r.runs.size(), 2u);
+  ASSERT_FALSE(r.runs[0].notes.empty());
+  EXPECT_TRUE(r.runs[1].notes.empty());
+  const std::string s = report::covarianceSummary(r);
+  EXPECT_NE(s.find("note (gyro / short_gm): " + r.runs[0].notes.front()), std::string::npos) << s;
+  EXPECT_EQ(s.find("note (gyro / plain)"), std::string::npos) << s;
 }

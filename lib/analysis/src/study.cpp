@@ -59,33 +59,51 @@ double chi2Quantile(double p, double dof) {
   return boost::math::quantile(d, p);
 }
 
+void headerToJson(const StudyHeader& h, json& j) {
+  j["version"] = h.version;
+  j["versions"] = h.versions;
+  j["config_file"] = h.config_file;
+  j["config_text"] = h.config_text;
+  j["seed"] = h.seed;
+  j["runs_total"] = h.runs_total;
+  j["labels"] = h.labels;
+  json sets = json::array();
+  for (const auto& s : h.sets)
+    sets.push_back({{"name", s.name}, {"title", s.title}, {"models", s.models}, {"reference", s.reference},
+                    {"white_noise", s.white_noise}});
+  j["sets"] = sets;
+  j["margin"] = h.margin;
+}
+
+void headerFromJson(const json& j, StudyHeader& h) {
+  h.version = j.at("version");
+  h.versions = j.at("versions").get<std::vector<std::pair<std::string, std::string>>>();
+  h.config_file = j.at("config_file");
+  h.config_text = j.at("config_text");
+  h.seed = j.at("seed");
+  h.runs_total = j.at("runs_total");
+  h.labels = j.at("labels").get<std::vector<std::string>>();
+  for (const auto& s : j.at("sets"))
+    h.sets.push_back({s.at("name"), s.at("title"), s.at("models").get<std::vector<std::string>>(),
+                      s.at("reference"), s.at("white_noise")});
+  h.margin = j.at("margin");
+}
+
 json metaToJson(const StudyMeta& m) {
   json j;
-  j["version"] = m.version;
-  j["versions"] = m.versions;
-  j["config_file"] = m.config_file;
-  j["config_text"] = m.config_text;
-  j["seed"] = m.seed;
-  j["runs_total"] = m.runs_total;
+  headerToJson(m, j);
   j["t0"] = m.t0;
   j["duration_s"] = m.duration_s;
   j["imu_rate_hz"] = m.imu_rate_hz;
   j["trajectory"] = m.trajectory;
   j["truth_description"] = m.truth_description;
   j["notices"] = m.notices;
-  j["labels"] = m.labels;
   j["sources"] = m.sources;
   j["states"] = m.states;
-  json sets = json::array();
-  for (const auto& s : m.sets)
-    sets.push_back({{"name", s.name}, {"title", s.title}, {"models", s.models}, {"reference", s.reference},
-                    {"white_noise", s.white_noise}});
-  j["sets"] = sets;
   json o = json::array();
   for (const auto& w : m.outages) o.push_back({w.start_s, w.end_s});
   j["outages"] = o;
   j["epochs"] = m.epochs;
-  j["margin"] = m.margin;
   j["plot_before_s"] = m.plot_before_s;
   j["plot_after_s"] = m.plot_after_s;
   j["settings"] = m.settings;
@@ -95,27 +113,17 @@ json metaToJson(const StudyMeta& m) {
 StudyMeta metaFromJson(const json& j, const std::string& where) {
   try {
     StudyMeta m;
-    m.version = j.at("version");
-    m.versions = j.at("versions").get<std::vector<std::pair<std::string, std::string>>>();
-    m.config_file = j.at("config_file");
-    m.config_text = j.at("config_text");
-    m.seed = j.at("seed");
-    m.runs_total = j.at("runs_total");
+    headerFromJson(j, m);
     m.t0 = j.at("t0");
     m.duration_s = j.at("duration_s");
     m.imu_rate_hz = j.at("imu_rate_hz");
     m.trajectory = j.at("trajectory");
     m.truth_description = j.at("truth_description");
     m.notices = j.at("notices").get<std::vector<std::string>>();
-    m.labels = j.at("labels").get<std::vector<std::string>>();
     m.sources = j.at("sources").get<std::vector<std::string>>();
     m.states = j.at("states").get<std::vector<int>>();
-    for (const auto& s : j.at("sets"))
-      m.sets.push_back({s.at("name"), s.at("title"), s.at("models").get<std::vector<std::string>>(),
-                        s.at("reference"), s.at("white_noise")});
     for (const auto& o : j.at("outages")) m.outages.push_back({o.at(0), o.at(1)});
     m.epochs = j.at("epochs").get<std::vector<double>>();
-    m.margin = j.at("margin");
     m.plot_before_s = j.at("plot_before_s");
     m.plot_after_s = j.at("plot_after_s");
     m.settings = j.at("settings");

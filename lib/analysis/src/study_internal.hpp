@@ -10,6 +10,11 @@ namespace navimpact::analysis::detail {
 /// Values stored per epoch in a run record: err[9], sigma[9], nees[4].
 constexpr int kEpochValues = 22;
 
+/// The StudyHeader fields of a study's or a sweep's meta JSON, written into @p j / read from @p j
+/// (json::exception for a missing or mistyped field: the caller names the file).
+void headerToJson(const StudyHeader& h, nlohmann::json& j);
+void headerFromJson(const nlohmann::json& j, StudyHeader& h);
+
 nlohmann::json metaToJson(const StudyMeta& m);
 StudyMeta metaFromJson(const nlohmann::json& j, const std::string& where);
 

@@ -244,13 +244,8 @@ json gnssToJson(const GnssQuality& q) {
 
 json metaToJson(const SweepMeta& m) {
   json j;
-  j["version"] = m.version;
-  j["versions"] = m.versions;
-  j["config_file"] = m.config_file;
-  j["config_text"] = m.config_text;
+  detail::headerToJson(m, j);
   j["inputs_hash"] = m.inputs_hash;
-  j["seed"] = m.seed;
-  j["runs_total"] = m.runs_total;
   j["outage_start_s"] = m.outage_start_s;
   j["durations_s"] = m.durations_s;
   json g = json::array();
@@ -259,14 +254,7 @@ json metaToJson(const SweepMeta& m) {
   j["baro"] = m.baro;
   j["imu_rates_hz"] = m.imu_rates_hz;
   j["alpha"] = m.alpha;
-  j["margin"] = m.margin;
   j["bootstrap"] = m.bootstrap;
-  j["labels"] = m.labels;
-  json sets = json::array();
-  for (const auto& s : m.sets)
-    sets.push_back({{"name", s.name}, {"title", s.title}, {"models", s.models}, {"reference", s.reference},
-                    {"white_noise", s.white_noise}});
-  j["sets"] = sets;
   json cols = json::array();
   for (const auto& c : m.columns)
     cols.push_back({{"axes", {c.axes.gnss, c.axes.baro, c.axes.rate}},
@@ -283,13 +271,8 @@ json metaToJson(const SweepMeta& m) {
 SweepMeta metaFromJson(const json& j, const std::string& where) {
   try {
     SweepMeta m;
-    m.version = j.at("version");
-    m.versions = j.at("versions").get<std::vector<std::pair<std::string, std::string>>>();
-    m.config_file = j.at("config_file");
-    m.config_text = j.at("config_text");
+    detail::headerFromJson(j, m);
     m.inputs_hash = j.at("inputs_hash");
-    m.seed = j.at("seed");
-    m.runs_total = j.at("runs_total");
     m.outage_start_s = j.at("outage_start_s");
     m.durations_s = j.at("durations_s").get<std::vector<double>>();
     for (const auto& q : j.at("gnss")) {
@@ -305,12 +288,7 @@ SweepMeta metaFromJson(const json& j, const std::string& where) {
     m.baro = j.at("baro").get<std::vector<bool>>();
     m.imu_rates_hz = j.at("imu_rates_hz").get<std::vector<double>>();
     m.alpha = j.at("alpha");
-    m.margin = j.at("margin");
     m.bootstrap = j.at("bootstrap");
-    m.labels = j.at("labels").get<std::vector<std::string>>();
-    for (const auto& s : j.at("sets"))
-      m.sets.push_back({s.at("name"), s.at("title"), s.at("models").get<std::vector<std::string>>(),
-                        s.at("reference"), s.at("white_noise")});
     for (const auto& c : j.at("columns")) {
       SweepMeta::Column col;
       col.axes = {c.at("axes").at(0), c.at("axes").at(1), c.at("axes").at(2)};

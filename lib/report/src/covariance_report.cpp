@@ -65,6 +65,7 @@ void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStud
         jr["covariance_repair_worst_eigenvalue"] = r.pd_worst_eigenvalue;
         jr["covariance_first_repair_s"] = r.pd_first_repair_s;
       }
+      if (!r.notes.empty()) jr["notes"] = r.notes;  // how the model entered the filter (filter::layoutFor)
       jr["at"] = nlohmann::json::array();
       for (double ts : cfg.summary_times_s) {
         const std::size_t i = nearest(r.t, ts);
@@ -128,6 +129,7 @@ std::string covarianceSummary(const CovarianceStudyResult& res) {
     std::snprintf(b, sizeof b, "%-14s %-12s %9.1f %9.4f %9.5f %10.5f %9.5f\n", r.model_set.c_str(),
                   r.model.c_str(), r.t.back(), s[0], s[3], s[6] / units::kDeg, s[8] / units::kDeg);
     out += b;
+    for (const auto& n : r.notes) out += "  note (" + r.model_set + " / " + r.model + "): " + n + "\n";
   }
   for (const auto& r : res.runs)
     if (r.pd_repairs > 0) {

@@ -161,18 +161,26 @@ SetVerdict judge(const View& v, const ModelSetSpec& s, std::size_t o) {
   return out;
 }
 
+}  // namespace
+
+void provenanceJson(const analysis::StudyHeader& h, json& j) {
+  j["navimpact_version"] = h.version;
+  json versions = json::object();
+  for (const auto& [name, ver] : h.versions) versions[name] = ver;
+  j["versions"] = versions;
+  j["config_file"] = h.config_file;
+  j["config_text"] = h.config_text;
+  j["seed"] = h.seed;
+}
+
+namespace {
+
 json buildJson(const View& v, bool with_cost) {
   const auto& meta = v.r.meta;
   json j;
   json study;
-  study["navimpact_version"] = meta.version;
-  json versions = json::object();
-  for (const auto& [name, ver] : meta.versions) versions[name] = ver;
-  study["versions"] = versions;
-  study["config_file"] = meta.config_file;
-  study["config_text"] = meta.config_text;
+  provenanceJson(meta, study);
   study["runs"] = v.r.acc.runs;
-  study["seed"] = meta.seed;
   study["seed_rule"] =
       "run i uses seed_i = deriveSeed(seed, i); streams deriveSeed(seed_i, s): s=0 IMU errors (axis a: "
       "deriveSeed(., a)), 1 GNSS noise, 2 baro noise, 3 initial navigation error, 4 window of a measured recording";

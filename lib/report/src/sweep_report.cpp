@@ -11,6 +11,7 @@
 
 #include "navimpact/core/format.hpp"
 #include "navimpact/plot/figure.hpp"
+#include "navimpact/report/study_report.hpp"
 #include "navimpact/report/timing.hpp"
 
 namespace navimpact::report {
@@ -240,14 +241,8 @@ std::string sweepJson(const SweepResults& r) {
   const auto& meta = r.meta;
   json j;
   json s;
-  s["navimpact_version"] = meta.version;
-  json versions = json::object();
-  for (const auto& [name, ver] : meta.versions) versions[name] = ver;
-  s["versions"] = versions;
-  s["config_file"] = meta.config_file;
-  s["config_text"] = meta.config_text;
+  provenanceJson(meta, s);
   s["inputs_hash"] = meta.inputs_hash;
-  s["seed"] = meta.seed;
   s["seed_rule"] =
       "every column runs the study with this seed: run i uses deriveSeed(seed, i) (see study.json's seed_rule); "
       "bootstrap of column c, set s: mt19937_64(deriveSeed(deriveSeed(seed, 0x5EE9B007), 1000 c + s))";

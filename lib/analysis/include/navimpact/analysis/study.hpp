@@ -189,22 +189,30 @@ struct RunRecord {
 };
 
 /// Description of the study needed to interpret and write results (JSON-serialisable).
-struct StudyMeta {
+/// What a study and a sweep both record of themselves (in their shards and
+/// results): versions, configuration, seed, run count, the candidates and the
+/// model sets, the margin. One JSON writer and reader for both (study.cpp).
+struct StudyHeader {
   std::string version, config_file, config_text;
   std::vector<std::pair<std::string, std::string>> versions;  ///< navimpact + libraries (core/build_info.hpp)
   std::uint64_t seed = 0;
   std::size_t runs_total = 0;
+  std::vector<std::string> labels;            ///< candidates, in config order
+  std::vector<ModelSetSpec> sets;
+  double margin = 0.25;                       ///< relative accuracy margin of the judgement
+};
+
+struct StudyMeta : StudyHeader {
   double t0 = 0.0;                            ///< first trajectory time [s]
   double duration_s = 0.0;                    ///< trajectory duration [s]
   double imu_rate_hz = 0.0;
   std::string trajectory, truth_description;
   std::vector<std::string> notices;
-  std::vector<std::string> labels, sources;   ///< candidates and their model text
+  std::vector<std::string> sources;           ///< each candidate's model text
   std::vector<int> states;                    ///< EKF state count per candidate
-  std::vector<ModelSetSpec> sets;
   std::vector<Outage> outages;                ///< absolute filter time [s]
   std::vector<double> epochs;                 ///< record epochs, absolute [s]
-  double margin = 0.25, plot_before_s = 30.0, plot_after_s = 10.0;
+  double plot_before_s = 30.0, plot_after_s = 10.0;
   std::string settings;                       ///< GNSS/baro/filter settings, one line each
 };
 

@@ -102,21 +102,15 @@ struct SweepColumn {
 };
 
 /// What a sweep needs to interpret its per-run values (and what shards must share).
-struct SweepMeta {
-  std::string version, config_file, config_text;
-  std::vector<std::pair<std::string, std::string>> versions;
+struct SweepMeta : StudyHeader {
   std::string inputs_hash;          ///< FNV-1a 64 of the config and every file it reads (hex)
-  std::uint64_t seed = 0;
-  std::size_t runs_total = 0;
   double outage_start_s = 0.0;
   std::vector<double> durations_s;
   std::vector<GnssQuality> gnss;
   std::vector<bool> baro;
   std::vector<double> imu_rates_hz;
-  double alpha = 0.05, margin = 0.25;
+  double alpha = 0.05;
   std::size_t bootstrap = 0;
-  std::vector<std::string> labels;  ///< candidates, in config order
-  std::vector<ModelSetSpec> sets;
   struct Column {
     SweepColumn axes;
     std::string name;               ///< e.g. "gnss=Table 2, baro on, 200 Hz"

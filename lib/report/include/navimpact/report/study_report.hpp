@@ -7,6 +7,8 @@
 
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/output.hpp"
 
@@ -20,5 +22,9 @@ void writeStudyOutputs(const analysis::StudyResults& r, OutputSet& out);
 
 /// The metrics part of study.json (no timings): used by tests to compare runs.
 std::string studyMetricsJson(const analysis::StudyResults& r);
+
+/// What study.json and sweep.json both say of where they come from, into @p j:
+/// navimpact_version, versions (library -> version), config_file, config_text, seed.
+void provenanceJson(const analysis::StudyHeader& h, nlohmann::json& j);
 
 }  // namespace navimpact::report
