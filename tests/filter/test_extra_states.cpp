@@ -132,6 +132,46 @@ TEST(ExtraStates, ConfigKeysSwitchThemOn) {
   EXPECT_NE(err("extra_states: {lever_arm: {sigma_m: 0}}").find("(0, 10] m"), std::string::npos);
 }
 
+// Initial estimates (prior means): read from the configuration within the
+// effects' ranges, and the filter starts from them (zero for a group that is off).
+TEST(ExtraStates, InitialEstimatesAreReadAndUsed) {
+  const ConfigNode n = ConfigNode::parse(
+      "extra_states:\n"
+      "  scale_factor: {gyro_sigma: 0.001, gyro: [0.002, -0.001, 0.0005], acc: [0.01, 0, 0]}\n"
+      "  misalignment: {acc_sigma_rad: 0.002, acc_rad: [0.001, 0.002, -0.003]}\n"
+      "  lever_arm: {sigma_m: 0.1, error_m: [0.3, -0.2, 0.1]}\n"
+      "  time_offset: {sigma_s: 0.001, offset_s: -0.02}\n",
+      "f.yaml");
+  filter::ExtraStates x;
+  x.loadFrom(n.map("extra_states"));
+  EXPECT_EQ(x.gyro_scale0, Vector3d(0.002, -0.001, 0.0005));
+  EXPECT_EQ(x.acc_misalignment0_rad, Vector3d(0.001, 0.002, -0.003));
+  EXPECT_EQ(x.lever_arm_error0_m, Vector3d(0.3, -0.2, 0.1));
+  EXPECT_EQ(x.time_offset0_s, -0.02);
+  using P = stochastic::Process;
+  const auto mdl = model({P::wn(1e-3)}, {P::wn(5e-3)}, 200.0);
+  filter::EkfConfig cfg;
+  cfg.imu.extra = x;
+  ins::NavState x0;
+  x0.lat = 0.8;
+  filter::ErrorStateEkf ekf(x0, filter::Matrix9d::Identity(), mdl, cfg);
+  const filter::SensorParams e = ekf.extraEstimates();
+  EXPECT_EQ(e.gyro_scale, x.gyro_scale0);
+  EXPECT_EQ(e.acc_scale, Vector3d::Zero());  // acc_sigma left out: off, its initial value unused
+  EXPECT_EQ(e.acc_misalignment_rad, x.acc_misalignment0_rad);
+  EXPECT_EQ(e.lever_arm_error_B_m, x.lever_arm_error0_m);
+  EXPECT_EQ(e.time_offset_s, -0.02);
+  EXPECT_EQ(ekf.extraSigmas().time_offset_s, 0.001);
+  try {
+    filter::ExtraStates y;
+    y.loadFrom(ConfigNode::parse("extra_states: {time_offset: {sigma_s: 0.01, offset_s: 0.2}}", "f.yaml")
+                   .map("extra_states"));
+    FAIL() << "no error";
+  } catch (const Error& err) {
+    EXPECT_EQ(std::string(err.what()), "f.yaml: key 'extra_states.time_offset.offset_s': must be in [-0.1, 0.1] s, got 0.2");
+  }
+}
+
 // F columns of the scale-factor and misalignment states: Phi from the exact
 // exponential against central differences of the nonlinear mechanization fed
 // the output the estimate corrects (corrected = M_est^-1 M_true true with the

@@ -164,6 +164,8 @@ struct NavRunner::Impl {
       e.t = tt;
       e.est = ekf.state();
       e.err = filter::navError(ekf.state(), xt);
+      // with a time-offset state the solution at true time t is the state carried forward by d_est
+      if (ekf.layout().extraIndex(filter::Extra::TimeOffset) >= 0) e.err += ekf.timeOffsetCarry();
       if (opt.reference_lever_B.squaredNorm() > 0.0) e.err.head<3>() += ekf.state().C_BtoN() * opt.reference_lever_B;
       const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();

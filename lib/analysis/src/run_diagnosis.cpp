@@ -16,6 +16,7 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/emulation/sensor_effects.hpp"
 #include "navimpact/emulation/sensors.hpp"
@@ -291,6 +292,144 @@ void addRandomWalk(stochastic::ImuModel& m, int ch, double q) {
   m.axis[ch].terms.push_back(stochastic::Process::rw(std::sqrt(q / r)));
 }
 
+/// The causes an optional filter state carries (filter::ExtraStates).
+enum class ExtraCause { ScaleFactor, Misalignment, TimeOffset, LeverArm };
+
+// Prior sigmas of the fitting replays when the replay configuration has the
+// state off: half the documented range of the effect (limits.hpp), so that an
+// effect anywhere in the range is within about two sigma.
+constexpr double kFitScaleSigma = 0.5 * limits::kScaleFactor.hi;        // [ratio]
+constexpr double kFitMisalignmentSigmaRad = 0.5 * limits::kMisalignmentRad.hi;  // [rad]
+constexpr double kFitTimeOffsetSigmaS = 0.5 * limits::kTimeOffsetS.hi;  // [s]
+constexpr double kFitLeverArmSigmaM = 0.5 * limits::kLeverArmErrorM.hi; // [m]
+constexpr double kZ95 = 1.959963984540054;                              // two-sided 95 % normal quantile
+
+/// @p base with the group(s) of @p kind on at the fitting prior (the configured one when larger).
+filter::ExtraStates withFitPrior(ExtraCause kind, filter::ExtraStates x) {
+  switch (kind) {
+    case ExtraCause::ScaleFactor:
+      x.gyro_scale_sigma = std::max(x.gyro_scale_sigma, kFitScaleSigma);
+      x.acc_scale_sigma = std::max(x.acc_scale_sigma, kFitScaleSigma);
+      break;
+    case ExtraCause::Misalignment:
+      x.gyro_misalignment_sigma_rad = std::max(x.gyro_misalignment_sigma_rad, kFitMisalignmentSigmaRad);
+      x.acc_misalignment_sigma_rad = std::max(x.acc_misalignment_sigma_rad, kFitMisalignmentSigmaRad);
+      break;
+    case ExtraCause::TimeOffset:
+      x.time_offset_sigma_s = std::max(x.time_offset_sigma_s, kFitTimeOffsetSigmaS);
+      break;
+    case ExtraCause::LeverArm:
+      x.lever_arm_sigma_m = std::max(x.lever_arm_sigma_m, kFitLeverArmSigmaM);
+      break;
+  }
+  return x;
+}
+
+/// Prior sigma of a group fitted from a replay's sigmas: max_i s_i, within (0, hi].
+double fittedSigma(const Eigen::Vector3d& s, int n, double hi) {
+  double v = 0.0;
+  for (int i = 0; i < n; ++i) v = std::max(v, s(i));
+  return std::min(hi, std::max(1e-9 * hi, v));
+}
+
+/// An estimate clamped into the effect's range (the extension's initial value).
+Eigen::Vector3d clampTo(const Eigen::Vector3d& e, const limits::Range& r) {
+  return e.cwiseMax(r.lo).cwiseMin(r.hi);
+}
+
+/// @p x with the group(s) of @p kind on, initialised at a replay's estimates with its sigmas as prior.
+filter::ExtraStates withFitted(ExtraCause kind, filter::ExtraStates x, const filter::SensorParams& e,
+                               const filter::SensorParams& s) {
+  switch (kind) {
+    case ExtraCause::ScaleFactor:
+      x.gyro_scale_sigma = fittedSigma(s.gyro_scale, 3, limits::kScaleFactorSigma.hi);
+      x.acc_scale_sigma = fittedSigma(s.acc_scale, 3, limits::kScaleFactorSigma.hi);
+      x.gyro_scale0 = clampTo(e.gyro_scale, limits::kScaleFactor);
+      x.acc_scale0 = clampTo(e.acc_scale, limits::kScaleFactor);
+      break;
+    case ExtraCause::Misalignment:
+      x.gyro_misalignment_sigma_rad = fittedSigma(s.gyro_misalignment_rad, 3, limits::kMisalignmentSigmaRad.hi);
+      x.acc_misalignment_sigma_rad = fittedSigma(s.acc_misalignment_rad, 3, limits::kMisalignmentSigmaRad.hi);
+      x.gyro_misalignment0_rad = clampTo(e.gyro_misalignment_rad, limits::kMisalignmentRad);
+      x.acc_misalignment0_rad = clampTo(e.acc_misalignment_rad, limits::kMisalignmentRad);
+      break;
+    case ExtraCause::TimeOffset:
+      x.time_offset_sigma_s = fittedSigma(Eigen::Vector3d(s.time_offset_s, 0, 0), 1, limits::kTimeOffsetSigmaS.hi);
+      x.time_offset0_s = std::min(limits::kTimeOffsetS.hi, std::max(limits::kTimeOffsetS.lo, e.time_offset_s));
+      break;
+    case ExtraCause::LeverArm:
+      x.lever_arm_sigma_m = fittedSigma(s.lever_arm_error_B_m, 3, limits::kLeverArmErrorSigmaM.hi);
+      x.lever_arm_error0_m = clampTo(e.lever_arm_error_B_m, limits::kLeverArmErrorM);
+      break;
+  }
+  return x;
+}
+
+/// Findings of a filter-state cause: each state's estimate and its 95 % interval (estimate +- 1.96 sigma).
+std::vector<RunFinding> extraFindings(ExtraCause kind, const filter::SensorParams& e, const filter::SensorParams& s) {
+  std::vector<RunFinding> v;
+  auto add = [&](const std::string& cause, const std::string& channel, const std::string& name, double est, double sd,
+                 const std::string& note) {
+    RunFinding f;
+    f.cause = cause;
+    f.channel = channel;
+    f.params = {{name, est}, {name + "_sigma", sd}};
+    f.interval = {{name, {est - kZ95 * sd, est + kZ95 * sd}}};
+    f.note = note;
+    v.push_back(f);
+  };
+  const std::string how = "the filter's estimate of the state at the end of the whole run (GNSS throughout), 95 % "
+                          "interval +- 1.96 sigma from its covariance";
+  switch (kind) {
+    case ExtraCause::ScaleFactor:
+      for (int c = 0; c < 6; ++c)
+        add("scale_factor", kChannelNames[c], "scale", c < 3 ? e.gyro_scale(c) : e.acc_scale(c - 3),
+            c < 3 ? s.gyro_scale(c) : s.acc_scale(c - 3), "scale factor [ratio]: " + how);
+      break;
+    case ExtraCause::Misalignment:
+      for (int c = 0; c < 6; ++c)
+        add("misalignment", kChannelNames[c], "angle", c < 3 ? e.gyro_misalignment_rad(c) : e.acc_misalignment_rad(c - 3),
+            c < 3 ? s.gyro_misalignment_rad(c) : s.acc_misalignment_rad(c - 3),
+            "misalignment angle of the triad about this axis [rad]: " + how);
+      break;
+    case ExtraCause::TimeOffset:
+      add("time_offset", "all", "time_offset", e.time_offset_s, s.time_offset_s,
+          "IMU-GNSS time offset t_IMU - t_true [s]: " + how);
+      break;
+    case ExtraCause::LeverArm: {
+      RunFinding f;
+      f.cause = "lever_arm";
+      f.channel = "gnss";
+      const char* ax[3] = {"x", "y", "z"};
+      for (int i = 0; i < 3; ++i) {
+        const double est = e.lever_arm_error_B_m(i), sd = s.lever_arm_error_B_m(i);
+        f.params.push_back({std::string("error_") + ax[i], est});
+        f.params.push_back({std::string("error_") + ax[i] + "_sigma", sd});
+        f.interval.push_back({std::string("error_") + ax[i], {est - kZ95 * sd, est + kZ95 * sd}});
+      }
+      f.note = "antenna lever-arm error told - true, body FRD [m]: " + how;
+      v.push_back(f);
+      break;
+    }
+  }
+  return v;
+}
+
+/// What the extension of a filter-state cause changes, in words.
+std::string extraExtension(ExtraCause kind) {
+  switch (kind) {
+    case ExtraCause::ScaleFactor:
+      return "filter scale-factor states (gyro and accelerometer) initialised at the fitted estimates, their sigma as prior";
+    case ExtraCause::Misalignment:
+      return "filter misalignment states (gyro and accelerometer) initialised at the fitted estimates, their sigma as prior";
+    case ExtraCause::TimeOffset:
+      return "a filter IMU-GNSS time-offset state initialised at the fitted estimate, its sigma as prior";
+    case ExtraCause::LeverArm:
+      return "filter lever-arm error states initialised at the fitted estimates, their sigma as prior";
+  }
+  return "";
+}
+
 }  // namespace
 
 /// The causes: fitted per fold outside the held-out block, scored on the held-out outages.
@@ -346,7 +485,6 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
         ++heldCount[f];
       }
   }
-  const Exclusion none{};
 
   // IMU residual against the trajectory (real IMU read again from the rawlog).
   ImuResidual res;
@@ -373,9 +511,11 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
   const auto& innov = measured.front().run.gnss_innovations;
 
   // The fits; each returns the extended replay configuration and, for the whole run, findings.
-  using Fit = std::function<ReplayConfig(const Exclusion&, std::vector<RunFinding>*, CauseResult*)>;
-  auto fitMotion = [&](const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
-    stochastic::ImuModel m = model;
+  // @p base is the configuration extended (today's, or another cause's extension).
+  using Fit = std::function<ReplayConfig(const ReplayConfig& base, const Exclusion&, std::vector<RunFinding>*, CauseResult*)>;
+  auto baseModel = [&](const ReplayConfig& base) { return base.model ? *base.model : model; };
+  auto fitMotion = [&](const ReplayConfig& base, const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
+    stochastic::ImuModel m = baseModel(base);
     for (int c = 0; c < 6; ++c) {
       const auto b = wnBatches(res, c, true, ex);
       if (b.empty()) continue;
@@ -402,16 +542,16 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
         fnd->push_back(f);
       }
     }
-    m.source = model.source + " with in-motion white noise";
+    m.source += " with in-motion white noise";
     if (cr) {
       cr->model_after = m;
       cr->extension = "each channel's white noise multiplied by its in-motion factor";
     }
-    ReplayConfig c = opt.replay;
+    ReplayConfig c = base;
     c.model = m;
     return c;
   };
-  auto fitGnss = [&](const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
+  auto fitGnss = [&](const ReplayConfig& base, const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
     // per axis group (horizontal N, E pooled; vertical): innovations outside the block
     std::array<std::vector<double>, 2> dz2, hph, rr;
     std::array<double, 3> nis{0, 0, 0}, lag{0, 0, 0};
@@ -466,7 +606,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
       slo[grp] = solve(grp, boost::math::quantile(chi, 0.995) / N);
       shi[grp] = solve(grp, boost::math::quantile(chi, 0.005) / N);
     }
-    ReplayConfig c = opt.replay;
+    ReplayConfig c = base;
     c.sigma_pos_h_m = scale[0] * percentile(rh, 0.5);
     c.sigma_pos_v_m = scale[1] * percentile(rv, 0.5);
     if (fnd) {
@@ -501,7 +641,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
     }
     return c;
   };
-  auto fitBias = [&](const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
+  auto fitBias = [&](const ReplayConfig& base, const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
     std::vector<const Item*> tr_items;
     for (const auto& it : items)
       if (!ex.overlaps(it.a, it.b)) tr_items.push_back(&it);
@@ -522,11 +662,11 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
     };
     double qh, qv;
     lsq(tr_items, qh, qv);
-    stochastic::ImuModel m = model;
+    stochastic::ImuModel m = baseModel(base);
     addRandomWalk(m, 3, qh);
     addRandomWalk(m, 4, qh);
     addRandomWalk(m, 5, qv);
-    m.source = model.source + " with an accelerometer bias random walk";
+    m.source += " with an accelerometer bias random walk";
     if (fnd) {
       // seeded bootstrap over the outages
       std::mt19937_64 rng(stochastic::deriveSeed(opt.seed, 9001));
@@ -557,87 +697,195 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
       cr->model_after = m;
       cr->extension = "an accelerometer bias random walk added (horizontal channels from the horizontal errors, acc_z from the vertical)";
     }
-    ReplayConfig c = opt.replay;
+    ReplayConfig c = base;
     c.model = m;
     return c;
   };
+  // Causes a filter state carries (scale factor, misalignment, lever arm, time
+  // offset): fitted by replaying the run with that state on, GNSS dropped in
+  // the held-out block (no other outage); the state's estimate at the end of
+  // the run, its 95 % interval from the filter's covariance. The extension is
+  // the filter with that state on, initialised at the fitted estimate (clamped
+  // to the documented range) with the largest fitted sigma of the group as prior.
+  const double tz = measured.front().t_zero;
+  auto fitExtra = [&](ExtraCause kind) -> Fit {
+    return [&, kind](const ReplayConfig& base, const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
+      ReplayConfig c = base;
+      c.outages.clear();
+      c.outages_every.reset();
+      if (ex.b >= ex.a) {
+        const double a = std::max(0.0, ex.a - tz), b = std::min(ex.b - tz, out.run_end_s);
+        if (b > a) c.outages.push_back(Outage{a, b});
+      }
+      c.extra_states = withFitPrior(kind, base.extra_states);
+      const ReplayResult r = runReplay(c);
+      const filter::SensorParams& e = r.run.extra_estimates;
+      const filter::SensorParams& sg = r.run.extra_sigmas;
+      ReplayConfig x = base;
+      x.extra_states = withFitted(kind, base.extra_states, e, sg);
+      if (fnd) *fnd = extraFindings(kind, e, sg);
+      if (cr) {
+        cr->model_after = model;
+        cr->extra_states = x.extra_states;
+        cr->extension = extraExtension(kind);
+      }
+      return x;
+    };
+  };
   const std::vector<std::pair<std::string, Fit>> cands = {
-      {"in_motion_noise", fitMotion}, {"gnss_noise", fitGnss}, {"bias_instability", fitBias}};
+      {"in_motion_noise", fitMotion},
+      {"gnss_noise", fitGnss},
+      {"bias_instability", fitBias},
+      {"scale_factor", fitExtra(ExtraCause::ScaleFactor)},
+      {"misalignment", fitExtra(ExtraCause::Misalignment)},
+      {"time_offset", fitExtra(ExtraCause::TimeOffset)},
+      {"lever_arm", fitExtra(ExtraCause::LeverArm)}};
   const int C = static_cast<int>(cands.size());
 
-  // Held-out scores: task (cause, fold) replays every duration with the fold's extension.
-  std::vector<std::vector<std::vector<OutageScore>>> after(C * K);  // [task][duration] scored outages
-  std::vector<std::vector<std::vector<std::pair<filter::Vector9d, filter::Vector9d>>>> afterEnds(C * K);
-  std::vector<std::vector<std::pair<filter::Vector9d, filter::Vector9d>>> beforeEnds(D);
-  for (std::size_t i = 0; i < D; ++i) beforeEnds[i] = scoredEnds(measured[i]);
-  std::atomic<int> done{0};
-  std::mutex mu;
-  parallelFor(C * K, opt.threads, [&](int task) {
-    const int c = task / K, f = task % K;
-    if (heldCount[f] == 0) return;
-    ReplayConfig cfg = cands[c].second(excl[f], nullptr, nullptr);
-    std::vector<std::vector<OutageScore>> per(D);
-    std::vector<std::vector<std::pair<filter::Vector9d, filter::Vector9d>>> ends(D);
+  // Held-out scores: task (cause, fold) replays every duration with the fold's
+  // extension; task (cause, K) fits the cause on the whole run (its findings).
+  using Ends = std::vector<std::pair<filter::Vector9d, filter::Vector9d>>;
+  struct Scored {
+    std::vector<std::vector<OutageScore>> per;  // [duration] scored outages
+    std::vector<Ends> ends;                     // [duration] end errors and sigmas
+  };
+  auto replayScored = [&](ReplayConfig cfg) {
+    Scored sc;
     for (std::size_t i = 0; i < D; ++i) {
       cfg.outages.clear();
       cfg.outages_every = measured[i].cfg.outages_every;
       const ReplayResult r = runReplay(cfg);
       if (!r.score || r.score->outages.size() != measured[i].score->outages.size())
         throw Error("diagnose --run: the extended replay scored other outages than today's");
-      per[i] = r.score->outages;
-      ends[i] = scoredEnds(r);
+      sc.per.push_back(r.score->outages);
+      sc.ends.push_back(scoredEnds(r));
     }
-    after[task] = std::move(per);
-    afterEnds[task] = std::move(ends);
+    return sc;
+  };
+  Scored today;
+  for (std::size_t i = 0; i < D; ++i) {
+    today.per.push_back(measured[i].score->outages);
+    today.ends.push_back(scoredEnds(measured[i]));
+  }
+  std::vector<Scored> after(C * K);
+  std::vector<ReplayConfig> foldCfg(C * K);
+  std::vector<CauseResult> whole(C);
+  std::atomic<int> done{0};
+  std::mutex mu;
+  parallelFor(C * (K + 1), opt.threads, [&](int t) {
+    const int c = t / (K + 1), f = t % (K + 1);
+    if (f == K) {
+      whole[c].cause = cands[c].first;
+      cands[c].second(opt.replay, Exclusion{}, &whole[c].findings, &whole[c]);
+      return;
+    }
+    const int task = c * K + f;
+    if (heldCount[f] == 0) return;
+    foldCfg[task] = cands[c].second(opt.replay, excl[f], nullptr, nullptr);
+    after[task] = replayScored(foldCfg[task]);
     const int dn = ++done;
     std::lock_guard<std::mutex> lk(mu);
-    progress(0.80 + 0.19 * double(dn) / double(C * K), "causes");
+    progress(0.80 + 0.17 * double(dn) / double(C * K), "causes");
   });
 
-  for (int c = 0; c < C; ++c) {
-    CauseResult cr;
-    cr.cause = cands[c].first;
-    cands[c].second(Exclusion{}, &cr.findings, &cr);
+  // Paired held-out comparison: every outage scored by @p before and @p after of its fold.
+  struct Paired {
+    double eb = 0, ea = 0, vb = 0, va = 0, nb = 0, na = 0, gain = 0, p = 1, error_p = 1;
+  };
+  auto paired = [&](const std::function<const Scored&(int)>& before, const std::function<const Scored&(int)>& aft,
+                    std::uint64_t seed_tag) {
     std::vector<double> g, ge;
-    double eb = 0, ea = 0, vb = 0, va = 0, nb = 0, na = 0;
+    Paired r;
     for (const auto& it : items) {
-      const auto& ob = measured[it.i].score->outages[simOut[it.i][it.j].score_index];
-      const auto& oa = after[c * K + it.fold][it.i][simOut[it.i][it.j].score_index];
       const std::size_t si = simOut[it.i][it.j].score_index;
-      g.push_back(outageNll(ob, ref) + navNll(beforeEnds[it.i][si], ref) - outageNll(oa, ref) -
-                  navNll(afterEnds[c * K + it.fold][it.i][si], ref));
+      const Scored& B = before(it.fold);
+      const Scored& A = aft(it.fold);
+      const auto& ob = B.per[it.i][si];
+      const auto& oa = A.per[it.i][si];
+      g.push_back(outageNll(ob, ref) + navNll(B.ends[it.i][si], ref) - outageNll(oa, ref) - navNll(A.ends[it.i][si], ref));
       ge.push_back(ob.err_N.norm() - oa.err_N.norm());
-      eb += ob.horizontal_error_m * ob.horizontal_error_m;
-      ea += oa.horizontal_error_m * oa.horizontal_error_m;
-      vb += ob.vertical_error_m * ob.vertical_error_m;
-      va += oa.vertical_error_m * oa.vertical_error_m;
-      nb += ob.nees;
-      na += oa.nees;
+      r.eb += ob.horizontal_error_m * ob.horizontal_error_m;
+      r.ea += oa.horizontal_error_m * oa.horizontal_error_m;
+      r.vb += ob.vertical_error_m * ob.vertical_error_m;
+      r.va += oa.vertical_error_m * oa.vertical_error_m;
+      r.nb += ob.nees;
+      r.na += oa.nees;
     }
     const double n = double(items.size());
+    for (double x : g) r.gain += x;
+    r.gain /= n;
+    r.eb = std::sqrt(r.eb / n);
+    r.ea = std::sqrt(r.ea / n);
+    r.vb = std::sqrt(r.vb / n);
+    r.va = std::sqrt(r.va / n);
+    r.nb /= n;
+    r.na /= n;
+    r.p = signFlipP(g, stochastic::deriveSeed(opt.seed, seed_tag));
+    r.error_p = signFlipP(ge, stochastic::deriveSeed(opt.seed, seed_tag + 100));
+    return r;
+  };
+
+  std::vector<int> order;
+  for (int c = 0; c < C; ++c) {
+    CauseResult& cr = whole[c];
+    const Paired pr = paired([&](int) -> const Scored& { return today; },
+                             [&](int f) -> const Scored& { return after[c * K + f]; }, 7000 + c);
     cr.heldout_outages = items.size();
-    cr.error_before_m = std::sqrt(eb / n);
-    cr.error_after_m = std::sqrt(ea / n);
-    cr.vertical_before_m = std::sqrt(vb / n);
-    cr.vertical_after_m = std::sqrt(va / n);
-    cr.anees_before = nb / n;
-    cr.anees_after = na / n;
-    double s = 0;
-    for (double x : g) s += x;
-    cr.gain = s / n;
-    cr.p_value = signFlipP(g, stochastic::deriveSeed(opt.seed, 7000 + c));
-    cr.error_p_value = signFlipP(ge, stochastic::deriveSeed(opt.seed, 7100 + c));
+    cr.error_before_m = pr.eb;
+    cr.error_after_m = pr.ea;
+    cr.vertical_before_m = pr.vb;
+    cr.vertical_after_m = pr.va;
+    cr.anees_before = pr.nb;
+    cr.anees_after = pr.na;
+    cr.gain = pr.gain;
+    cr.p_value = pr.p;
+    cr.error_p_value = pr.error_p;
     cr.significant = cr.gain > 0 && cr.p_value < opt.alpha / C;
-    out.causes.push_back(std::move(cr));
+    order.push_back(c);
   }
-  std::stable_sort(out.causes.begin(), out.causes.end(),
-                   [](const CauseResult& a, const CauseResult& b) { return a.gain > b.gain; });
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return whole[a].gain > whole[b].gain; });
+
+  // The best significant cause is named. Each other significant cause is named
+  // too only if adding it to the best cause's extension (fitted per fold on top
+  // of it) gains on the held-out outages against that extension, at the same level:
+  // causes that share the best one's signature (a misalignment absorbing part of
+  // a scale factor) are not named twice.
+  int bestC = -1;
+  for (int c : order)
+    if (whole[c].significant) {
+      bestC = c;
+      break;
+    }
+  if (bestC >= 0) {
+    std::vector<int> others;
+    for (int c : order)
+      if (c != bestC && whole[c].significant) others.push_back(c);
+    const int O = static_cast<int>(others.size());
+    std::vector<Scored> both(O * K);
+    parallelFor(O * K, opt.threads, [&](int t) {
+      const int c = others[t / K], f = t % K;
+      if (heldCount[f] == 0) return;
+      both[t] = replayScored(cands[c].second(foldCfg[bestC * K + f], excl[f], nullptr, nullptr));
+      std::lock_guard<std::mutex> lk(mu);
+      progress(0.97 + 0.02 * double(t + 1) / double(O * K), "causes");
+    });
+    for (int k = 0; k < O; ++k) {
+      const int c = others[k];
+      const Paired pr = paired([&](int f) -> const Scored& { return after[bestC * K + f]; },
+                               [&](int f) -> const Scored& { return both[k * K + f]; }, 7200 + c);
+      CauseResult& cr = whole[c];
+      cr.given = whole[bestC].cause;
+      cr.gain_given = pr.gain;
+      cr.p_given = pr.p;
+      cr.adds = pr.gain > 0 && pr.p < opt.alpha / C;
+    }
+  }
+  for (int c : order) out.causes.push_back(std::move(whole[c]));
   for (std::size_t k = 0; k < out.causes.size(); ++k)
-    if (out.causes[k].significant) {
+    if (out.causes[k].significant && (out.best < 0 || out.causes[k].adds)) {
       if (out.best < 0) out.best = static_cast<int>(k);
       for (const auto& f : out.causes[k].findings) out.findings.push_back(f);
     }
-  (void)none;
 }
 
 RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {

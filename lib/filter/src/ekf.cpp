@@ -121,6 +121,20 @@ ErrorStateEkf::ErrorStateEkf(const ins::NavState& x0, const Matrix9d& P0_nav,
   P_.topLeftCorner<9, 9>() = P0_nav;
   P_.bottomRightCorner(m, m) = layout_.imuP0();
   x_imu_ = VectorXd::Zero(m);
+  {
+    // initial estimates of the extra states (prior means; zero by default)
+    const ExtraStates& e = cfg.imu.extra;
+    auto set3 = [&](Extra g, const Vector3d& v) {
+      if (const int k = layout_.extraIndex(g); k >= 0) x_imu_.segment<3>(k - kNav) = v;
+    };
+    set3(Extra::GyroScale, e.gyro_scale0);
+    set3(Extra::AccScale, e.acc_scale0);
+    set3(Extra::GyroMisalignment, e.gyro_misalignment0_rad);
+    set3(Extra::AccMisalignment, e.acc_misalignment0_rad);
+    set3(Extra::LeverArm, e.lever_arm_error0_m);
+    if (const int k = layout_.extraIndex(Extra::TimeOffset); k >= 0) x_imu_(k - kNav) = e.time_offset0_s;
+    if (!x_imu_.allFinite()) throw Error("initial estimates of the extra states must be finite");
+  }
   A_acc_.setIdentity();
   B_acc_ = MatrixXd::Zero(9, m);
   D_acc_ = MatrixXd::Identity(m, m);
@@ -181,6 +195,19 @@ SensorParams ErrorStateEkf::extraEstimates() const {
 
 SensorParams ErrorStateEkf::extraSigmas() const {
   return paramsFrom(layout_, [&](int k) { return std::sqrt(std::max(P_(k, k), 0.0)); });
+}
+
+Vector9d ErrorStateEkf::timeOffsetCarry() const {
+  Vector9d c = Vector9d::Zero();
+  const int k = layout_.extraIndex(Extra::TimeOffset);
+  if (k < 0) return c;
+  const double d = x_imu_(k - kNav);
+  const ins::NavState& x = state();
+  const Vector3d w_IN_N = earth::w_IE_N(x.lat) + earth::w_EN_N(x.lat, x.h, x.v_N);
+  c.segment<3>(0) = x.v_N * d;
+  c.segment<3>(3) = accelerationN() * d;
+  c.segment<3>(6) = (x.C_BtoN() * w_IB_B_ - w_IN_N) * d;  // C w_NB_B
+  return c;
 }
 
 void ErrorStateEkf::addExtraCouplings(const Lin& L, Eigen::Ref<MatrixXd> X, int col0) const {

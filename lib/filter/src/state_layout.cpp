@@ -47,22 +47,28 @@ stochastic::Model whiteShortGms(const stochastic::Model& in, double t_max, const
 void ExtraStates::loadFrom(const ConfigNode& n) {
   n.allowKeys({"scale_factor", "misalignment", "lever_arm", "time_offset"});
   if (const auto s = n.optMap("scale_factor")) {
-    s->allowKeys({"gyro_sigma", "acc_sigma"});
+    s->allowKeys({"gyro_sigma", "acc_sigma", "gyro", "acc"});
     s->read("gyro_sigma", gyro_scale_sigma, limits::kScaleFactorSigma);
     s->read("acc_sigma", acc_scale_sigma, limits::kScaleFactorSigma);
+    s->read("gyro", gyro_scale0, limits::kScaleFactor);
+    s->read("acc", acc_scale0, limits::kScaleFactor);
   }
   if (const auto m = n.optMap("misalignment")) {
-    m->allowKeys({"gyro_sigma_rad", "acc_sigma_rad"});
+    m->allowKeys({"gyro_sigma_rad", "acc_sigma_rad", "gyro_rad", "acc_rad"});
     m->read("gyro_sigma_rad", gyro_misalignment_sigma_rad, limits::kMisalignmentSigmaRad);
     m->read("acc_sigma_rad", acc_misalignment_sigma_rad, limits::kMisalignmentSigmaRad);
+    m->read("gyro_rad", gyro_misalignment0_rad, limits::kMisalignmentRad);
+    m->read("acc_rad", acc_misalignment0_rad, limits::kMisalignmentRad);
   }
   if (const auto l = n.optMap("lever_arm")) {
-    l->allowKeys({"sigma_m"});
+    l->allowKeys({"sigma_m", "error_m"});
     l->read("sigma_m", lever_arm_sigma_m, limits::kLeverArmErrorSigmaM);
+    l->read("error_m", lever_arm_error0_m, limits::kLeverArmErrorM);
   }
   if (const auto t = n.optMap("time_offset")) {
-    t->allowKeys({"sigma_s"});
+    t->allowKeys({"sigma_s", "offset_s"});
     t->read("sigma_s", time_offset_sigma_s, limits::kTimeOffsetSigmaS);
+    t->read("offset_s", time_offset0_s, limits::kTimeOffsetS);
   }
 }
 

@@ -491,16 +491,16 @@ std::string summaryFrom(const ReplayResult& r, const ReplayWriter::State& st) {
     const auto& sg = r.run.extra_sigmas;
     auto v3 = [](const Eigen::Vector3d& v) { return json::array({v(0), v(1), v(2)}); };
     json ex = json::object();
-    if (x.gyro_scale_sigma > 0) ex["gyro_scale"] = {{"estimate", v3(e.gyro_scale)}, {"sigma", v3(sg.gyro_scale)}, {"prior_sigma", x.gyro_scale_sigma}};
-    if (x.acc_scale_sigma > 0) ex["acc_scale"] = {{"estimate", v3(e.acc_scale)}, {"sigma", v3(sg.acc_scale)}, {"prior_sigma", x.acc_scale_sigma}};
+    if (x.gyro_scale_sigma > 0) ex["gyro_scale"] = {{"estimate", v3(e.gyro_scale)}, {"sigma", v3(sg.gyro_scale)}, {"prior_sigma", x.gyro_scale_sigma}, {"initial", v3(x.gyro_scale0)}};
+    if (x.acc_scale_sigma > 0) ex["acc_scale"] = {{"estimate", v3(e.acc_scale)}, {"sigma", v3(sg.acc_scale)}, {"prior_sigma", x.acc_scale_sigma}, {"initial", v3(x.acc_scale0)}};
     if (x.gyro_misalignment_sigma_rad > 0)
-      ex["gyro_misalignment_rad"] = {{"estimate", v3(e.gyro_misalignment_rad)}, {"sigma", v3(sg.gyro_misalignment_rad)}, {"prior_sigma", x.gyro_misalignment_sigma_rad}};
+      ex["gyro_misalignment_rad"] = {{"estimate", v3(e.gyro_misalignment_rad)}, {"sigma", v3(sg.gyro_misalignment_rad)}, {"prior_sigma", x.gyro_misalignment_sigma_rad}, {"initial", v3(x.gyro_misalignment0_rad)}};
     if (x.acc_misalignment_sigma_rad > 0)
-      ex["acc_misalignment_rad"] = {{"estimate", v3(e.acc_misalignment_rad)}, {"sigma", v3(sg.acc_misalignment_rad)}, {"prior_sigma", x.acc_misalignment_sigma_rad}};
+      ex["acc_misalignment_rad"] = {{"estimate", v3(e.acc_misalignment_rad)}, {"sigma", v3(sg.acc_misalignment_rad)}, {"prior_sigma", x.acc_misalignment_sigma_rad}, {"initial", v3(x.acc_misalignment0_rad)}};
     if (x.lever_arm_sigma_m > 0)
-      ex["lever_arm_error_B_m"] = {{"estimate", v3(e.lever_arm_error_B_m)}, {"sigma", v3(sg.lever_arm_error_B_m)}, {"prior_sigma", x.lever_arm_sigma_m}};
+      ex["lever_arm_error_B_m"] = {{"estimate", v3(e.lever_arm_error_B_m)}, {"sigma", v3(sg.lever_arm_error_B_m)}, {"prior_sigma", x.lever_arm_sigma_m}, {"initial", v3(x.lever_arm_error0_m)}};
     if (x.time_offset_sigma_s > 0)
-      ex["time_offset_s"] = {{"estimate", e.time_offset_s}, {"sigma", sg.time_offset_s}, {"prior_sigma", x.time_offset_sigma_s}};
+      ex["time_offset_s"] = {{"estimate", e.time_offset_s}, {"sigma", sg.time_offset_s}, {"prior_sigma", x.time_offset_sigma_s}, {"initial", x.time_offset0_s}};
     j["extra_states"] = ex;
   }
   // gate events, the first 1000 of each kind; re-admissions with the factor P was scaled by

@@ -72,6 +72,11 @@ std::string runDiagnosisJson(const RunDiagnosis& d, const std::string& input_jso
   nlohmann::json cs = nlohmann::json::array();
   for (const auto& c : d.causes) {
     nlohmann::json cj = gainJson(c);
+    if (!c.given.empty())
+      cj["on_top_of_best"] = {{"best_cause", c.given},
+                              {"nll_gain", num(c.gain_given)},
+                              {"p_value", num(c.p_given)},
+                              {"named", c.adds}};
     cj["findings"] = nlohmann::json::array();
     for (const auto& f : c.findings) cj["findings"].push_back(findingJson(f));
     cs.push_back(cj);
@@ -194,6 +199,13 @@ std::string runDiagnosisMarkdown(const RunDiagnosis& d) {
         << r3(c.anees_before) << " / " << r3(c.anees_after) << " | " << r3(c.gain) << " | "
         << formatReadable(c.p_value, 2) << " | " << (c.significant ? "yes" : "no") << " |\n";
     }
+    for (const auto& c : d.causes)
+      if (!c.given.empty())
+        s << "\n" << c.cause << " added to the extension of " << c.given << ": held-out gain " << r3(c.gain_given)
+          << ", p = " << formatReadable(c.p_given, 2) << " -> "
+          << (c.adds ? "it explains more than " + c.given + ": named too"
+                     : "nothing beyond " + c.given + " (it shares its signature): not named")
+          << ".\n";
     s << "\n### Fitted parameters (whole run)\n\n| cause | channel | parameter | value | interval |\n|---|---|---|---|---|\n";
     for (const auto& c : d.causes)
       for (const auto& f : c.findings)
@@ -233,7 +245,11 @@ std::string runDiagnosisSummary(const RunDiagnosis& d) {
       << r3(dd.anees_hi) << "]" << (dd.anees_rejects ? " outside" : "") << "\n";
   for (const auto& c : d.causes)
     s << "  cause " << c.cause << ": held-out gain " << r3(c.gain) << ", p = " << formatReadable(c.p_value, 2)
-      << (c.significant ? " significant" : "") << "\n";
+      << (c.significant ? " significant" : "")
+      << (c.given.empty() ? std::string()
+                          : "; on top of " + c.given + ": gain " + r3(c.gain_given) + ", p = " +
+                                formatReadable(c.p_given, 2) + (c.adds ? ", named" : ", not named"))
+      << "\n";
   s << "  " << formatFixed(d.wall_s, 1) << " s\n";
   return s.str();
 }
@@ -255,6 +271,35 @@ std::size_t writeRunDiagnosisOutputs(const RunDiagnosis& d, const std::string& i
       f << "noise:\n";
       if (b.gnss_sigma_h_m) f << "  sigma_pos_h_m: " << formatExact(*b.gnss_sigma_h_m) << "\n";
       if (b.gnss_sigma_v_m) f << "  sigma_pos_v_m: " << formatExact(*b.gnss_sigma_v_m) << "\n";
+    }
+    if (b.extra_states) {
+      const filter::ExtraStates& x = *b.extra_states;
+      auto v3 = [](const Eigen::Vector3d& v) {
+        return "[" + formatExact(v(0)) + ", " + formatExact(v(1)) + ", " + formatExact(v(2)) + "]";
+      };
+      f << "filter:\n  extra_states:\n";
+      if (x.gyro_scale_sigma > 0 || x.acc_scale_sigma > 0) {
+        f << "    scale_factor:\n";
+        if (x.gyro_scale_sigma > 0)
+          f << "      gyro_sigma: " << formatExact(x.gyro_scale_sigma) << "\n      gyro: " << v3(x.gyro_scale0) << "\n";
+        if (x.acc_scale_sigma > 0)
+          f << "      acc_sigma: " << formatExact(x.acc_scale_sigma) << "\n      acc: " << v3(x.acc_scale0) << "\n";
+      }
+      if (x.gyro_misalignment_sigma_rad > 0 || x.acc_misalignment_sigma_rad > 0) {
+        f << "    misalignment:\n";
+        if (x.gyro_misalignment_sigma_rad > 0)
+          f << "      gyro_sigma_rad: " << formatExact(x.gyro_misalignment_sigma_rad)
+            << "\n      gyro_rad: " << v3(x.gyro_misalignment0_rad) << "\n";
+        if (x.acc_misalignment_sigma_rad > 0)
+          f << "      acc_sigma_rad: " << formatExact(x.acc_misalignment_sigma_rad)
+            << "\n      acc_rad: " << v3(x.acc_misalignment0_rad) << "\n";
+      }
+      if (x.lever_arm_sigma_m > 0)
+        f << "    lever_arm:\n      sigma_m: " << formatExact(x.lever_arm_sigma_m)
+          << "\n      error_m: " << v3(x.lever_arm_error0_m) << "\n";
+      if (x.time_offset_sigma_s > 0)
+        f << "    time_offset:\n      sigma_s: " << formatExact(x.time_offset_sigma_s)
+          << "\n      offset_s: " << formatExact(x.time_offset0_s) << "\n";
     }
     out.writeText("filter_extended.yaml", f.str());
   }

@@ -77,9 +77,20 @@
  *    for acc_x, acc_y; vertical for acc_z), clipped at 0; 99 % interval by a
  *    seeded bootstrap over outages. Extension: an RW term of gamma =
  *    sqrt(q / rate) added to those channels.
+ *  - scale_factor, misalignment, time_offset, lever_arm: the filter's optional
+ *    states (filter::ExtraStates). Fitted by replaying the run with that state
+ *    on (GNSS dropped in the held-out block, no other outage; prior sigma half
+ *    the effect's documented range, limits.hpp, or the configured one when
+ *    larger): the estimate at the end of the run and its 95 % interval from
+ *    the filter's covariance. Extension: the filter with that state on,
+ *    initialised at the fitted estimate, the group's largest fitted sigma as prior.
+ * The best significant cause is named; another significant cause is named too
+ * only if, added to the best one's extension (fitted per fold on top of it),
+ * it gains on the held-out outages against that extension at the same level.
  */
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -94,8 +105,8 @@ namespace navimpact::analysis {
 
 /// A cause's parameter for one channel, fitted on the whole run.
 struct RunFinding {
-  std::string cause;     ///< in_motion_noise, gnss_noise, bias_instability
-  std::string channel;   ///< gyro_x .. acc_z, or gnss
+  std::string cause;     ///< in_motion_noise, gnss_noise, bias_instability, scale_factor, misalignment, time_offset, lever_arm
+  std::string channel;   ///< gyro_x .. acc_z, gnss (gnss_noise, lever_arm) or all (time_offset)
   std::vector<std::pair<std::string, double>> params;                    ///< SI, names as in the README
   std::vector<std::pair<std::string, std::pair<double, double>>> interval;  ///< per parameter, its interval
   std::string note;      ///< how it was estimated
@@ -113,10 +124,17 @@ struct CauseResult {
   double gain = 0.0;                     ///< mean decrease of the position negative log-likelihood per held-out outage
   double p_value = 1.0;                  ///< one-sided paired sign-flip permutation test of gain > 0
   double error_p_value = 1.0;            ///< the same test on the 3-D position error at the ends
-  bool significant = false;              ///< p_value < alpha / (number of causes)
+  bool significant = false;              ///< gain > 0 and p_value < alpha / (number of causes)
+  /// A significant cause other than the best one, added to the best cause's
+  /// extension (fitted per fold on top of it) and scored against it on the
+  /// same held-out outages: named (findings) only if that gain is significant too.
+  std::string given;                     ///< the best cause it was added to ("" = not tested)
+  double gain_given = NAN, p_given = NAN;  ///< its held-out gain and p on top of that cause
+  bool adds = false;                     ///< gain_given > 0 and p_given < alpha / (number of causes)
   std::string extension;                 ///< what the extension changes, in words
   stochastic::ImuModel model_after;      ///< the extended model (whole-run fit; = today's for GNSS causes)
   std::optional<double> gnss_sigma_h_m, gnss_sigma_v_m;  ///< the extended filter's GNSS sigmas (gnss_noise)
+  std::optional<filter::ExtraStates> extra_states;  ///< the extended filter's extra states (scale_factor, misalignment, time_offset, lever_arm)
 };
 
 /// Options of a run diagnosis.
@@ -193,7 +211,7 @@ struct RunDiagnosis {
   int folds = 0;                           ///< cross-validation folds used
   std::vector<CauseResult> causes;         ///< ranked by held-out gain, best first
   int best = -1;                           ///< index of the best significant cause (-1: none)
-  std::vector<RunFinding> findings;        ///< of the significant causes, in rank order
+  std::vector<RunFinding> findings;        ///< of the named causes (the best significant one, and others that add to it), in rank order
   stochastic::ImuModel model_before;       ///< today's model
   double wall_s = 0.0;                     ///< wall-clock time [s]
 };

@@ -287,6 +287,12 @@ class ErrorStateEkf {
   SensorParams extraEstimates() const;
   /// Their 1-sigma from P (zero for groups that are off).
   SensorParams extraSigmas() const;
+  /// With the time-offset state on, the state at IMU time t is the truth at
+  /// t - d_est (state_layout.hpp); the navigation solution at true time t is
+  /// the state carried forward by d_est. Returns that first-order change of
+  /// (dp NED [m], dv NED [m/s], psi [rad]): (v_N, a_N, C_BtoN w_NB_B) d_est
+  /// (Groves 2013 eq. 5.54 for a_N); zero when the state is off.
+  Vector9d timeOffsetCarry() const;
   const StateLayout& layout() const { return layout_; }
   int size() const { return layout_.size(); }
   const UpdateResult& lastUpdate() const { return last_; }

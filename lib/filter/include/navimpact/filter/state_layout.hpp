@@ -88,14 +88,25 @@ struct ExtraStates {
   double acc_misalignment_sigma_rad = 0.0;   ///< accelerometer misalignment angles x,y,z [rad]
   double lever_arm_sigma_m = 0.0;            ///< antenna lever-arm error x,y,z, body FRD [m]
   double time_offset_sigma_s = 0.0;          ///< IMU-GNSS time offset [s]
+  /// Initial estimates (prior means) of the groups that are on, SI, within the
+  /// effects' ranges (limits.hpp); zero by default (used only where the group is on).
+  Eigen::Vector3d gyro_scale0 = Eigen::Vector3d::Zero();             ///< [ratio]
+  Eigen::Vector3d acc_scale0 = Eigen::Vector3d::Zero();              ///< [ratio]
+  Eigen::Vector3d gyro_misalignment0_rad = Eigen::Vector3d::Zero();  ///< [rad]
+  Eigen::Vector3d acc_misalignment0_rad = Eigen::Vector3d::Zero();   ///< [rad]
+  Eigen::Vector3d lever_arm_error0_m = Eigen::Vector3d::Zero();      ///< told - true, body FRD [m]
+  double time_offset0_s = 0.0;                                       ///< t_IMU - t_true [s]
   /**
-   * Read the `extra_states` map of a filter section (every group optional):
+   * Read the `extra_states` map of a filter section (every group optional;
+   * the initial estimates optional, default 0):
    * @code
    * extra_states:
-   *   scale_factor: {gyro_sigma: 0.005, acc_sigma: 0.005}          # [ratio], (0, 0.05]
-   *   misalignment: {gyro_sigma_rad: 0.003, acc_sigma_rad: 0.003}  # [rad], (0, 0.05]
-   *   lever_arm: {sigma_m: 0.5}                                    # [m], (0, 10]
-   *   time_offset: {sigma_s: 0.05}                                 # [s], (0, 0.1]
+   *   scale_factor: {gyro_sigma: 0.005, acc_sigma: 0.005,          # [ratio], (0, 0.05]
+   *                  gyro: [0, 0, 0], acc: [0, 0, 0]}              # initial [ratio], [-0.05, 0.05]
+   *   misalignment: {gyro_sigma_rad: 0.003, acc_sigma_rad: 0.003,  # [rad], (0, 0.05]
+   *                  gyro_rad: [0, 0, 0], acc_rad: [0, 0, 0]}      # initial [rad], [-0.05, 0.05]
+   *   lever_arm: {sigma_m: 0.5, error_m: [0, 0, 0]}                # [m], (0, 10]; initial [-10, 10]
+   *   time_offset: {sigma_s: 0.05, offset_s: 0}                    # [s], (0, 0.1]; initial [-0.1, 0.1]
    * @endcode
    * @throws navimpact::Error naming the file and dotted key (unknown key, out of range).
    */
