@@ -845,36 +845,33 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
   }
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return whole[a].gain > whole[b].gain; });
 
-  // The best significant cause is named. Each other significant cause is named
-  // too only if adding it to the best cause's extension (fitted per fold on top
-  // of it) gains on the held-out outages against that extension, at the same level:
-  // causes that share the best one's signature (a misalignment absorbing part of
-  // a scale factor) are not named twice.
-  int bestC = -1;
-  for (int c : order)
-    if (whole[c].significant) {
-      bestC = c;
-      break;
-    }
-  if (bestC >= 0) {
+  // The top-ranked cause (largest held-out gain) is named when it is
+  // significant. Every other significant cause is added to the top cause's
+  // extension (fitted per fold on top of it) and scored against that extension
+  // on the same held-out outages; it is named only if that gain is significant
+  // at the same level too: a cause that shares part of the top one's signature
+  // (a misalignment absorbing part of a scale factor, a lever arm part of a
+  // misalignment) is not named beside or instead of it.
+  const int top = order.front();
+  {
     std::vector<int> others;
     for (int c : order)
-      if (c != bestC && whole[c].significant) others.push_back(c);
+      if (c != top && whole[c].significant) others.push_back(c);
     const int O = static_cast<int>(others.size());
     std::vector<Scored> both(O * K);
     parallelFor(O * K, opt.threads, [&](int t) {
       const int c = others[t / K], f = t % K;
       if (heldCount[f] == 0) return;
-      both[t] = replayScored(cands[c].second(foldCfg[bestC * K + f], excl[f], nullptr, nullptr));
+      both[t] = replayScored(cands[c].second(foldCfg[top * K + f], excl[f], nullptr, nullptr));
       std::lock_guard<std::mutex> lk(mu);
       progress(0.97 + 0.02 * double(t + 1) / double(O * K), "causes");
     });
     for (int k = 0; k < O; ++k) {
       const int c = others[k];
-      const Paired pr = paired([&](int f) -> const Scored& { return after[bestC * K + f]; },
+      const Paired pr = paired([&](int f) -> const Scored& { return after[top * K + f]; },
                                [&](int f) -> const Scored& { return both[k * K + f]; }, 7200 + c);
       CauseResult& cr = whole[c];
-      cr.given = whole[bestC].cause;
+      cr.given = whole[top].cause;
       cr.gain_given = pr.gain;
       cr.p_given = pr.p;
       cr.adds = pr.gain > 0 && pr.p < opt.alpha / C;
@@ -882,7 +879,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
   }
   for (int c : order) out.causes.push_back(std::move(whole[c]));
   for (std::size_t k = 0; k < out.causes.size(); ++k)
-    if (out.causes[k].significant && (out.best < 0 || out.causes[k].adds)) {
+    if (out.causes[k].significant && (k == 0 || out.causes[k].adds)) {
       if (out.best < 0) out.best = static_cast<int>(k);
       for (const auto& f : out.causes[k].findings) out.findings.push_back(f);
     }

@@ -84,9 +84,10 @@
  *    larger): the estimate at the end of the run and its 95 % interval from
  *    the filter's covariance. Extension: the filter with that state on,
  *    initialised at the fitted estimate, the group's largest fitted sigma as prior.
- * The best significant cause is named; another significant cause is named too
- * only if, added to the best one's extension (fitted per fold on top of it),
- * it gains on the held-out outages against that extension at the same level.
+ * The top-ranked cause (largest held-out gain) is named when significant;
+ * another significant cause is named only if, added to the top cause's
+ * extension (fitted per fold on top of it), it gains on the held-out outages
+ * against that extension at the same level.
  */
 #pragma once
 
@@ -125,10 +126,10 @@ struct CauseResult {
   double p_value = 1.0;                  ///< one-sided paired sign-flip permutation test of gain > 0
   double error_p_value = 1.0;            ///< the same test on the 3-D position error at the ends
   bool significant = false;              ///< gain > 0 and p_value < alpha / (number of causes)
-  /// A significant cause other than the best one, added to the best cause's
+  /// A significant cause other than the top-ranked one, added to the top cause's
   /// extension (fitted per fold on top of it) and scored against it on the
   /// same held-out outages: named (findings) only if that gain is significant too.
-  std::string given;                     ///< the best cause it was added to ("" = not tested)
+  std::string given;                     ///< the top-ranked cause it was added to ("" = not tested)
   double gain_given = NAN, p_given = NAN;  ///< its held-out gain and p on top of that cause
   bool adds = false;                     ///< gain_given > 0 and p_given < alpha / (number of causes)
   std::string extension;                 ///< what the extension changes, in words
