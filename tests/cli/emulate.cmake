@@ -69,3 +69,37 @@ foreach(_case "baro_sigma|imu: {errors: none}\nbaro: {sigma_m: 1e308}|key 'baro.
     ARGS emulate --config ${_edir}/range_${_n}.yaml --out ${_edir}/range_${_n}.rawlog
     REGEX "${_re}" NOOUT ${_edir}/range_${_n}.rawlog)
 endforeach()
+
+# Sensor effects in an emulation (effects: ...): a 240 s run whose gyros read
+# 1 % too much (a scale factor 5x the detection limit of README "Run diagnosis"),
+# then diagnose --run with the model the sensor was emulated with names
+# scale_factor with a significant held-out gain and writes the extension.
+file(WRITE ${_edir}/gyro_scale.yaml "
+trajectory: {file: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz, system: geodetic, end_s: 240}
+imu: {rate_hz: 200, errors: model, model: ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref, seed: 41601}
+gnss: {seed: 41602}
+baro: {seed: 41603}
+effects: {gyro_scale: [0.01, -0.01, 0.01], seed: 41604}
+")
+add_test(NAME cli_emulate_effects
+  COMMAND ${NI} emulate --config ${_edir}/gyro_scale.yaml --out ${_edir}/gyro_scale.rawlog --overwrite)
+set_tests_properties(cli_emulate_effects PROPERTIES FIXTURES_SETUP emu_effects
+  PASS_REGULAR_EXPRESSION "IMU 48000 samples at 200 Hz")
+navimpact_cli_check(cli_emulate_effects_diagnose_run CHECK run_json
+  ARGS diagnose --run ${_edir}/gyro_scale.rawlog --model ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref
+       --durations 10 --reconverge 10 --realisations 8 --folds 3 --alpha 0.05 --seed 41605
+       --out ${_edir}/gyro_scale_diagnosis
+  DEFINES OUT=${_edir}/gyro_scale_diagnosis JSON_FILE=run_diagnosis.json
+  JSON "verdict=^inadequate$" "findings/0/cause=^scale_factor$" "findings/0/channel=^gyro_x$"
+       "findings/0/params/scale=^0[.]0(09|1)" "gain/cause=^scale_factor$" "gain/significant=^(true|ON)$"
+  FILES report.md model_extended.yaml filter_extended.yaml)
+set_tests_properties(cli_emulate_effects_diagnose_run PROPERTIES FIXTURES_REQUIRED emu_effects)
+# an effect out of its documented range is refused, naming the key
+navimpact_cli_fail(cli_emulate_effects_bad_range
+  ARGS emulate --config ${_edir}/gyro_scale_bad.yaml --out ${_edir}/gyro_scale_bad.rawlog
+  REGEX "gyro_scale_bad.yaml.*effects.time_offset_s.*must be in .-0.1, 0.1. s" NOOUT ${_edir}/gyro_scale_bad.rawlog)
+file(WRITE ${_edir}/gyro_scale_bad.yaml "
+trajectory: {file: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz, end_s: 30}
+imu: {errors: none}
+effects: {time_offset_s: 0.5}
+")

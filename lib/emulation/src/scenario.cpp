@@ -48,7 +48,7 @@ EmulationConfig loadEmulationConfig(const std::string& path) {
   Ctx c{path};
   EmulationConfig cfg;
   cfg.config_file = path;
-  root.allowKeys({"trajectory", "smoothing", "imu", "gnss", "baro", "ground_truth", "output"});
+  root.allowKeys({"trajectory", "smoothing", "imu", "gnss", "baro", "effects", "ground_truth", "output"});
   cfg.trajectory.loadFrom(root.map("trajectory", "file, system, columns, ..."));
   if (const auto s = root.optMap("smoothing")) cfg.smoothing.loadFrom(*s);
 
@@ -67,6 +67,31 @@ EmulationConfig loadEmulationConfig(const std::string& path) {
 
   if (const auto g = root.optMap("gnss")) cfg.gnss.loadFrom(*g, true);
   if (const auto b = root.optMap("baro")) cfg.baro.loadFrom(*b, true);
+  if (const auto e = root.optMap("effects")) {
+    SensorEffects& fx = cfg.effects;
+    e->allowKeys({"gyro_scale", "acc_scale", "gyro_misalignment_rad", "acc_misalignment_rad",
+                  "gyro_nonorthogonality_rad", "acc_nonorthogonality_rad", "time_offset_s",
+                  "gyro_motion_noise_factor", "acc_motion_noise_factor", "motion_rate_threshold_rad_s",
+                  "motion_acc_threshold_mps2", "lever_arm_error_m", "seed"});
+    e->read("gyro_scale", fx.gyro_scale, limits::kScaleFactor);
+    e->read("acc_scale", fx.acc_scale, limits::kScaleFactor);
+    e->read("gyro_misalignment_rad", fx.gyro_misalignment_rad, limits::kMisalignmentRad);
+    e->read("acc_misalignment_rad", fx.acc_misalignment_rad, limits::kMisalignmentRad);
+    e->read("gyro_nonorthogonality_rad", fx.gyro_nonorthogonality_rad, limits::kMisalignmentRad);
+    e->read("acc_nonorthogonality_rad", fx.acc_nonorthogonality_rad, limits::kMisalignmentRad);
+    e->read("time_offset_s", fx.time_offset_s, limits::kTimeOffsetS);
+    e->read("gyro_motion_noise_factor", fx.gyro_motion_noise_factor, limits::kMotionNoiseFactor);
+    e->read("acc_motion_noise_factor", fx.acc_motion_noise_factor, limits::kMotionNoiseFactor);
+    e->read("motion_rate_threshold_rad_s", fx.motion_rate_threshold_rad_s, limits::kMotionRateThresholdRadS);
+    e->read("motion_acc_threshold_mps2", fx.motion_acc_threshold_mps2, limits::kMotionAccThresholdMps2);
+    e->read("lever_arm_error_m", fx.lever_arm_error_B_m, limits::kLeverArmErrorM);
+    e->readSeed("seed", cfg.effects_seed);
+    validateEffects(fx, path, "effects.");
+    if ((fx.gyro_motion_noise_factor != 1.0 || fx.acc_motion_noise_factor != 1.0) && cfg.imu_errors != "model")
+      throw keyError(path, fx.gyro_motion_noise_factor != 1.0 ? "effects.gyro_motion_noise_factor"
+                                                               : "effects.acc_motion_noise_factor",
+                     "needs imu.errors: model (the factor multiplies the model's white noise)");
+  }
   if (const auto gt = root.optMap("ground_truth")) {
     gt->allowKeys({"rate_hz"});
     gt->read("rate_hz", cfg.truth_rate_hz, limits::kAidingRateHz);
@@ -105,15 +130,32 @@ Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
   }
   d.notices = err.notices;
   d.imu.resize(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const auto& s = perfect[k];
-    ImuRecord& r = d.imu[k];
-    r.t = s.t;
-    r.w_IB_B = s.dtheta_B / s.dt + Eigen::Vector3d(err.axis[0][k], err.axis[1][k], err.axis[2][k]);
-    r.f_B = s.dv_B / s.dt + Eigen::Vector3d(err.axis[3][k], err.axis[4][k], err.axis[5][k]);
+  std::string effects = "none";
+  if (cfg.effects.none()) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto& s = perfect[k];
+      ImuRecord& r = d.imu[k];
+      r.t = s.t;
+      r.w_IB_B = s.dtheta_B / s.dt + Eigen::Vector3d(err.axis[0][k], err.axis[1][k], err.axis[2][k]);
+      r.f_B = s.dv_B / s.dt + Eigen::Vector3d(err.axis[3][k], err.axis[4][k], err.axis[5][k]);
+    }
+  } else {
+    // the sensor's output with the effects (sensor_effects.hpp); the white noise the
+    // motion factors inflate is the model's
+    std::array<double, 6> ws{};
+    if (cfg.imu_errors == "model") ws = whiteNoiseSigma(model, cfg.imu_rate_hz);
+    const EffectedImu e = applySensorEffects(perfect, err.axis, cfg.effects, ws, cfg.effects_seed);
+    for (std::size_t k = 0; k < n; ++k) {
+      ImuRecord& r = d.imu[k];
+      r.t = e.imu[k].t;
+      r.w_IB_B = e.imu[k].dtheta_B / e.imu[k].dt;
+      r.f_B = e.imu[k].dv_B / e.imu[k].dt;
+    }
+    effects = e.description;
   }
   const double t0 = tr.tBegin(), t1 = perfect.back().t;
-  d.gnss = simulateGnss(tr, cfg.gnss, t0, t1);
+  // GNSS of the true antenna (told - lever-arm error); the rawlog states the told one
+  d.gnss = simulateGnss(tr, gnssWithEffects(cfg.gnss, cfg.effects), t0, t1);
   d.baro = simulateBaro(tr, cfg.baro, t0, t1);
   const auto nt = static_cast<std::size_t>(std::floor((t1 - t0) * cfg.truth_rate_hz + 1e-9)) + 1;
   d.reference.resize(nt);
@@ -151,7 +193,10 @@ Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
     << formatNumber(g.lever_arm_B[1], 17) << ", " << formatNumber(g.lever_arm_B[2], 17) << "], seed: " << g.seed << "}\n"
     << "  baro: {rate_hz: " << formatNumber(cfg.baro.rate_hz, 17) << ", sigma_m: " << formatNumber(cfg.baro.sigma_m, 17)
     << ", seed: " << cfg.baro.seed << "}\n"
-    << "  ground_truth: {rate_hz: " << formatNumber(cfg.truth_rate_hz, 17) << "}\n"
+    << "  ground_truth: {rate_hz: " << formatNumber(cfg.truth_rate_hz, 17) << "}\n";
+  if (!cfg.effects.none())  // a run without effects keeps its scenario text
+    y << "  effects: {description: " << quote(effects) << ", seed: " << cfg.effects_seed << "}\n";
+  y
     << "  notices:\n";
   for (const auto& nline : d.notices) y << "    - " << quote(nline) << "\n";
   if (d.notices.empty()) y << "    []\n";

@@ -31,6 +31,16 @@
  * gnss: {rate_hz: 1, sigma_pos_h_m: 2, sigma_pos_v_m: 4, sigma_vel_h_mps: 0.05,
  *        sigma_vel_v_mps: 0.10, lever_arm_B_m: [0, 0, 0], seed: 2}
  * baro: {rate_hz: 10, sigma_m: 0.5, seed: 3}
+ * effects:                     # sensor effects the model lacks (sensor_effects.hpp), each off by default, SI
+ *   gyro_scale: [0.002, 0, 0]   # [ratio], each in [-0.05, 0.05]; acc_scale likewise
+ *   gyro_misalignment_rad: [0, 0, 0.001]   # [rad], each in [-0.05, 0.05]; acc_misalignment_rad,
+ *                               # gyro_nonorthogonality_rad, acc_nonorthogonality_rad likewise
+ *   time_offset_s: 0.02         # t_IMU - t_true [s], in [-0.1, 0.1]
+ *   gyro_motion_noise_factor: 3 # white noise x k while moving, [1, 100] (imu.errors: model); acc_ likewise
+ *   motion_rate_threshold_rad_s: 0.05   # moving above [rad/s], [1e-3, 10]
+ *   motion_acc_threshold_mps2: 0.3      # moving when ||f| - g| above [m/s^2], [0.05, 100]
+ *   lever_arm_error_m: [0.3, 0, 0]      # told - true antenna, body FRD [m], each in [-10, 10]
+ *   seed: 4                     # of the in-motion noise
  * ground_truth: {rate_hz: 10}   # [Hz]
  * output: {start_utc: "2026-01-01T00:00:00Z"}   # timestamp of the first trajectory time
  * @endcode
@@ -40,6 +50,7 @@
 #include <string>
 
 #include "navimpact/core/recording.hpp"
+#include "navimpact/emulation/sensor_effects.hpp"
 #include "navimpact/emulation/sensors.hpp"
 #include "navimpact/emulation/trajectory.hpp"
 
@@ -55,8 +66,10 @@ struct EmulationConfig {
   std::string model_spec;           ///< FILE[:NAME] for "model"
   std::uint64_t imu_seed = 1;       ///< seed of the simulated IMU errors
   StaticRecordingSpec static_rec;   ///< for "static"
-  GnssOptions gnss;
+  GnssOptions gnss;                 ///< lever_arm_B: the antenna the rawlog states (told)
   BaroOptions baro;
+  SensorEffects effects;            ///< effects the model lacks (all off by default)
+  std::uint64_t effects_seed = 4;   ///< seed of the in-motion noise
   double truth_rate_hz = 10.0;      ///< ground-truth record rate [Hz]
   std::string start_utc = "2026-01-01T00:00:00Z";  ///< UTC of the first trajectory time
 };
