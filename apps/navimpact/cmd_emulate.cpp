@@ -38,6 +38,7 @@ navimpact::cli::Registrar reg({
       return [o]() -> int {
         namespace fs = std::filesystem;
         auto outs = navimpact::OutputSet::singleFile(o->out, navimpact::cli::overwriteMode(o->overwrite));
+        const navimpact::InputScope scope(o->config);  // names the configuration when the run fails (e.g. out of memory)
         const auto cfg = navimpact::emulation::loadEmulationConfig(o->config);
         auto data = navimpact::emulation::runEmulation(cfg, NAVIMPACT_VERSION);
         if (o->no_gt) {

@@ -30,6 +30,9 @@ int fail(int code, const std::string& msg) {
 std::string subject(const std::string& command) {
   const std::string f = navimpact::InputScope::failedInput();
   if (!f.empty()) return f;
+  // the command without the program name ("navimpact: emulate: ...", not "navimpact: navimpact emulate: ...")
+  const std::string program = "navimpact ";
+  if (command.rfind(program, 0) == 0) return command.substr(program.size());
   return command.empty() ? std::string("navimpact") : command;
 }
 
