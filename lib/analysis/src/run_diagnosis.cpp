@@ -999,86 +999,68 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   // 3. Simulated realisations.
   const int R = opt.realisations;
   std::vector<RealisationOut> sims(R);
-  std::atomic<int> next{0}, done{0};
-  std::mutex mu;
-  std::string first_error;
-  auto work = [&]() {
-    for (;;) {
-      const int r = next++;
-      if (r >= R) return;
-      try {
-        const std::uint64_t seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(r));
-        std::array<std::vector<double>, 6> err;
-        if (rec) {
-          emulation::StaticRecordingSpec spec;
-          spec.file = opt.static_file;
-          spec.seed = stochastic::deriveSeed(seed, 4);
-          err = emulation::staticImuErrors(*rec, spec, rate, n).axis;
-        } else {
-          err = emulation::modelImuErrors(model, rate, n, stochastic::deriveSeed(seed, 0)).axis;
-        }
-        EmulatedRun run = emulateRun(perfect, err, tr, t0, t1, emulation::GnssOptions{}, emulation::BaroOptions{},
-                                     truth0, sigma0, seed);
-        // GNSS and baro at the run's own epochs with its own sigmas.
-        run.gnss.clear();
-        run.baro.clear();
-        const auto zg = emulation::standardNormal(6 * realGnss.size() + 1, stochastic::deriveSeed(seed, 5));
-        for (std::size_t k = 0; k < realGnss.size(); ++k) {
-          const GnssFix& f = realGnss[k];
-          if (f.t < t0 || f.t > t1) continue;
-          const emulation::TruthState s = tr.at(f.t);
-          const Eigen::Matrix3d Lp = f.cov_pos_N->llt().matrixL();
-          const Eigen::Vector3d np(zg[6 * k], zg[6 * k + 1], zg[6 * k + 2]);
-          GnssFix g;
-          g.t = f.t;
-          g.pos = earth::nedToGeodetic(tr.origin(), s.p_L + s.C_BtoN * lever + Lp * np);
-          g.cov_pos_N = f.cov_pos_N;
-          if (f.v_N && f.cov_vel_N) {
-            const Eigen::Matrix3d Lv = f.cov_vel_N->llt().matrixL();
-            const Eigen::Vector3d nv(zg[6 * k + 3], zg[6 * k + 4], zg[6 * k + 5]);
-            g.v_N = s.v_N + s.C_BtoN * s.w_NB_B.cross(lever) + Lv * nv;
-            g.cov_vel_N = f.cov_vel_N;
-          }
-          run.gnss.push_back(g);
-        }
-        const auto zb = emulation::standardNormal(realBaro.size() + 1, stochastic::deriveSeed(seed, 6));
-        for (std::size_t k = 0; k < realBaro.size(); ++k) {
-          const BaroSample& b = realBaro[k];
-          if (b.t < t0 || b.t > t1 || !b.sigma_m) continue;
-          BaroSample o = b;
-          o.h = tr.at(b.t).pos.h + *b.sigma_m * zb[k];
-          run.baro.push_back(o);
-        }
-        RealisationOut& ro = sims[r];
-        ro.err.resize(D);
-        ro.nees.resize(D);
-        for (std::size_t i = 0; i < D; ++i) {
-          const NavRunResult res = runNav(run.input(truths[i]), model, navs[i]);
-          if (res.epochs.size() != simOut[i].size())
-            throw Error("diagnose --run: realisation " + std::to_string(r) + " recorded " +
-                        std::to_string(res.epochs.size()) + " outage ends, expected " + std::to_string(simOut[i].size()));
-          for (const auto& e : res.epochs) {
-            ro.err[i].push_back(e.err);
-            ro.nees[i].push_back(e.nees[0]);
-          }
-          const int dn = ++done;
-          std::lock_guard<std::mutex> lk(mu);
-          progress(0.15 + (opt.causes ? 0.65 : 0.85) * double(dn) / double(R * D), "simulation");
-        }
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lk(mu);
-        if (first_error.empty()) first_error = e.what();
-        next = R;
-      }
+  std::atomic<int> done{0};
+  std::mutex progress_mu;
+  parallelFor(R, opt.threads, [&](int r) {
+    const std::uint64_t seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(r));
+    std::array<std::vector<double>, 6> err;
+    if (rec) {
+      emulation::StaticRecordingSpec spec;
+      spec.file = opt.static_file;
+      spec.seed = stochastic::deriveSeed(seed, 4);
+      err = emulation::staticImuErrors(*rec, spec, rate, n).axis;
+    } else {
+      err = emulation::modelImuErrors(model, rate, n, stochastic::deriveSeed(seed, 0)).axis;
     }
-  };
-  int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = std::min(threads, R);
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (!first_error.empty()) throw Error(first_error);
+    EmulatedRun run = emulateRun(perfect, err, tr, t0, t1, emulation::GnssOptions{}, emulation::BaroOptions{},
+                                 truth0, sigma0, seed);
+    // GNSS and baro at the run's own epochs with its own sigmas.
+    run.gnss.clear();
+    run.baro.clear();
+    const auto zg = emulation::standardNormal(6 * realGnss.size() + 1, stochastic::deriveSeed(seed, 5));
+    for (std::size_t k = 0; k < realGnss.size(); ++k) {
+      const GnssFix& f = realGnss[k];
+      if (f.t < t0 || f.t > t1) continue;
+      const emulation::TruthState s = tr.at(f.t);
+      const Eigen::Matrix3d Lp = f.cov_pos_N->llt().matrixL();
+      const Eigen::Vector3d np(zg[6 * k], zg[6 * k + 1], zg[6 * k + 2]);
+      GnssFix g;
+      g.t = f.t;
+      g.pos = earth::nedToGeodetic(tr.origin(), s.p_L + s.C_BtoN * lever + Lp * np);
+      g.cov_pos_N = f.cov_pos_N;
+      if (f.v_N && f.cov_vel_N) {
+        const Eigen::Matrix3d Lv = f.cov_vel_N->llt().matrixL();
+        const Eigen::Vector3d nv(zg[6 * k + 3], zg[6 * k + 4], zg[6 * k + 5]);
+        g.v_N = s.v_N + s.C_BtoN * s.w_NB_B.cross(lever) + Lv * nv;
+        g.cov_vel_N = f.cov_vel_N;
+      }
+      run.gnss.push_back(g);
+    }
+    const auto zb = emulation::standardNormal(realBaro.size() + 1, stochastic::deriveSeed(seed, 6));
+    for (std::size_t k = 0; k < realBaro.size(); ++k) {
+      const BaroSample& b = realBaro[k];
+      if (b.t < t0 || b.t > t1 || !b.sigma_m) continue;
+      BaroSample o = b;
+      o.h = tr.at(b.t).pos.h + *b.sigma_m * zb[k];
+      run.baro.push_back(o);
+    }
+    RealisationOut& ro = sims[r];
+    ro.err.resize(D);
+    ro.nees.resize(D);
+    for (std::size_t i = 0; i < D; ++i) {
+      const NavRunResult res = runNav(run.input(truths[i]), model, navs[i]);
+      if (res.epochs.size() != simOut[i].size())
+        throw Error("diagnose --run: realisation " + std::to_string(r) + " recorded " +
+                    std::to_string(res.epochs.size()) + " outage ends, expected " + std::to_string(simOut[i].size()));
+      for (const auto& e : res.epochs) {
+        ro.err[i].push_back(e.err);
+        ro.nees[i].push_back(e.nees[0]);
+      }
+      const int dn = ++done;
+      std::lock_guard<std::mutex> lk(progress_mu);
+      progress(0.15 + (opt.causes ? 0.65 : 0.85) * double(dn) / double(R * D), "simulation");
+    }
+  });
 
   // 4. Comparisons and NEES bands.
   const ReferenceInfo& ref = out.reference;
