@@ -11,6 +11,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/emulation/scenario.hpp"
+#include "navimpact/ins/nav_state.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/report/replay_report.hpp"
 #include "test_support.hpp"
@@ -231,6 +232,44 @@ TEST(Replay, WithoutGroundTruthTheFilterStartsAfterAnAligningPhase) {
                                                             e.est.geodetic());
   std::printf("position error at the end %.2f m\n", p.norm());
   EXPECT_LT(p.norm(), 10.0);
+}
+
+// A reference with attitude but without velocity: the filter cannot start from
+// it, so an aligning phase runs; its heading comes from the reference's attitude
+// at time zero (reported), unless turned off, then from the GNSS course later.
+TEST(Replay, AligningPhaseTakesItsHeadingFromTheReferenceAtTimeZero) {
+  const auto dir = navimpact::test::tempDir();
+  auto d = emulate60("model");
+  const double yaw0 = navimpact::ins::rollPitchYaw(d.reference.front().q_BtoN->toRotationMatrix())[2];
+  for (auto& g : d.reference) g.v_N.reset();
+  const auto path = (dir / "refatt.rawlog").string();
+  navimpact::rawlog::writeRawlog(path, d);
+  an::ReplayConfig c;
+  c.rawlog = path;
+  c.use_gnss_velocity = true;
+  const auto r = an::runReplay(c);
+  ASSERT_TRUE(r.alignment.has_value());
+  EXPECT_EQ(r.alignment->heading, "reference");
+  std::printf("reference heading: aligned at %.3f s, yaw %.3f deg (reference at time zero %.3f deg)\n",
+              r.aided_from_s, r.alignment->rpy[2] * 180.0 / M_PI, yaw0 * 180.0 / M_PI);
+  ASSERT_TRUE(r.score.has_value());  // scored on position and attitude
+  // the aligned heading at the filter start against the reference there
+  const navimpact::ReferenceRecord* g = nullptr;
+  for (const auto& x : d.reference)
+    if (std::abs(x.t - (r.t_zero + r.aided_from_s)) < 0.5e-2) g = &x;
+  ASSERT_NE(g, nullptr);
+  const double yaw_ref = navimpact::ins::rollPitchYaw(g->q_BtoN->toRotationMatrix())[2];
+  const double dyaw = std::remainder(r.alignment->rpy[2] - yaw_ref, 2.0 * M_PI);
+  std::printf("yaw at the start %.3f deg, reference there %.3f deg, 1-sigma %.3f deg\n", r.alignment->rpy[2] * 180 / M_PI,
+              yaw_ref * 180 / M_PI, r.alignment->sigma_rpy[2] * 180 / M_PI);
+  EXPECT_LT(std::abs(dyaw), 3.0 * r.alignment->sigma_rpy[2]);
+  c.alignment_yaw_from_reference = false;
+  const auto r2 = an::runReplay(c);
+  ASSERT_TRUE(r2.alignment.has_value());
+  EXPECT_NE(r2.alignment->heading, "reference");
+  EXPECT_EQ(r2.alignment->heading.rfind("gnss_", 0), 0u) << r2.alignment->heading;
+  // the heading at time zero is known, not waited for: the filter starts no later
+  EXPECT_LE(r.aided_from_s, r2.aided_from_s);
 }
 
 // The new configuration keys load with their units and ranges; bad values name the key.

@@ -135,8 +135,9 @@ void ReplayConfig::loadFrom(const ConfigNode& root) {
   }
   root.read("reference_lever_arm_B_m", c.reference_lever_arm_B, limits::kLeverArmM);
   if (const auto a = root.optMap("alignment")) {
-    a->allowKeys({"yaw_deg", "yaw_sigma_deg", "max_align_s", "max_course_sigma_deg", "min_static_s", "max_level_s",
-                  "sideslip_sigma_deg"});
+    a->allowKeys({"yaw_deg", "yaw_sigma_deg", "yaw_from_reference", "max_align_s", "max_course_sigma_deg",
+                  "min_static_s", "max_level_s", "sideslip_sigma_deg"});
+    a->read("yaw_from_reference", c.alignment_yaw_from_reference);
     double x = 0.0;
     if (a->read("yaw_deg", x, kAngleDeg)) {
       c.alignment.yaw_rad = x * kDeg;
@@ -596,6 +597,12 @@ void ReplayDriver::run() {
     if (!ao.yaw_rad && cfg.initial_attitude_deg) {
       ao.yaw_rad = (*cfg.initial_attitude_deg)[2] * kDeg;
       ao.yaw_source = "configuration (initial_attitude_deg)";
+    }
+    if (!ao.yaw_rad && hasTruth_ && cfg.alignment_yaw_from_reference && !truthAhead_.t.empty() &&
+        std::abs(truthAhead_.t.front() - r.t_zero) <= 0.5 * dt_ && truthAhead_.x.front().q_BtoN.coeffs().allFinite()) {
+      // Heading from the reference's attitude at time zero (its entry there).
+      ao.yaw_rad = truthAhead_.x.front().rollPitchYaw()[2];
+      ao.yaw_source = "reference";
     }
     auto aligning = [&](auto&& f) {
       try {

@@ -41,7 +41,8 @@
  * outages_every: {period_s: 120, duration_s: 30}  # or --outages-every 120:30
  * reference_sigma: {horizontal_m: 0.05, vertical_m: 0.1}   # the reference's own 1-sigma
  * reference_lever_arm_B_m: [0, 0, 0]        # the reference's point (e.g. the antenna) from the IMU
- * alignment: {yaw_deg: 40, yaw_sigma_deg: 2, max_align_s: 600, max_course_sigma_deg: 3}
+ * alignment: {yaw_deg: 40, yaw_sigma_deg: 2, max_align_s: 600, max_course_sigma_deg: 3,
+ *             yaw_from_reference: true}
  * imu_at_rest: {gyro_sigma_rad_s: 1e-3, acc_sigma_mps2: 1e-2, window_s: 0.5, false_alarm: 0.01}
  * aids: {zupt: {sigma_mps: 0.02, interval_s: 0.1},
  *        nhc: {sigma_lateral_mps: 0.1, sigma_vertical_mps: 0.1, interval_s: 0.1,
@@ -49,8 +50,9 @@
  *
  * Rawlogs without ground truth (label GT absent, e.g. a real run): an
  * aligning phase (filter/alignment.hpp: static or GNSS-velocity levelling,
- * heading from `alignment.yaw_deg` / `initial_attitude_deg`'s yaw or the GNSS
- * course once moving) runs from time zero until it has an attitude, a
+ * heading from `alignment.yaw_deg` / `initial_attitude_deg`'s yaw, else from
+ * the reference's attitude at time zero when it has one there (unless
+ * `yaw_from_reference: false`), else from the GNSS course once moving) runs from time zero until it has an attitude, a
  * position and a velocity; the filter starts there (no fix is needed at the
  * first IMU sample) and the phase is reported. The estimate and the
  * predicted sigmas are recorded every `record_interval_s` (default 0.1 s);
@@ -108,6 +110,9 @@ struct ReplayConfig {
   double reference_sigma_v_m = 0.0;             ///< its vertical 1-sigma [m]
   Eigen::Vector3d reference_lever_arm_B = Eigen::Vector3d::Zero();  ///< the reference's point from the IMU, body FRD [m]
   filter::AlignmentOptions alignment;           ///< the aligning phase without GT (lever arm and yaw set by the replay)
+  /// Heading of the aligning phase from the reference's attitude at time zero
+  /// (when it has one there and no yaw is configured); false: from the GNSS course.
+  bool alignment_yaw_from_reference = true;
   NavRunOptions aids;                           ///< only its zupt* / nhc* fields are used (ground-vehicle aids)
   /// false: the rawlog's reference (GT) is ignored, as for a rawlog without
   /// one (aligning phase, estimate recorded every record_interval_s); used to
