@@ -9,7 +9,7 @@ PKGS=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev zlib1g-dev
   libmrpt-obs-dev libmrpt-io-dev libmrpt-poses-dev libmrpt-random-dev
   libmrpt-system-dev libmrpt-config-dev
-  mrpt-apps
+  mrpt-apps xvfb xauth x11-utils
   libopencv-dev libopencv-contrib-dev fonts-dejavu-core
   libgtest-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev llvm-14

@@ -768,6 +768,49 @@ function(check_sweep_shards)
   message(STATUS "sweep: unsharded and merged outputs identical byte for byte")
 endfunction()
 
+# RawLogViewer (package mrpt-apps) opens RAWLOG on a virtual X display (xvfb-run,
+# x11-utils' xwininfo): EXPECT=loaded when its windows show the load done (the
+# load progress gone and the start-up "Tip of the Day" up, which comes after the
+# tree view is built) and no "Zero entries loaded" box; EXPECT=zero when that box
+# is what it shows (a file it cannot read). A fresh HOME so no saved settings
+# change what it shows; 60 s at most.
+function(check_rawlog_viewer)
+  foreach(p RawLogViewer xvfb-run xwininfo)
+    find_program(_p_${p} ${p})
+    if(NOT _p_${p})
+      fail("${p} not found (scripts/deps.sh installs mrpt-apps, xvfb, x11-utils)")
+    endif()
+  endforeach()
+  get_filename_component(dir ${RAWLOG} DIRECTORY)
+  set(home ${dir}/rawlog_viewer_home)
+  file(REMOVE_RECURSE ${home})
+  file(MAKE_DIRECTORY ${home})
+  set(script [=[
+RawLogViewer "$1" >/dev/null 2>&1 &
+pid=$!
+state=timeout
+seen=
+for i in $(seq 1 240); do
+  sleep 0.25
+  w=$(xwininfo -root -tree 2>/dev/null | grep -oE '^ +0x[0-9a-f]+ "[^"]+"' | sed 's/^[^"]*"//; s/"$//' | sort -u | tr '\n' '|')
+  seen="$w"
+  case "$w" in *"Zero entries loaded"*) state=zero; break ;; esac
+  case "$w" in *"Tip of the Day"*) case "$w" in *"Progress of rawlog load"*) ;; *) state=loaded; break ;; esac ;; esac
+  kill -0 $pid 2>/dev/null || { state=exited; break; }
+done
+kill $pid 2>/dev/null; wait $pid 2>/dev/null
+echo "RawLogViewer: $state (windows: $seen)"
+]=])
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env HOME=${home} XDG_CONFIG_HOME=${home}
+                          xvfb-run -a -s "-screen 0 1280x1024x24" bash -c "${script}" viewer ${RAWLOG}
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 90)
+  string(STRIP "${out}" out)
+  if(NOT "${out}" MATCHES "RawLogViewer: ${EXPECT} ")
+    fail("RawLogViewer on ${RAWLOG}: expected '${EXPECT}', got: ${out} (exit ${rc}) ${err}")
+  endif()
+  message("${out}")
+endfunction()
+
 if(NOT DEFINED CHECK OR NOT COMMAND check_${CHECK})
   fail("cli_helpers.cmake: unknown CHECK '${CHECK}'")
 endif()

@@ -30,6 +30,15 @@ set_tests_properties(cli_emulate_uav30 PROPERTIES FIXTURES_SETUP emu_rawlog
 navimpact_cli_check(cli_emulate_rawlog_edit_info CHECK rawlog_edit_info DEFINES RAWLOG=${_edir}/uav30.rawlog)
 set_tests_properties(cli_emulate_rawlog_edit_info PROPERTIES FIXTURES_REQUIRED emu_rawlog)
 
+# RawLogViewer opens it (on a virtual display); a file of random bytes it cannot
+# read shows its "Zero entries loaded" box instead, so the check can say no.
+navimpact_cli_check(cli_emulate_rawlog_viewer CHECK rawlog_viewer DEFINES RAWLOG=${_edir}/uav30.rawlog EXPECT=loaded)
+set_tests_properties(cli_emulate_rawlog_viewer PROPERTIES FIXTURES_REQUIRED emu_rawlog)
+string(RANDOM LENGTH 4000 RANDOM_SEED 20261125 _garbage)
+file(WRITE ${_edir}/garbage.rawlog "${_garbage}")
+navimpact_cli_check(cli_rawlog_viewer_refuses_garbage CHECK rawlog_viewer DEFINES RAWLOG=${_edir}/garbage.rawlog EXPECT=zero)
+
+
 # Bad input: one-line error, nothing written.
 navimpact_cli_fail(cli_emulate_bad_key
   ARGS emulate --config ${_edir}/bad_key.yaml --out ${_edir}/bad.rawlog

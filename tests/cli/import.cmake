@@ -16,6 +16,10 @@ navimpact_cli_check(cli_import_rawlog_edit_distance CHECK rawlog_edit_gt_distanc
   DEFINES RAWLOG=${_idir}/katwijk.rawlog ROWS=101 MIN_M=45 MAX_M=70)
 set_tests_properties(cli_import_rawlog_edit_distance PROPERTIES FIXTURES_REQUIRED import_katwijk)
 
+# RawLogViewer opens the imported real run
+navimpact_cli_check(cli_import_rawlog_viewer CHECK rawlog_viewer DEFINES RAWLOG=${_idir}/katwijk.rawlog EXPECT=loaded)
+set_tests_properties(cli_import_rawlog_viewer PROPERTIES FIXTURES_REQUIRED import_katwijk)
+
 # navimpact's own readers take the imported rawlog (IMU at its real rate)
 add_test(NAME cli_import_wv_reads_it
   COMMAND ${NI} wv --input ${_idir}/katwijk.rawlog --label IMU --out ${_idir}/wv --overwrite)
