@@ -35,6 +35,9 @@ Discretization parseDiscretization(const std::string& s) {
 struct ErrorStateEkf::Transition {
   Matrix9d A;
   MatrixXd B, D, Q;
+  /// D and the IMU block of Q hold the exact blocks of this interval length
+  /// (they depend on dt only); -1: not filled, or Q overwritten whole (Van Loan).
+  double imu_dt = -1.0;
 };
 
 struct ErrorStateEkf::Cache {
@@ -57,7 +60,6 @@ struct ErrorStateEkf::Cache {
   MatrixXd Mni;                     // scratch of the propagation
   MatrixXd PHt, K, KS, Pc;          // scratch of the update (KS holds K L)
   VectorXd inv;
-  Eigen::LLT<MatrixXd> llt;
 };
 
 /// The cached exact IMU-error blocks for @p dt (relative tolerance 1e-9, far
@@ -271,12 +273,17 @@ void ErrorStateEkf::buildTransition(const Lin& L, double dt, Transition& T) cons
   const auto& blocks = layout_.blocks();
   Cache& c = *cache_;
   const Cache::Blocks& cb = c.blocksFor(blocks, dt);
-  T.D.setZero(m, m);
-  T.Q.setZero(9 + m, 9 + m);
-  for (std::size_t k = 0; k < blocks.size(); ++k) {
-    const int o = blocks[k].offset - kNav, n = blocks[k].ss.n;
-    T.D.block(o, o, n, n) = cb.Phi[k];
-    T.Q.block(9 + o, 9 + o, n, n) = cb.Qd[k];
+  // D and the IMU block of Q: the exact blocks of cb, written once per interval
+  // length (the navigation rows and columns of Q are overwritten below)
+  if (T.imu_dt != cb.dt || T.D.rows() != m || T.Q.rows() != 9 + m) {
+    T.D.setZero(m, m);
+    T.Q.setZero(9 + m, 9 + m);
+    for (std::size_t k = 0; k < blocks.size(); ++k) {
+      const int o = blocks[k].offset - kNav, n = blocks[k].ss.n;
+      T.D.block(o, o, n, n) = cb.Phi[k];
+      T.Q.block(9 + o, 9 + o, n, n) = cb.Qd[k];
+    }
+    T.imu_dt = cb.dt;
   }
 
   if (cfg_.discretization == Discretization::VanLoan) {
@@ -297,6 +304,7 @@ void ErrorStateEkf::buildTransition(const Lin& L, double dt, Transition& T) cons
     const MatrixXd Qii = T.Q.bottomRightCorner(m, m);
     T.Q = Qd;
     T.Q.bottomRightCorner(m, m) = Qii;
+    T.imu_dt = -1.0;  // Q overwritten whole
     return;
   }
 
@@ -310,7 +318,9 @@ void ErrorStateEkf::buildTransition(const Lin& L, double dt, Transition& T) cons
   MatrixXd& FniQii = c.FniQii;
   MatrixXd& FniQiiFii = c.FniQiiFii;
   MatrixXd& FniFiiQii = c.FniFiiQii;
-  for (MatrixXd* M : {&Fni, &FniFii, &FniQii, &FniQiiFii, &FniFiiQii}) M->setZero(9, m);
+  // every call writes the same entries below (the layout's), the rest stays zero
+  if (Fni.rows() != 9 || Fni.cols() != m)
+    for (MatrixXd* M : {&Fni, &FniFii, &FniQii, &FniQiiFii, &FniFiiQii}) M->setZero(9, m);
   for (const ProcessBlock& b : blocks) {
     const int o = b.offset - kNav, n = b.ss.n;
     const int row = b.channel < 3 ? kAtt : kVel;
@@ -573,8 +583,12 @@ void ErrorStateEkf::checkPositiveDefinite(const char* where) {
   if (!Pc.allFinite())
     throw Error("filter covariance is not finite at t = " + formatNumber(state().t, 9) + " s after " + where);
   Pc.diagonal().array() += PdCheck::tolerance;
-  c.llt.compute(Pc);
-  if (c.llt.info() == Eigen::Success) return;
+  // Factorised in place: the decomposition Eigen::LLT::compute() runs, without
+  // its copy of Pc and its L1 norm (unused here); the same bits, the same verdict.
+  if (Eigen::internal::llt_inplace<double, Eigen::Lower>::blocked(Pc) == -1) return;
+  // not positive definite: Pc again as it was before the factorisation
+  Pc = inv.asDiagonal() * P_ * inv.asDiagonal();
+  Pc.diagonal().array() += PdCheck::tolerance;
   Pc.diagonal().array() -= PdCheck::tolerance;
   const Eigen::SelfAdjointEigenSolver<MatrixXd> es(Pc);
   const double lambda = es.eigenvalues()(0);
@@ -866,7 +880,13 @@ UpdateResult ErrorStateEkf::update(const VectorXd& dz, const MatrixXd& H, const 
   KL.noalias() = K * llt.matrixL();
   auto Pl = P_.selfadjointView<Eigen::Lower>();
   for (int j = 0; j < mz; ++j) Pl.rankUpdate(K.col(j), PHt.col(j), -1.0);
-  Pl.rankUpdate(KL, 1.0);
+  // A scalar measurement (baro) adds the rank-one (K L)(K L)': as a vector,
+  // P_ij + k_i k_j, the same sum the general product forms with one term,
+  // without its packing.
+  if (mz == 1)
+    Pl.rankUpdate(KL.col(0), 1.0);
+  else
+    Pl.rankUpdate(KL, 1.0);
   P_.triangularView<Eigen::StrictlyUpper>() = P_.transpose();
   if (feedback) {
     const VectorXd dx = K * dz;  // estimated error (estimate minus truth)
