@@ -4,7 +4,6 @@
 //   navimpact study-merge DIR1 DIR2 ... --out DIR
 #include <iostream>
 #include <memory>
-#include <thread>
 
 #include "cli_common.hpp"
 #include "navimpact/analysis/study.hpp"
@@ -46,15 +45,13 @@ int runStudyCmd(const StudyOpts& o) {
   if (o.seed >= 0) cfg.seed = static_cast<std::uint64_t>(o.seed);
   if (o.threads >= 0) cfg.threads = static_cast<unsigned>(o.threads);
   const an::Shard shard = o.shard.empty() ? an::Shard{} : an::parseShard(o.shard);
-  unsigned threads = cfg.threads;
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
 
   const auto plan = an::prepareStudy(cfg, NAVIMPACT_VERSION);  // every input error is thrown here
   std::size_t todo = 0;
   for (std::size_t i = 0; i < cfg.runs; ++i) todo += shard.contains(i) ? 1 : 0;
   navimpact::cli::Progress bar("study", todo);
   const an::StudyResults res =
-      an::runStudy(plan, shard, threads, [&bar](std::size_t done, std::size_t) { bar.update(done); });
+      an::runStudy(plan, shard, cfg.threads, [&bar](std::size_t done, std::size_t) { bar.update(done); });
   bar.finish();
 
   if (shard.whole()) {

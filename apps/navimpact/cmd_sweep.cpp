@@ -10,7 +10,6 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
-#include <thread>
 
 #include "cli_common.hpp"
 #include "navimpact/analysis/sweep.hpp"
@@ -89,8 +88,6 @@ int runSweepCmd(const SweepOpts& o) {
   if (o.seed >= 0) cfg.study.seed = static_cast<std::uint64_t>(o.seed);
   if (o.threads >= 0) cfg.study.threads = static_cast<unsigned>(o.threads);
   const an::Shard shard = o.shard.empty() ? an::Shard{} : an::parseShard(o.shard);
-  unsigned threads = cfg.study.threads;
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
 
   const auto plan = an::prepareSweep(cfg, NAVIMPACT_VERSION);  // every input error is thrown here
   if (emit) return emitSlurm(o, cfg, an::sweepMeta(*plan));
@@ -98,7 +95,7 @@ int runSweepCmd(const SweepOpts& o) {
   for (std::size_t i = 0; i < cfg.study.runs; ++i) per += shard.contains(i) ? 1 : 0;
   navimpact::cli::Progress bar("sweep", per * an::sweepMeta(*plan).columns.size());
   const an::SweepRuns runs =
-      an::runSweep(plan, shard, threads, [&bar](std::size_t done, std::size_t) { bar.update(done); });
+      an::runSweep(plan, shard, cfg.study.threads, [&bar](std::size_t done, std::size_t) { bar.update(done); });
   bar.finish();
 
   if (shard.whole()) {

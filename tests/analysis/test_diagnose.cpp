@@ -106,6 +106,34 @@ TEST(Diagnose, NullRecordsFalseAlarmsAtAlpha) {
   EXPECT_LE(alarms, mcBound(0.05, R) * R);
 }
 
+// The channels go over the worker pool: diagnosis.json is the same whatever the
+// thread count, on a six-channel record with one hidden effect of a cause
+// drawn at random (seeded; printed) at 5x its detection limit.
+TEST(DiagnoseThreads, ResultDoesNotDependOnTheThreadCount) {
+  const std::uint64_t s = ns::deriveSeed(rootSeed(), 770000u);
+  const std::vector<na::Cause> all = {na::Cause::WhiteNoise, na::Cause::QuantizationNoise, na::Cause::RandomWalk,
+                                      na::Cause::Drift,      na::Cause::GaussMarkov,       na::Cause::Sinusoid,
+                                      na::Cause::LevelShift, na::Cause::Outliers};
+  const na::Cause cause = all[s % all.size()];
+  pw::DrawRanges rg = testRanges();
+  rg.max_samples = 1 << 15;
+  const pw::Case c = pw::drawCase({cause}, rg, 5.0, s, 6);
+  std::cout << "seed " << s << ": " << c.text << "\n";
+  std::string one;
+  for (int threads : {1, 2, 6}) {
+    na::DiagnoseOptions o;
+    o.seed = s;
+    o.threads = threads;
+    o.simulations = 4;
+    const std::string json = navimpact::report::diagnosisJson(na::diagnose(c.data, c.model, o), "{}");
+    if (threads == 1) {
+      one = json;
+    } else {
+      EXPECT_EQ(json, one) << threads << " threads";
+    }
+  }
+}
+
 class HiddenCause : public ::testing::TestWithParam<na::Cause> {};
 
 TEST_P(HiddenCause, FoundAtFiveTimesTheLimitWithTheRightCauseAndParameter) {

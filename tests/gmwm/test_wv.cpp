@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <random>
 #include <sstream>
@@ -286,5 +287,47 @@ TEST(Wv, NonFiniteResultIsAnErrorNamingTheCause) {
     const std::string m = e.what();
     EXPECT_NE(m.find("big_sample.csv: channel gyro_z: wavelet variance at tau"), std::string::npos) << m;
     EXPECT_NE(m.find("is not finite"), std::string::npos) << m;
+  }
+}
+
+// The channels go over the worker pool: the wavelet variances (classical and
+// robust) are the same whatever the thread count. Six channels of white noise
+// plus a random walk, lengths and levels drawn at random (seeded, printed).
+TEST(Wv, ChannelsGiveTheSameResultOnAnyNumberOfThreads) {
+  const std::uint64_t seed = 20261125;
+  std::mt19937_64 rng(seed);
+  ImuSeries s;
+  s.source = "threads.csv";
+  s.rate_hz = 100;
+  const int n = 1024 + int(rng() % 3000);
+  std::cout << "seed " << seed << ": " << n << " samples per channel\n";
+  for (int c = 0; c < 6; ++c) {
+    ImuChannel ch;
+    ch.name = kChannelNames[c];
+    ch.quantity = channelQuantity(ch.name);
+    const double sigma = std::pow(10.0, std::uniform_real_distribution<>(-4, -1)(rng)), q = sigma * 1e-2;
+    std::normal_distribution<> g(0, 1);
+    double walk = 0.0;
+    for (int i = 0; i < n; ++i) {
+      walk += q * g(rng);
+      ch.x.push_back(sigma * g(rng) + walk);
+    }
+    s.channels.push_back(ch);
+  }
+  for (bool robust : {false, true}) {
+    gmwm::WvOptions o;
+    o.robust = robust;
+    o.threads = 1;
+    const auto one = gmwm::waveletVariances(s, o);
+    for (int threads : {2, 3, 6, 0}) {
+      o.threads = threads;
+      const auto many = gmwm::waveletVariances(s, o);
+      ASSERT_EQ(many.size(), one.size());
+      for (std::size_t c = 0; c < one.size(); ++c) {
+        EXPECT_EQ(many[c].wv, one[c].wv) << "robust " << robust << ", " << threads << " threads, channel " << c;
+        EXPECT_EQ(many[c].ci_low, one[c].ci_low);
+        EXPECT_EQ(many[c].ci_high, one[c].ci_high);
+      }
+    }
   }
 }

@@ -2,21 +2,19 @@
 #include "navimpact/analysis/diagnose_power.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <optional>
 #include <ctime>
-#include <mutex>
 #include <random>
 #include <sstream>
-#include <thread>
 
 #include <boost/math/distributions/normal.hpp>
 
 #include "diagnosis_internal.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/parallel.hpp"
 #include "navimpact/detect/null_model.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
@@ -398,60 +396,45 @@ PowerResult runPower(const PowerOptions& opt_in) {
     for (int i = 0; i < opt.runs_per_cause; ++i) jobs.push_back({static_cast<int>(c), i});
   std::vector<PowerRun> out(jobs.size());
   std::vector<char> alarm(jobs.size(), 0);
-  std::atomic<std::size_t> next{0}, done{0};
-  std::mutex mu;
-  std::string first_error;
   const auto wall0 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();
-  auto work = [&]() {
-    for (;;) {
-      const std::size_t i = next++;
-      if (i >= jobs.size()) return;
-      try {
-        const Job& j = jobs[i];
-        const std::uint64_t s = stochastic::deriveSeed(opt.seed, 1000000u * static_cast<std::uint64_t>(j.cause + 1) + j.index);
-        Rng rng(stochastic::deriveSeed(s, 1));
-        const double snr = j.cause < 0 ? 0.0 : rng.logU(opt.min_snr, opt.max_snr);
-        const std::vector<Cause> cs = j.cause < 0 ? std::vector<Cause>{} : std::vector<Cause>{opt.causes[j.cause]};
-        const Case c = drawCase(cs, opt.ranges, snr, s, j.cause < 0 ? 6 : 1);
-        DiagnoseOptions dopt;
-        dopt.seed = s;
-        dopt.threads = 1;
-        dopt.simulations = opt.simulations;
-        dopt.alpha = opt.alpha;
-        const Diagnosis d = diagnose(c.data, c.model, dopt);
-        PowerRun& r = out[i];
-        r.rate_hz = c.data.rate_hz;
-        r.duration_s = static_cast<double>(c.data.size()) / c.data.rate_hz;
-        r.snr = snr;
-        if (j.cause < 0) {
-          alarm[i] = !d.adequate;
-          if (!d.adequate) r.why = c.text + ":" + describe(d);
-        } else {
-          const Outcome o = judge(c, d);
-          r.cause = opt.causes[j.cause];
-          r.detected = o.detected[0];
-          r.right = o.right[0];
-          r.why = o.why;
-        }
-        const std::size_t dn = ++done;
-        if (opt.progress) {
-          std::lock_guard<std::mutex> lk(mu);
-          opt.progress(static_cast<double>(dn) / static_cast<double>(jobs.size()));
-        }
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lk(mu);
-        if (first_error.empty()) first_error = e.what();
-        next = jobs.size();
+  TaskProgress progress;
+  if (opt.progress)
+    progress = [&](std::size_t done, std::size_t count) {
+      opt.progress(static_cast<double>(done) / static_cast<double>(count));
+    };
+  try {
+    parallelFor(jobs.size(), static_cast<unsigned>(std::max(opt.threads, 0)), [&](std::size_t i) {
+      const Job& j = jobs[i];
+      const std::uint64_t s = stochastic::deriveSeed(opt.seed, 1000000u * static_cast<std::uint64_t>(j.cause + 1) + j.index);
+      Rng rng(stochastic::deriveSeed(s, 1));
+      const double snr = j.cause < 0 ? 0.0 : rng.logU(opt.min_snr, opt.max_snr);
+      const std::vector<Cause> cs = j.cause < 0 ? std::vector<Cause>{} : std::vector<Cause>{opt.causes[j.cause]};
+      const Case c = drawCase(cs, opt.ranges, snr, s, j.cause < 0 ? 6 : 1);
+      DiagnoseOptions dopt;
+      dopt.seed = s;
+      dopt.threads = 1;
+      dopt.simulations = opt.simulations;
+      dopt.alpha = opt.alpha;
+      const Diagnosis d = diagnose(c.data, c.model, dopt);
+      PowerRun& r = out[i];
+      r.rate_hz = c.data.rate_hz;
+      r.duration_s = static_cast<double>(c.data.size()) / c.data.rate_hz;
+      r.snr = snr;
+      if (j.cause < 0) {
+        alarm[i] = !d.adequate;
+        if (!d.adequate) r.why = c.text + ":" + describe(d);
+      } else {
+        const Outcome o = judge(c, d);
+        r.cause = opt.causes[j.cause];
+        r.detected = o.detected[0];
+        r.right = o.right[0];
+        r.why = o.why;
       }
-    }
-  };
-  int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (!first_error.empty()) throw Error("diagnose-power: " + first_error);
+    }, progress);
+  } catch (const Error& e) {
+    throw Error("diagnose-power: " + std::string(e.what()));
+  }
   for (std::size_t i = 0; i < jobs.size(); ++i) {
     if (jobs[i].cause < 0) {
       ++res.null_runs;

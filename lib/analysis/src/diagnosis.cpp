@@ -9,7 +9,6 @@
 #include <map>
 #include <mutex>
 #include <sstream>
-#include <thread>
 #include <tuple>
 
 #include <boost/math/distributions/chi_squared.hpp>
@@ -19,6 +18,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/golden_section.hpp"
+#include "navimpact/core/parallel.hpp"
 #include "navimpact/detect/change_points.hpp"
 #include "navimpact/detect/lines.hpp"
 #include "navimpact/detect/null_model.hpp"
@@ -1773,33 +1773,14 @@ Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
   sh.channels = C;
   sh.total_units = static_cast<int>(data.channels.size()) * (opt.simulations + 4);
   d.channels.resize(data.channels.size());
-  std::atomic<int> next{0};
-  std::mutex err_mu;
-  std::string first_error;
-  int first_error_ch = -1;
-  auto worker = [&]() {
-    for (;;) {
-      const int i = next++;
-      if (i >= static_cast<int>(data.channels.size())) return;
-      try {
-        d.channels[i] = diagnoseChannel(sh, i);
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lk(err_mu);
-        if (first_error_ch < 0 || i < first_error_ch) {
-          first_error_ch = i;
-          first_error = data.source + ": channel " + data.channels[i].name + ": " + e.what();
-        }
-      }
+  // Channels in parallel; a failure names its channel (the lowest one that failed).
+  parallelFor(data.channels.size(), static_cast<unsigned>(std::max(opt.threads, 0)), [&](std::size_t i) {
+    try {
+      d.channels[i] = diagnoseChannel(sh, static_cast<int>(i));
+    } catch (const Error& e) {
+      throw Error(data.source + ": channel " + data.channels[i].name + ": " + e.what());
     }
-  };
-  int threads = opt.threads > 0 ? opt.threads
-                                : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = std::min<int>(threads, static_cast<int>(data.channels.size()));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  if (first_error_ch >= 0) throw Error(first_error);
+  });
   d.model_after = d.model_before;
   d.adequate = true;
   for (const auto& c : d.channels) {

@@ -4,12 +4,9 @@
 // analysis::runNav. Built from the same library pieces as the study
 // (emulation::perfectImu / staticImuErrors / simulateGnss / simulateBaro).
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <mutex>
 #include <sstream>
-#include <thread>
 
 #include <boost/math/distributions/binomial.hpp>
 #include <boost/math/distributions/students_t.hpp>
@@ -21,6 +18,7 @@
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/parallel.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/filter/state_layout.hpp"
@@ -186,60 +184,37 @@ void addNavigationGain(Diagnosis& d, const ImuSeries& data, const NavGainPlan& p
 
   const std::size_t O = run.nav.outages.size(), E = run.truth.t.size();
   std::vector<RunOut> outs(opt.runs);
-  std::atomic<int> next{0}, done{0};
-  std::mutex mu;
-  std::string first_error;
-  auto work = [&]() {
-    for (;;) {
-      const int r = next++;
-      if (r >= opt.runs) return;
-      try {
-        const std::uint64_t seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(r));
-        emulation::StaticRecordingSpec spec;
-        spec.file = data.source;
-        spec.offset_s = double(offs[r]) / run.rate_hz;
-        const auto err = emulation::staticImuErrors(rec, spec, run.rate_hz, n).axis;
-        const EmulatedRun emulated = run.emulate(err, seed);
-        const NavRunInput in = run.input(emulated);
-        RunOut& o = outs[r];
-        for (int m = 0; m < 2; ++m) {
-          const NavRunResult res = runNav(in, m == 0 ? before : after, run.nav);
-          if (res.epochs.size() != E)
-            throw Error("navigation gain: run " + std::to_string(r) + " recorded " +
-                        std::to_string(res.epochs.size()) + " epochs, expected " + std::to_string(E));
-          for (std::size_t e = 0; e < E; ++e) {
-            const auto& ep = res.epochs[e];
-            o.eh[m].push_back(std::hypot(ep.err(0), ep.err(1)));
-            o.ev[m].push_back(std::abs(ep.err(2)));
-            o.sh[m].push_back(std::hypot(ep.sigma(0), ep.sigma(1)));
-          }
-          for (std::size_t q = 0; q < O; ++q) {
-            const auto& ep = res.epochs[run.outage_end_epoch[q]];
-            o.h[m].push_back(std::hypot(ep.err(0), ep.err(1)));
-            o.v[m].push_back(std::abs(ep.err(2)));
-            o.nees[m].push_back(ep.nees[0]);
-            o.drift[m].push_back(res.outages[q].max_drift_h);
-          }
-          const int dn = ++done;
-          if (progress) {
-            std::lock_guard<std::mutex> lk(mu);
-            progress(static_cast<double>(dn) / (2.0 * opt.runs));
-          }
-        }
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lk(mu);
-        if (first_error.empty()) first_error = e.what();
-        next = opt.runs;
+  TaskProgress each;
+  if (progress) each = [&](std::size_t done, std::size_t count) { progress(double(done) / double(count)); };
+  parallelFor(static_cast<std::size_t>(opt.runs), static_cast<unsigned>(std::max(opt.threads, 0)), [&](std::size_t r) {
+    const std::uint64_t seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(r));
+    emulation::StaticRecordingSpec spec;
+    spec.file = data.source;
+    spec.offset_s = double(offs[r]) / run.rate_hz;
+    const auto err = emulation::staticImuErrors(rec, spec, run.rate_hz, n).axis;
+    const EmulatedRun emulated = run.emulate(err, seed);
+    const NavRunInput in = run.input(emulated);
+    RunOut& o = outs[r];
+    for (int m = 0; m < 2; ++m) {
+      const NavRunResult res = runNav(in, m == 0 ? before : after, run.nav);
+      if (res.epochs.size() != E)
+        throw Error("navigation gain: run " + std::to_string(r) + " recorded " +
+                    std::to_string(res.epochs.size()) + " epochs, expected " + std::to_string(E));
+      for (std::size_t e = 0; e < E; ++e) {
+        const auto& ep = res.epochs[e];
+        o.eh[m].push_back(std::hypot(ep.err(0), ep.err(1)));
+        o.ev[m].push_back(std::abs(ep.err(2)));
+        o.sh[m].push_back(std::hypot(ep.sigma(0), ep.sigma(1)));
+      }
+      for (std::size_t q = 0; q < O; ++q) {
+        const auto& ep = res.epochs[run.outage_end_epoch[q]];
+        o.h[m].push_back(std::hypot(ep.err(0), ep.err(1)));
+        o.v[m].push_back(std::abs(ep.err(2)));
+        o.nees[m].push_back(ep.nees[0]);
+        o.drift[m].push_back(res.outages[q].max_drift_h);
       }
     }
-  };
-  int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = std::min(threads, opt.runs);
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (!first_error.empty()) throw Error(first_error);
+  }, each);
 
   // Per outage, paired over runs.
   for (std::size_t q = 0; q < O; ++q) {

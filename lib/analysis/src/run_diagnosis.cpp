@@ -3,12 +3,9 @@
 #include "navimpact/analysis/run_diagnosis.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <mutex>
 #include <random>
-#include <thread>
 
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/fisher_f.hpp>
@@ -17,6 +14,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/limits.hpp"
+#include "navimpact/core/parallel.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/emulation/sensor_effects.hpp"
 #include "navimpact/emulation/sensors.hpp"
@@ -125,33 +123,6 @@ LogTest logTest(double x, const std::vector<double>& logs, double a) {
   if (se > 0) r.p = std::min(1.0, 2.0 * boost::math::cdf(boost::math::complement(st, std::abs(r.log_ratio) / se)));
   else r.p = r.log_ratio == 0.0 ? 1.0 : 0.0;
   return r;
-}
-
-/// Run tasks 0..n-1 on up to @p threads threads; the first error is rethrown.
-void parallelFor(int n, int threads, const std::function<void(int)>& task) {
-  std::atomic<int> next{0};
-  std::mutex mu;
-  std::string first_error;
-  auto work = [&]() {
-    for (;;) {
-      const int i = next++;
-      if (i >= n) return;
-      try {
-        task(i);
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lk(mu);
-        if (first_error.empty()) first_error = e.what();
-        next = n;
-      }
-    }
-  };
-  int t = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  t = std::max(1, std::min(t, n));
-  std::vector<std::thread> pool;
-  for (int k = 1; k < t; ++k) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
-  if (!first_error.empty()) throw Error(first_error);
 }
 
 /// Error and predicted sigma (nine navigation errors) at the end of each scored outage of @p r.
@@ -770,10 +741,9 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
   std::vector<Scored> after(C * K);
   std::vector<ReplayConfig> foldCfg(C * K);
   std::vector<CauseResult> whole(C);
-  std::atomic<int> done{0};
-  std::mutex mu;
-  parallelFor(C * (K + 1), opt.threads, [&](int t) {
-    const int c = t / (K + 1), f = t % (K + 1);
+  const unsigned threads = static_cast<unsigned>(std::max(opt.threads, 0));
+  parallelFor(std::size_t(C * (K + 1)), threads, [&](std::size_t i) {
+    const int t = static_cast<int>(i), c = t / (K + 1), f = t % (K + 1);
     if (f == K) {
       whole[c].cause = cands[c].first;
       cands[c].second(opt.replay, Exclusion{}, &whole[c].findings, &whole[c]);
@@ -783,10 +753,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
     if (heldCount[f] == 0) return;
     foldCfg[task] = cands[c].second(opt.replay, excl[f], nullptr, nullptr);
     after[task] = replayScored(foldCfg[task]);
-    const int dn = ++done;
-    std::lock_guard<std::mutex> lk(mu);
-    progress(0.80 + 0.17 * double(dn) / double(C * K), "causes");
-  });
+  }, [&](std::size_t done, std::size_t count) { progress(0.80 + 0.17 * double(done) / double(count), "causes"); });
 
   // Paired held-out comparison: every outage scored by @p before and @p after of its fold.
   struct Paired {
@@ -859,13 +826,11 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
       if (c != top && whole[c].significant) others.push_back(c);
     const int O = static_cast<int>(others.size());
     std::vector<Scored> both(O * K);
-    parallelFor(O * K, opt.threads, [&](int t) {
-      const int c = others[t / K], f = t % K;
+    parallelFor(std::size_t(O * K), threads, [&](std::size_t t) {
+      const int c = others[t / K], f = static_cast<int>(t % K);
       if (heldCount[f] == 0) return;
       both[t] = replayScored(cands[c].second(foldCfg[top * K + f], excl[f], nullptr, nullptr));
-      std::lock_guard<std::mutex> lk(mu);
-      progress(0.97 + 0.02 * double(t + 1) / double(O * K), "causes");
-    });
+    }, [&](std::size_t done, std::size_t count) { progress(0.97 + 0.02 * double(done) / double(count), "causes"); });
     for (int k = 0; k < O; ++k) {
       const int c = others[k];
       const Paired pr = paired([&](int f) -> const Scored& { return after[top * K + f]; },
@@ -999,9 +964,7 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   // 3. Simulated realisations.
   const int R = opt.realisations;
   std::vector<RealisationOut> sims(R);
-  std::atomic<int> done{0};
-  std::mutex progress_mu;
-  parallelFor(R, opt.threads, [&](int r) {
+  parallelFor(std::size_t(R), static_cast<unsigned>(std::max(opt.threads, 0)), [&](std::size_t r) {
     const std::uint64_t seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(r));
     std::array<std::vector<double>, 6> err;
     if (rec) {
@@ -1056,10 +1019,9 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
         ro.err[i].push_back(e.err);
         ro.nees[i].push_back(e.nees[0]);
       }
-      const int dn = ++done;
-      std::lock_guard<std::mutex> lk(progress_mu);
-      progress(0.15 + (opt.causes ? 0.65 : 0.85) * double(dn) / double(R * D), "simulation");
     }
+  }, [&](std::size_t done, std::size_t count) {
+    progress(0.15 + (opt.causes ? 0.65 : 0.85) * double(done) / double(count), "simulation");
   });
 
   // 4. Comparisons and NEES bands.

@@ -5,22 +5,20 @@
 #include <boost/math/distributions/chi_squared.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstring>
-#include <exception>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <optional>
 #include <sstream>
-#include <thread>
 
 #include "navimpact/core/build_info.hpp"
 #include "navimpact/core/csv_reader.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
+#include "navimpact/core/parallel.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/analysis/run_plan.hpp"
 #include "navimpact/filter/error_model.hpp"
@@ -412,45 +410,23 @@ StudyResults runStudy(const std::shared_ptr<const StudyPlan>& plan, const Shard&
   if (N == 0) throw Error("study: shard " + std::to_string(shard.k) + "/" + std::to_string(shard.n) +
                           " holds no run (only " + std::to_string(p.cfg.runs) + " runs)");
   const std::size_t E = p.run.truth.t.size(), O = p.run.nav.outages.size();
-  threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(N)));
-
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> stop{false};
   std::mutex mu;
   std::map<std::size_t, RunRecord> pending;  // finished out of order, by position
   std::size_t merged = 0;
-  std::exception_ptr failure;
-  auto worker = [&]() {
-    for (;;) {
-      if (stop) return;
-      const std::size_t pos = next++;
-      if (pos >= N) return;
-      RunRecord rec;
-      try {
-        rec = doRun(p, res.run_indices[pos]);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mu);
-        if (!failure) failure = std::current_exception();
-        stop = true;
-        return;
-      }
-      std::lock_guard<std::mutex> lock(mu);
-      pending.emplace(pos, std::move(rec));
-      // Add in run-index order: the sums do not depend on scheduling.
-      for (auto it = pending.find(merged); it != pending.end(); it = pending.find(merged)) {
-        res.acc.add(it->second, E, O);
-        if (sink) sink(it->second);
-        else if (!shard.whole()) res.records.push_back(std::move(it->second));
-        pending.erase(it);
-        ++merged;
-        if (progress) progress(merged, N);
-      }
+  parallelFor(N, threads, [&](std::size_t pos) {
+    RunRecord rec = doRun(p, res.run_indices[pos]);
+    std::lock_guard<std::mutex> lock(mu);
+    pending.emplace(pos, std::move(rec));
+    // Add in run-index order: the sums do not depend on scheduling.
+    for (auto it = pending.find(merged); it != pending.end(); it = pending.find(merged)) {
+      res.acc.add(it->second, E, O);
+      if (sink) sink(it->second);
+      else if (!shard.whole()) res.records.push_back(std::move(it->second));
+      pending.erase(it);
+      ++merged;
+      if (progress) progress(merged, N);
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
+  });
   return res;
 }
 

@@ -7,21 +7,19 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <cstdio>
-#include <atomic>
 #include <cstdlib>
 #include <new>
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
-#include <exception>
 #include <functional>
 #include <memory>
 #include <sstream>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/parallel.hpp"
 #include "wv_internal.hpp"
 
 namespace navimpact::gmwm {
@@ -318,39 +316,16 @@ WaveletVariance waveletVariance(const double* x, std::size_t n, double rate_hz, 
 std::vector<WaveletVariance> waveletVariances(const ImuSeries& s, const WvOptions& opt) {
   const std::size_t nc = s.channels.size();
   std::vector<WaveletVariance> out(nc);
-  std::vector<std::exception_ptr> err(nc);
-  auto one = [&](std::size_t c) {
+  // Channels in parallel; a failure names its channel (the lowest one that failed).
+  parallelFor(nc, static_cast<unsigned>(std::max(opt.threads, 0)), [&](std::size_t c) {
+    const auto& ch = s.channels[c];
     try {
-      const auto& ch = s.channels[c];
-      out[c] = opt.robust
-                   ? robustWaveletVariance(ch.x.data(), ch.x.size(), s.rate_hz, opt.eff, opt.alpha)
-                   : waveletVariance(ch.x.data(), ch.x.size(), s.rate_hz, opt.alpha, opt.max_j);
-    } catch (...) {
-      err[c] = std::current_exception();
-    }
-  };
-  unsigned threads = opt.threads > 0 ? static_cast<unsigned>(opt.threads)
-                                     : std::max(1u, std::thread::hardware_concurrency());
-  threads = std::min<unsigned>(threads, static_cast<unsigned>(std::max<std::size_t>(nc, 1)));
-  if (threads <= 1) {
-    for (std::size_t c = 0; c < nc; ++c) one(c);
-  } else {
-    std::atomic<std::size_t> next{0};
-    std::vector<std::thread> pool;
-    for (unsigned t = 0; t < threads; ++t)
-      pool.emplace_back([&]() {
-        for (std::size_t c; (c = next.fetch_add(1)) < nc;) one(c);
-      });
-    for (auto& th : pool) th.join();
-  }
-  for (std::size_t c = 0; c < nc; ++c) {
-    if (!err[c]) continue;
-    try {
-      std::rethrow_exception(err[c]);
+      out[c] = opt.robust ? robustWaveletVariance(ch.x.data(), ch.x.size(), s.rate_hz, opt.eff, opt.alpha)
+                          : waveletVariance(ch.x.data(), ch.x.size(), s.rate_hz, opt.alpha, opt.max_j);
     } catch (const Error& e) {
-      throw Error(s.source + ": channel " + s.channels[c].name + ": " + e.what());
+      throw Error(s.source + ": channel " + ch.name + ": " + e.what());
     }
-  }
+  });
   // A non-finite result is an error naming its cause, never a file with inf/null.
   for (std::size_t c = 0; c < nc; ++c) {
     const auto& w = out[c];

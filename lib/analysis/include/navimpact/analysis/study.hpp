@@ -159,7 +159,7 @@ using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
  * Run the Monte Carlo study (or one shard of it) on a pool of threads.
  * @param[in] plan      from prepareStudy().
  * @param[in] shard     subset of run indices.
- * @param[in] threads   worker threads, >= 1.
+ * @param[in] threads   worker threads (0 = all hardware threads); the results do not depend on it.
  * @param[in] progress  may be empty.
  */
 struct RunRecord;

@@ -150,7 +150,8 @@ struct SweepRuns {
 /// Called with runs done and runs to do (over all columns).
 using SweepProgressFn = std::function<void(std::size_t done, std::size_t total)>;
 
-/// Run the sweep (or one shard: the run indices i with i % N == K - 1 in every column).
+/// Run the sweep (or one shard: the run indices i with i % N == K - 1 in every column)
+/// on @p threads worker threads (0 = all hardware threads; the results do not depend on it).
 SweepRuns runSweep(const std::shared_ptr<const SweepPlan>& plan, const Shard& shard, unsigned threads,
                    const SweepProgressFn& progress = {});
 
