@@ -42,7 +42,7 @@ std::pair<double, double> range(const std::string& flag, const std::string& v) {
     if (p1 != c || p2 != v.size() - c - 1 || !(a > 0) || !(b >= a)) throw std::invalid_argument("bad");
     return {a, b};
   } catch (const std::exception&) {
-    throw navimpact::Error(flag + " '" + v + "': expected LO:HI with 0 < LO <= HI");
+    throw navimpact::Error(flag + " '" + navimpact::printable(v, 60) + "': expected LO:HI with 0 < LO <= HI");
   }
 }
 

@@ -123,3 +123,24 @@ TEST(Outage, PatternClosedForm) {
   for (const char* bad : {"30", "30:30", "20:30", "a:b", "120:0", "120:-1", ":"})
     EXPECT_THROW(navimpact::parseOutagePattern(bad), navimpact::Error) << bad;
 }
+
+// Raw user text in a parse error is bounded and escaped (printable()): a control
+// character or a megabyte argument does not reach the message as it is.
+TEST(Outage, ParseErrorsEchoTheTextBoundedAndEscaped) {
+  const std::string huge(1 << 20, '7');
+  for (const std::string& bad : {std::string("12\n0:3\x1b[2J0"), std::string("120:0\t"), huge + ":x", "9:" + huge}) {
+    for (int which = 0; which < 2; ++which) {
+      try {
+        if (which == 0) navimpact::parseOutagePattern(bad);
+        else navimpact::parseOutage(bad, "--outage");
+        ADD_FAILURE() << "accepted " << bad.size() << " bytes";
+      } catch (const navimpact::Error& e) {
+        const std::string m = e.what();
+        EXPECT_LT(m.size(), 300u) << m;
+        for (char ch : m) EXPECT_FALSE(static_cast<unsigned char>(ch) < 0x20) << m;
+        const std::string head = which == 0 ? "outages every '" : "--outage '";
+        EXPECT_EQ(m.rfind(head + navimpact::printable(bad, 60) + "'", 0), 0u) << m;
+      }
+    }
+  }
+}

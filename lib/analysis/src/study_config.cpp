@@ -189,7 +189,7 @@ Shard parseShard(const std::string& text) {
   if (slash == std::string::npos || !parseDouble(text.substr(0, slash), k) ||
       !parseDouble(text.substr(slash + 1), n) || k != std::floor(k) || n != std::floor(n) || k < 1 || n < 1 ||
       k > n || n > 1e6)
-    throw Error("--shard '" + text + "': expected K/N with integers 1 <= K <= N (e.g. 2/4)");
+    throw Error("--shard '" + printable(text, 60) + "': expected K/N with integers 1 <= K <= N (e.g. 2/4)");
   return Shard{static_cast<unsigned>(k), static_cast<unsigned>(n)};
 }
 

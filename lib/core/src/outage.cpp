@@ -34,9 +34,9 @@ OutagePattern parseOutagePattern(const std::string& text) {
   OutagePattern p;
   if (c == std::string::npos || !parseDouble(trim(std::string_view(text).substr(0, c)), p.period_s) ||
       !parseDouble(trim(std::string_view(text).substr(c + 1)), p.duration_s))
-    throw Error("outages every '" + text + "': expected PERIOD:DURATION in seconds, e.g. 120:30");
+    throw Error("outages every '" + printable(text, 60) + "': expected PERIOD:DURATION in seconds, e.g. 120:30");
   if (!(p.duration_s > 0.0) || !(p.period_s > p.duration_s) || !std::isfinite(p.period_s))
-    throw Error("outages every '" + text +
+    throw Error("outages every '" + printable(text, 60) +
                 "': DURATION must be > 0 s and PERIOD > DURATION (GNSS time between outages to reconverge)");
   return p;
 }

@@ -50,13 +50,13 @@ Weighting weightingOf(const std::string& w) {
   if (w == "r") return Weighting::Fast;
   if (w == "model") return Weighting::ModelBased;
   if (w == "efficient") return Weighting::Efficient;
-  throw Error("--weights: expected 'r', 'model' or 'efficient', got '" + w + "'");
+  throw Error("--weights: expected 'r', 'model' or 'efficient', got '" + printable(w, 60) + "'");
 }
 
 IntervalMethod intervalsOf(const std::string& i) {
   if (i == "profile") return IntervalMethod::Profile;
   if (i == "asymptotic") return IntervalMethod::Asymptotic;
-  throw Error("--intervals: expected 'profile' or 'asymptotic', got '" + i + "'");
+  throw Error("--intervals: expected 'profile' or 'asymptotic', got '" + printable(i, 60) + "'");
 }
 
 std::vector<stochastic::ProcessKind> kindsOf(const stochastic::Model& m) {

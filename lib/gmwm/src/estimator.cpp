@@ -1040,7 +1040,7 @@ Weighting parseWeighting(const std::string& s) {
   if (s == "fast") return Weighting::Fast;
   if (s == "model") return Weighting::ModelBased;
   if (s == "efficient") return Weighting::Efficient;
-  throw Error("GMWM weights: '" + s + "' is not one of fast, model, efficient");
+  throw Error("GMWM weights: '" + printable(s, 60) + "' is not one of fast, model, efficient");
 }
 
 namespace detail {
