@@ -263,6 +263,66 @@ TEST(ChangePoints, PowerAtFiveTimesTheLimitAndLocation) {
   EXPECT_GE(right, 0.9 * found);
 }
 
+TEST(ChangePoints, KnocksAreTransientsJudgedAtTheirOwnScale) {
+  // A knock: the level leaves and comes back (a box) after L samples, L
+  // log-uniform from 2 to one second of the record's rate, anywhere in the
+  // middle 80 %, amplitude log-uniform 3-100x its limit (change_points.hpp
+  // testTransient: threshold x 2 nu(2m) x m / min(L, m), m = max(8, L)). It
+  // must come out as one transient starting within max(3, L / 10) samples of
+  // the truth, significant under the model at its own scale, and no change
+  // (alpha 1 %, as for the steps). Null records (alpha 5 %): a transient
+  // accepted by testTransient in at most alpha + 3 MC se of them.
+  const double alpha = 0.05, alpha_knock = 0.01;
+  const int R = runs(100);
+  std::mt19937_64 rng(rootSeed() + 12);
+  std::uniform_real_distribution<double> U(0, 1);
+  int right = 0, null_alarms = 0;
+  for (int r = 0; r < R; ++r) {
+    const Drawn d = drawNull(rng);
+    const std::size_t n = d.n;
+    const auto wv = nd::haarWvOf(d.model);
+    nd::ChangePointOptions o;
+    o.max_transient = static_cast<std::size_t>(d.model.rate_hz);
+    const std::size_t L = std::max<std::size_t>(
+        2, static_cast<std::size_t>(2.0 * std::pow(std::min(d.model.rate_hz, 0.05 * n) / 2.0, U(rng))));
+    const std::size_t k0 = static_cast<std::size_t>((0.1 + 0.8 * U(rng)) * (n - L));
+    const auto t0 = nd::testTransient(std::vector<double>(n, 0.0), k0, k0 + L, wv, alpha_knock, o);
+    const double m = static_cast<double>(t0.half_width);
+    const double limit = t0.threshold * 2.0 * std::sqrt(wv(2.0 * m)) * m / std::min(static_cast<double>(L), m);
+    const double snr = 3.0 * std::pow(100.0 / 3.0, U(rng));
+    const double A = (U(rng) < 0.5 ? -1 : 1) * snr * limit;
+    auto x = ns::simulate(d.model, n, rng());
+    {
+      auto xs = x;
+      const auto res = nd::detectChangePoints(xs, wv, alpha, o);
+      bool alarm = false;
+      for (const auto& t : res.transients)
+        alarm = alarm || nd::testTransient(x, t.first, t.last, wv, alpha, o).significant();
+      null_alarms += alarm;
+    }
+    for (std::size_t k = k0; k < k0 + L; ++k) x[k] += A;
+    auto xs = x;
+    const auto res = nd::detectChangePoints(xs, wv, alpha_knock, o);
+    bool ok = res.transients.size() == 1 && res.changes.empty();
+    if (ok) {
+      const auto& t = res.transients[0];
+      ok = std::abs(static_cast<double>(t.first) - static_cast<double>(k0)) <= std::max(3.0, 0.1 * L) &&
+           nd::testTransient(x, t.first, t.last, wv, alpha_knock, o).significant();
+    }
+    right += ok;
+    if (!ok)
+      std::cout << "  knock wrong: " << d.text << " k0=" << k0 << " L=" << L << " A=" << A << " (" << snr
+                << "x limit): " << res.transients.size() << " transient(s)"
+                << (res.transients.empty() ? std::string() : " first at " + std::to_string(res.transients[0].first) +
+                                                                 ".." + std::to_string(res.transients[0].last))
+                << ", " << res.changes.size() << " change(s)\n";
+  }
+  std::cout << "knocks at 3-100x limit: right " << right << "/" << R << "; null records with a transient " << null_alarms
+            << "/" << R << " at alpha " << alpha << "\n";
+  EXPECT_GE(right, 0.9 * R);
+  EXPECT_LE(null_alarms, mcBound(alpha, R) * R);
+}
+
 TEST(Outliers, NullFalseAlarmsAtAlpha) {
   const double alpha = 0.05;
   const int R = runs(200);

@@ -951,6 +951,23 @@ void pairedScaleTest(const std::vector<double>& nu_b_hat, const std::vector<doub
   *p = boost::math::cdf(boost::math::complement(boost::math::normal(), *z));
 }
 
+/// Transients (level excursions of up to 1 s) replaced by the local level and noise.
+void cleanTransients(std::vector<double>& x, const std::vector<detect::Transient>& ts) {
+  std::vector<detect::OutlierEvent> evs;
+  for (const auto& tr : ts) {
+    detect::OutlierEvent e;
+    e.first = tr.first;
+    e.last = tr.last > tr.first ? tr.last - 1 : tr.first;
+    e.peak = tr.first;
+    e.peak_value = tr.peak;
+    e.peak_z = tr.z;
+    evs.push_back(e);
+  }
+  detect::OutlierOptions o;
+  o.local_fill = true;
+  detect::cleanOutliers(x, evs, o);
+}
+
 ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   const ImuChannel& chan = sh.data->channels[ci];
   const DiagnoseOptions& opt = *sh.opt;
@@ -1101,45 +1118,59 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   bool x_after_pre_changed = false;
   {
     std::vector<double> xs = x;
-    auto cpr = detect::detectChangePoints(xs, detect::haarWvOf(m0n), B.steps);
+    detect::ChangePointOptions cpo;
+    cpo.max_transient = static_cast<std::size_t>(std::floor(rate));  // transients last at most 1 s
+    auto cpr = detect::detectChangePoints(xs, detect::haarWvOf(m0n), B.steps, cpo);
+    // Transients (a knock, a bump) last at most 1 s.
+    cpr.transients.erase(std::remove_if(cpr.transients.begin(), cpr.transients.end(),
+                                        [&](const detect::Transient& tr) {
+                                          return static_cast<double>(tr.last - tr.first) / rate > 1.0 ||
+                                                 tr.first == 0 || tr.last >= n;
+                                        }),
+                         cpr.transients.end());
     // The best stochastic explanation of the record without shifts (the
-    // runner-up of every shift and transient).
+    // runner-up of every shift and transient), fitted to the WV of the record
+    // with the transient candidates interpolated out: fitted with them, a
+    // short GM (and QN) takes up a knock's energy and the knock no longer
+    // stands out against it.
     int p_ext0 = 0;
     const Model ext0_model = [&]() {
       if (cpr.transients.empty() && cpr.changes.empty()) return m0n;  // only needed to judge those
       WvData d0{tau, toStd(wv_pre.wv), toStd(wv_pre.eta), static_cast<double>(n)};
+      if (!cpr.transients.empty()) {
+        std::vector<double> xt = x;
+        cleanTransients(xt, cpr.transients);
+        const auto wv_t = gmwm::waveletVariance(xt.data(), n, rate);
+        d0 = WvData{tau, toStd(wv_t.wv), toStd(wv_t.eta), static_cast<double>(n)};
+      }
       return greedyExtension(m0n, d0, opt.max_terms, B.wv / static_cast<double>(wv_pre.scales()), &p_ext0);
     }();
-    // Transients (a knock, a bump): at most 1 s long, seen in windows of at
-    // most 1 s, and still beyond the threshold under that stochastic
-    // explanation; others are left alone.
+    // Each transient judged at its own scale (the edge contrasts with the
+    // window matched to its duration, detect::testTransient) against that
+    // explanation; a candidate first seen in a long window (a knock leaves the
+    // search with long-window corrections of its sizes) counts by its own
+    // excursion, one that noise of that explanation makes is left alone.
     {
       const auto wv_ext0 = detect::haarWvOf(ext0_model);
-      cpr.transients.erase(
-          std::remove_if(cpr.transients.begin(), cpr.transients.end(),
-                         [&](const detect::Transient& tr) {
-                           const double dur = static_cast<double>(tr.last - tr.first) / rate;
-                           const double sd = 2.0 * std::sqrt(wv_ext0(2.0 * static_cast<double>(tr.half_width)));
-                           const double win = static_cast<double>(tr.half_width) / rate;
-                           return dur > 1.0 || win > 1.0 || !(std::abs(tr.peak) >= tr.threshold * sd);
-                         }),
-          cpr.transients.end());
+      std::vector<detect::Transient> kept;
+      for (auto tr : cpr.transients) {
+        const auto tt = detect::testTransient(x, tr.first, tr.last, wv_ext0, B.steps, cpo);
+        if (!tt.significant()) continue;
+        tr.peak = tt.level;
+        tr.z = tt.z;
+        tr.threshold = tt.threshold;
+        tr.p_value = tt.p_value;
+        tr.half_width = tt.half_width;
+        kept.push_back(tr);
+      }
+      cpr.transients = kept;
     }
     if (!cpr.transients.empty()) {
       // Transients: outlier events, interpolated out.
-      std::vector<detect::OutlierEvent> evs;
-      for (const auto& tr : cpr.transients) {
-        detect::OutlierEvent e;
-        e.first = tr.first;
-        e.last = tr.last > tr.first ? tr.last - 1 : tr.first;
-        e.peak = tr.first;
-        e.peak_value = tr.peak;
-        e.peak_z = tr.z;
-        evs.push_back(e);
+      for (const auto& tr : cpr.transients)
         cd.outlier_events.push_back({t0 + static_cast<double>(tr.first) / rate,
                                      static_cast<double>(tr.last - tr.first) / rate, tr.peak});
-      }
-      detect::cleanOutliers(x, evs);
+      cleanTransients(x, cpr.transients);
       x_after_pre_changed = true;
       Finding* of = nullptr;
       for (auto& f : cd.findings)
@@ -1153,7 +1184,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
         f.statistic = cpr.transients.front().z;
         f.threshold = cpr.transients.front().threshold;
         f.p_value = cpr.transients.front().p_value;
-        f.evidence = "level changes that undo each other within their detection window: a transient, not a level shift";
+        f.evidence = "level changes that undo each other within 1 s, significant at their own scale against the best stochastic explanation of the record without them: a transient (a knock), not level shifts";
         f.action = "remove them before estimating (they were interpolated here); not a filter state";
         cd.findings.push_back(f);
         of = &cd.findings.back();

@@ -33,16 +33,9 @@ std::vector<double> prefix(const std::vector<double>& x) {
   return S;
 }
 
-}  // namespace
-
-ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunction& null_wv,
-                                     double alpha, const ChangePointOptions& opt) {
-  if (!(alpha > 0 && alpha < 1)) throw Error("detectChangePoints: alpha must be in (0, 1)");
-  const std::size_t n = x.size();
-  ChangePointResult res;
-  if (n < 4 * std::max<std::size_t>(1, opt.min_half_width)) return res;
-  // Scales and their null sd / thresholds (the robust part from the record
-  // as given; steps affect few windows at the scales where it is used).
+/// The search's windows: half-widths on a geometric grid from
+/// min_half_width to n / 2, positions on a grid of stride max(1, m / 8).
+std::vector<Scale> scaleGrid(std::size_t n, const ChangePointOptions& opt) {
   std::vector<Scale> scales;
   for (double mf = static_cast<double>(opt.min_half_width); 2.0 * std::floor(mf) <= static_cast<double>(n);
        mf *= opt.scale_ratio) {
@@ -54,6 +47,49 @@ ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunctio
     s.positions = (n - 2 * m) / s.stride + 1;
     scales.push_back(s);
   }
+  return scales;
+}
+
+}  // namespace
+
+TransientTest testTransient(const std::vector<double>& x, std::size_t first, std::size_t last,
+                            const HaarWvFunction& null_wv, double alpha, const ChangePointOptions& opt) {
+  if (!(alpha > 0 && alpha < 1)) throw Error("testTransient: alpha must be in (0, 1)");
+  const std::size_t n = x.size();
+  if (!(first < last && last < n) || first == 0)
+    throw Error("testTransient: span [" + std::to_string(first) + ", " + std::to_string(last) +
+                ") is not inside a record of " + std::to_string(n) + " samples");
+  TransientTest t;
+  const auto scales = scaleGrid(n, opt);
+  const double J = static_cast<double>(std::max<std::size_t>(1, scales.size()));
+  const std::size_t m = std::min({std::max(opt.min_half_width, last - first), first, n - last});
+  t.half_width = m;
+  const auto S = prefix(x);
+  const double inside = meanOf(S, first, last);
+  // Edge contrasts (windows on both sides of each edge; first >= m and
+  // last + m <= n by the clipping of m).
+  const double d1 = meanOf(S, first, first + m) - meanOf(S, first - m, first);
+  const double d2 = meanOf(S, last - m, last) - meanOf(S, last, last + m);
+  t.level = inside - 0.5 * (meanOf(S, first - m, first) + meanOf(S, last, last + m));
+  const double sd = 2.0 * std::sqrt(std::max(0.0, null_wv(2.0 * static_cast<double>(m))));
+  t.z = sd > 0 ? std::max(std::abs(d1), std::abs(d2)) / sd : 0.0;
+  const std::size_t stride = std::max<std::size_t>(1, m / 8);
+  const double positions = static_cast<double>((n - 2 * std::min(m, n / 2)) / stride + 1);
+  t.threshold = twoSidedNormalQuantile(alpha / (J * positions));
+  const double p1 = 2.0 * boost::math::cdf(boost::math::complement(boost::math::normal(), t.z));
+  t.p_value = std::min(1.0, p1 * J * positions);
+  return t;
+}
+
+ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunction& null_wv,
+                                     double alpha, const ChangePointOptions& opt) {
+  if (!(alpha > 0 && alpha < 1)) throw Error("detectChangePoints: alpha must be in (0, 1)");
+  const std::size_t n = x.size();
+  ChangePointResult res;
+  if (n < 4 * std::max<std::size_t>(1, opt.min_half_width)) return res;
+  // Scales and their null sd / thresholds (the robust part from the record
+  // as given; steps affect few windows at the scales where it is used).
+  std::vector<Scale> scales = scaleGrid(n, opt);
   const double J = static_cast<double>(scales.size());
   res.scales_tested = static_cast<int>(scales.size());
   {
@@ -170,9 +206,11 @@ ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunctio
   std::vector<ChangePoint> kept;
   for (std::size_t i = 0; i < byIndex.size();) {
     std::size_t j = i;
-    while (j + 1 < byIndex.size() &&
-           byIndex[j + 1].index - byIndex[j].index <= std::min(byIndex[j].half_width, byIndex[j + 1].half_width))
-      ++j;
+    auto linked = [&](std::size_t q) {  // byIndex[q] joins the cluster that ends at q - 1
+      return byIndex[q].index - byIndex[q - 1].index <= std::min(byIndex[q - 1].half_width, byIndex[q].half_width) ||
+             byIndex[q].index - byIndex[i].index <= opt.max_transient;
+    };
+    while (j + 1 < byIndex.size() && linked(j + 1)) ++j;
     if (j == i) {
       kept.push_back(byIndex[i]);
       ++i;

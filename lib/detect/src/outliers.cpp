@@ -86,9 +86,31 @@ void cleanOutliers(std::vector<double>& x, const std::vector<OutlierEvent>& even
     const std::size_t a = e.first > opt.pad + 1 ? e.first - opt.pad - 1 : 0;  // kept
     const std::size_t b = std::min(n - 1, e.last + opt.pad + 1);             // kept
     if (b <= a + 1) continue;
-    const double xa = x[a], xb = x[b];
+    if (!opt.local_fill) {
+      const double xa = x[a], xb = x[b];
+      for (std::size_t k = a + 1; k < b; ++k)
+        x[k] = xa + (xb - xa) * static_cast<double>(k - a) / static_cast<double>(b - a);
+      continue;
+    }
+    const std::size_t len = b - a - 1;  // samples replaced
+    // The level on each side is the mean of up to len samples there (the kept
+    // neighbour included): across a long span one sample's noise would be a
+    // plateau of that size. The replaced samples take the deviations of the
+    // len samples before (or after) from their mean, so that the span keeps
+    // the short-scale variance of its neighbours instead of a noiseless line.
+    const std::size_t a0 = a + 1 >= len ? a + 1 - len : 0, b1 = std::min(n, b + len);
+    double ma = 0, mb = 0;
+    for (std::size_t k = a0; k <= a; ++k) ma += x[k];
+    for (std::size_t k = b; k < b1; ++k) mb += x[k];
+    ma /= static_cast<double>(a + 1 - a0);
+    mb /= static_cast<double>(b1 - b);
+    std::vector<double> dev(len, 0.0);
+    if (a + 1 - a0 == len)
+      for (std::size_t i = 0; i < len; ++i) dev[i] = x[a0 + i] - ma;
+    else if (b1 - b == len)
+      for (std::size_t i = 0; i < len; ++i) dev[i] = x[b + i] - mb;
     for (std::size_t k = a + 1; k < b; ++k)
-      x[k] = xa + (xb - xa) * static_cast<double>(k - a) / static_cast<double>(b - a);
+      x[k] = ma + (mb - ma) * static_cast<double>(k - a) / static_cast<double>(b - a) + dev[k - a - 1];
   }
 }
 

@@ -37,6 +37,10 @@ struct ChangePointOptions {
   int max_changes = 10;            ///< most changes found
   std::size_t min_half_width = 8;  ///< smallest window on each side [samples]
   double scale_ratio = 1.41421356237;
+  /// Changes within this many samples of the first of their cluster are one
+  /// cluster too (besides those closer than the smaller of their windows): a
+  /// short excursion's edges may be found in windows shorter than it. 0: off.
+  std::size_t max_transient = 0;
 };
 
 struct ChangePoint {
@@ -50,8 +54,9 @@ struct ChangePoint {
   double p_value = 1;          ///< Bonferroni-adjusted p-value
 };
 
-/// Changes closer together than their detecting windows whose sizes cancel
-/// (net below half the largest): a transient (a knock, a bump), not shifts.
+/// Changes closer together than their detecting windows (or within
+/// ChangePointOptions::max_transient of the first) whose sizes cancel (net below half the largest): a transient (a knock, a
+/// bump), not shifts.
 struct Transient {
   std::size_t first = 0, last = 0;  ///< first and last change index
   double peak = 0;                  ///< largest level reached relative to before [unit]
@@ -64,6 +69,29 @@ struct ChangePointResult {
   std::vector<Transient> transients;
   int scales_tested = 0;
 };
+
+/// A transient candidate [first, last) judged on its own under a null model.
+struct TransientTest {
+  std::size_t half_width = 0;  ///< window matched to the duration, max(min_half_width, last - first) [samples]
+  double level = 0;            ///< mean inside minus the mean of the windows on both sides [unit]
+  double z = 0;                ///< larger |edge contrast| over its null sd 2 nu(2m)
+  double threshold = 0;        ///< the search's threshold at that window (Bonferroni as detectChangePoints)
+  double p_value = 1;          ///< Bonferroni-adjusted p-value
+  bool significant() const { return z > threshold; }
+};
+
+/**
+ * Judge the transient [first, last) of @p x (the record as searched, the
+ * transient still in it) under the null whose Haar WV is @p null_wv: the
+ * equal-window contrasts at its two edges with the window m matched to its
+ * duration (m = max(min_half_width, last - first), clipped to the record), so
+ * that the excursion is measured at its own scale whatever window first
+ * found it. The threshold is detectChangePoints' at that window (alpha over
+ * the scales and their grid positions): the candidate came out of that search.
+ * @throws navimpact::Error for an empty or out-of-range span or invalid alpha.
+ */
+TransientTest testTransient(const std::vector<double>& x, std::size_t first, std::size_t last,
+                            const HaarWvFunction& null_wv, double alpha, const ChangePointOptions& opt = {});
 
 /**
  * Detect level shifts in @p x under the null whose Haar WV is @p null_wv.

@@ -22,6 +22,11 @@ namespace navimpact::detect {
 struct OutlierOptions {
   std::size_t gap = 10;  ///< exceedances at most this many samples apart are one event
   std::size_t pad = 2;   ///< samples on each side also replaced by cleanOutliers()
+  /// cleanOutliers() fill: false = the straight line between the kept
+  /// neighbours (spikes and bursts: a few samples); true = the local level and
+  /// noise (long excursions such as a knock, where one neighbour's noise would
+  /// become a plateau and a noiseless line a variance deficit).
+  bool local_fill = false;
 };
 
 struct OutlierEvent {
@@ -46,7 +51,11 @@ struct OutlierResult {
 OutlierResult detectOutliers(const std::vector<double>& x, double model_r_sd, double alpha,
                              const OutlierOptions& opt = {});
 
-/// Replace each event (padded) by the straight line between its neighbours.
+/// Replace each event (padded, len samples) by the straight line between its
+/// neighbours, or with OutlierOptions::local_fill by the line between the
+/// means of up to len samples on each side plus the deviations of the len
+/// samples before it (after it near the start) from their mean: the local
+/// level with the neighbours' short-scale noise.
 void cleanOutliers(std::vector<double>& x, const std::vector<OutlierEvent>& events,
                    const OutlierOptions& opt = {});
 
