@@ -3,7 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -38,26 +41,62 @@ struct TermBlock {
   double F = 0, H = 0, Q = 0, M = 0, R = 0, P0 = 0;
 };
 
-TermBlock blockForm(const SampledArma& a, std::size_t b) {
+/// The sums of blockForm() over the b samples of a block depend on phi, mu
+/// and b only (q and p0 scale them afterwards).
+struct BlockSums {
+  std::uint64_t phi = 0, mu = 0;  ///< bit patterns of the key
+  std::size_t b = 0;
+  double G = 0, c = 1, sdd = 0, scc = 0, scd = 0;
+};
+
+/// Cached per thread: the variance profile and the scans over block
+/// boundaries evaluate the same terms at many variances, and the loop over
+/// the b samples of a block was most of the cost of a likelihood. The cached
+/// values are those the loop computes (same arithmetic, same bits).
+BlockSums blockSums(double phi, double mu, std::size_t b) {
+  std::uint64_t kp = 0, km = 0;
+  std::memcpy(&kp, &phi, sizeof kp);
+  std::memcpy(&km, &mu, sizeof km);
+  constexpr std::size_t kSlots = 64;
+  thread_local std::vector<BlockSums> cache;
+  thread_local std::size_t next = 0;
+  for (const auto& e : cache)
+    if (e.b == b && e.phi == kp && e.mu == km) return e;
   // Sums over j = b-1 down to 0, i.e. m = b - j = 1..b samples to the block end:
   // G(m) = 1 + phi G(m-1), d_j = G(m) - mu G(m-1), c_j = phi^(m-1).
+  BlockSums e;
+  e.phi = kp;
+  e.mu = km;
+  e.b = b;
   double G_prev = 0, c = 1, sdd = 0, scc = 0, scd = 0;
   for (std::size_t m = 1; m <= b; ++m) {
-    const double G = 1.0 + a.phi * G_prev;
-    const double d = G - a.mu * G_prev;
+    const double G = 1.0 + phi * G_prev;
+    const double d = G - mu * G_prev;
     sdd += d * d;
     scc += c * c;
     scd += c * d;
     G_prev = G;
-    if (m < b) c *= a.phi;
+    if (m < b) c *= phi;
   }
+  e.G = G_prev;
+  e.c = c;
+  e.sdd = sdd;
+  e.scc = scc;
+  e.scd = scd;
+  if (cache.size() < kSlots) cache.push_back(e);
+  else cache[next++ % kSlots] = e;
+  return e;
+}
+
+TermBlock blockForm(const SampledArma& a, std::size_t b) {
+  const BlockSums s = blockSums(a.phi, a.mu, b);
   const double bd = static_cast<double>(b);
   TermBlock t;
-  t.H = (a.phi - a.mu) * G_prev / bd;  // G_prev = G(b)
-  t.F = c * a.phi;                      // phi^b
-  t.R = a.q * sdd / (bd * bd);
-  t.Q = a.q * scc;
-  t.M = a.q * scd / bd;
+  t.H = (a.phi - a.mu) * s.G / bd;  // G(b)
+  t.F = s.c * a.phi;                 // phi^b
+  t.R = a.q * s.sdd / (bd * bd);
+  t.Q = a.q * s.scc;
+  t.M = a.q * s.scd / bd;
   t.P0 = a.p0;
   return t;
 }
