@@ -1,7 +1,9 @@
 // Speed of `navimpact diagnose --run`: a 600 s run at 200 Hz (the lemniscate
 // of the shared data folder emulated with the Navchip Table 1 Ref errors and a
 // GT reference), 30 outages of 10 s (one every 20 s), 50 realisations, the
-// three causes with 5 folds, on the threads of the machine.
+// seven causes with 5 folds (/1; /0 the comparison alone), on the threads of
+// the machine. Measure process CPU too (e.g. GNU time): the table's CPU
+// column is the main thread's only.
 //   build/bin/navimpact_bench --benchmark_filter=RunDiagnosis
 // The emulation of the run (not timed) writes a temporary rawlog once.
 #include <benchmark/benchmark.h>

@@ -12,6 +12,7 @@
 #include "navimpact/core/format.hpp"
 #include "navimpact/emulation/scenario.hpp"
 #include "navimpact/ins/nav_state.hpp"
+#include "navimpact/rawlog/reader.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/report/replay_report.hpp"
 #include "test_support.hpp"
@@ -409,6 +410,70 @@ TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) 
       for (std::size_t k = 0; k < expected.size(); ++k) {
         EXPECT_EQ(streamed.run.outages[1 + k].window.start_s, expected[k].start_s);
         EXPECT_EQ(streamed.run.outages[1 + k].window.end_s, expected[k].end_s);
+      }
+    }
+  }
+}
+
+// The replay from the records read into memory once (diagnose --run replays
+// one run many times) is the replay; stopped early, it is the same up to the
+// stop: epochs, and the outages that end by then, with the same score (the
+// reference's content and sigma still come from the whole data). Outage
+// patterns and the stop drawn at random (seed printed).
+TEST(Replay, ReplayFromRecordsInMemoryIsTheReplayAndStopsWhereAsked) {
+  const auto dir = navimpact::test::tempDir();
+  navimpact::Recording rec = emulate60("model");
+  const auto withGt = (dir / "mem_gt.rawlog").string();
+  navimpact::rawlog::writeRawlog(withGt, rec);
+  rec.reference.clear();
+  const auto noGt = (dir / "mem_nogt.rawlog").string();
+  navimpact::rawlog::writeRawlog(noGt, rec);
+  const std::uint64_t seed = std::random_device{}();
+  std::mt19937_64 rng(seed);
+  for (int draw = 0; draw < 2; ++draw) {
+    const double period = std::uniform_real_distribution<double>(4.0, 20.0)(rng);
+    const double duration = std::uniform_real_distribution<double>(0.5, period - 0.5)(rng);
+    const double u = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+    std::printf("seed %llu draw %d: outages every %.4f:%.4f s, stop at %.4f of the filter's time\n",
+                static_cast<unsigned long long>(seed), draw, period, duration, u);
+    for (const auto& path : {withGt, noGt}) {
+      SCOPED_TRACE(path + " seed " + std::to_string(seed) + " draw " + std::to_string(draw));
+      an::ReplayConfig c;
+      c.rawlog = path;
+      c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
+      c.outages.push_back(navimpact::Outage::fromStartDuration(2.0, 3.0));
+      c.outages_every = navimpact::OutagePattern{period, duration};
+      const an::ReplayResult whole = an::runReplay(c);
+      const double stop = whole.aided_from_s + 1.0 + u * (55.0 - whole.aided_from_s);
+      const navimpact::rawlog::RawlogRecords data = navimpact::rawlog::readRawlogRecords(path);
+      const an::ReplayResult mem = an::runReplay(c, data);
+      EXPECT_EQ(navimpact::report::solutionCsv(mem), navimpact::report::solutionCsv(whole));
+      EXPECT_EQ(navimpact::report::summaryJson(mem), navimpact::report::summaryJson(whole));
+      EXPECT_EQ(mem.notices, whole.notices);
+      const an::ReplayResult cut = an::runReplay(c, data, stop);
+      ASSERT_FALSE(cut.run.epochs.empty());
+      EXPECT_LT(cut.run.epochs.size(), whole.run.epochs.size());
+      EXPECT_LE(cut.run.epochs.back().t - cut.t_zero, stop + 0.1);
+      for (std::size_t k = 0; k < cut.run.epochs.size(); ++k) {
+        EXPECT_EQ(cut.run.epochs[k].t, whole.run.epochs[k].t);
+        EXPECT_EQ(cut.run.epochs[k].est.lat, whole.run.epochs[k].est.lat);
+        EXPECT_EQ(cut.run.epochs[k].sigma, whole.run.epochs[k].sigma);
+      }
+      ASSERT_EQ(cut.score.has_value(), whole.score.has_value());
+      if (!whole.score) continue;
+      EXPECT_EQ(cut.score->reference.sigma_h_m, whole.score->reference.sigma_h_m);
+      EXPECT_EQ(cut.score->reference.has_velocity, whole.score->reference.has_velocity);
+      std::size_t ended = 0;
+      for (const auto& o : whole.score->outages) ended += o.start_s + o.duration_s <= stop ? 1 : 0;
+      ASSERT_GE(cut.score->outages.size(), ended);
+      for (std::size_t k = 0; k < ended; ++k) {
+        const auto& a = cut.score->outages[k];
+        const auto& b = whole.score->outages[k];
+        EXPECT_EQ(a.start_s, b.start_s);
+        EXPECT_EQ(a.end_s, b.end_s);
+        EXPECT_EQ(a.err_N, b.err_N);
+        EXPECT_EQ(a.sigma_N, b.sigma_N);
+        EXPECT_EQ(a.nees, b.nees);
       }
     }
   }

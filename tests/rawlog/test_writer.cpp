@@ -350,3 +350,57 @@ TEST(RawlogReader, ReturnsTheRecordsOfReadRawlogInTimeOrder) {
     }
   }
 }
+
+// The records read into memory once come back in the reader's order, field
+// for field, with its final header (a run replayed many times is decoded once).
+TEST(RawlogReader, RecordsInMemoryComeBackInTheReadersOrder) {
+  const auto dir = navimpact::test::tempDir();
+  const std::string p = (dir / "sample_mem.rawlog").string();
+  navimpact::rawlog::writeRawlog(p, sample());
+  for (const std::string& path : {p, navimpact::test::sourcePath("datasets/uav_flight_260s_ref.rawlog"),
+                                  navimpact::test::dataPath("imu_label_xsens.rawlog")}) {
+    SCOPED_TRACE(path);
+    const navimpact::rawlog::RawlogRecords mem = navimpact::rawlog::readRawlogRecords(path);
+    navimpact::rawlog::RawlogReader reader(path);
+    navimpact::rawlog::RawlogRecordCursor cursor(mem);
+    navimpact::rawlog::RawlogRecord a, b;
+    std::size_t n = 0;
+    using K = navimpact::rawlog::RawlogRecord::Kind;
+    while (reader.next(a)) {
+      ASSERT_TRUE(cursor.next(b)) << "record " << n;
+      ++n;
+      ASSERT_EQ(static_cast<int>(a.kind), static_cast<int>(b.kind)) << "record " << n;
+      EXPECT_EQ(a.t, b.t);
+      if (a.kind == K::Imu) {
+        EXPECT_EQ(a.imu.t, b.imu.t);
+        EXPECT_EQ(a.imu.w_IB_B, b.imu.w_IB_B);
+        EXPECT_EQ(a.imu.f_B, b.imu.f_B);
+      } else if (a.kind == K::Gnss) {
+        EXPECT_EQ(a.gnss.pos.lat, b.gnss.pos.lat);
+        EXPECT_EQ(a.gnss.pos.lon, b.gnss.pos.lon);
+        EXPECT_EQ(a.gnss.pos.h, b.gnss.pos.h);
+        EXPECT_EQ(a.gnss.v_N, b.gnss.v_N);
+        EXPECT_EQ(a.gnss.cov_pos_N, b.gnss.cov_pos_N);
+        EXPECT_EQ(a.gnss.cov_vel_N, b.gnss.cov_vel_N);
+      } else if (a.kind == K::Baro) {
+        EXPECT_EQ(a.baro.h, b.baro.h);
+        EXPECT_EQ(a.baro.sigma_m, b.baro.sigma_m);
+      } else {
+        EXPECT_EQ(a.reference.p_L, b.reference.p_L);
+        EXPECT_EQ(a.reference.v_N, b.reference.v_N);
+        EXPECT_EQ(a.reference.q_BtoN.has_value(), b.reference.q_BtoN.has_value());
+        if (a.reference.q_BtoN) EXPECT_EQ(a.reference.q_BtoN->coeffs(), b.reference.q_BtoN->coeffs());
+        EXPECT_EQ(a.reference.sigma_p_L, b.reference.sigma_p_L);
+      }
+    }
+    EXPECT_FALSE(cursor.next(b));
+    EXPECT_EQ(n, mem.order.size());
+    EXPECT_GT(n, 50u);
+    EXPECT_EQ(mem.data.notices, reader.header().notices);
+    EXPECT_EQ(mem.data.metadata, reader.header().metadata);
+    EXPECT_EQ(mem.data.origin.lat, reader.header().origin.lat);
+    EXPECT_EQ(mem.data.origin.h, reader.header().origin.h);
+    EXPECT_EQ(mem.data.start_unix_s, reader.header().start_unix_s);
+    EXPECT_EQ(mem.data.t_start_s, reader.header().t_start_s);
+  }
+}

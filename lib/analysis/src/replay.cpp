@@ -190,8 +190,15 @@ namespace {
 /// exists (then records go straight to it).
 class ReplayDriver {
  public:
-  ReplayDriver(const ReplayConfig& cfg, ReplayResult& r, ReplayObserver* obs)
-      : cfg_(cfg), r_(r), obs_(obs), reader_(cfg.rawlog, {cfg.imu_label, cfg.gnss_label}) {}
+  ReplayDriver(const ReplayConfig& cfg, ReplayResult& r, ReplayObserver* obs) : cfg_(cfg), r_(r), obs_(obs) {
+    reader_.emplace(cfg.rawlog, rawlog::RawlogReadOptions{cfg.imu_label, cfg.gnss_label});
+  }
+  /// From records in memory; the filter stops at the first IMU sample after
+  /// @p stop_after_s from time zero (the rest of the data is still read).
+  ReplayDriver(const ReplayConfig& cfg, ReplayResult& r, const rawlog::RawlogRecords& data, double stop_after_s)
+      : cfg_(cfg), r_(r), obs_(nullptr), data_(&data), stopAfter_(stop_after_s) {
+    cursor_.emplace(data);
+  }
 
   void run();
 
@@ -200,8 +207,13 @@ class ReplayDriver {
   const ReplayConfig& cfg_;
   ReplayResult& r_;
   ReplayObserver* obs_;
-  rawlog::RawlogReader reader_;
+  std::optional<rawlog::RawlogReader> reader_;        // the rawlog read as the filter goes
+  const rawlog::RawlogRecords* data_ = nullptr;       // or its records in memory
+  std::optional<rawlog::RawlogRecordCursor> cursor_;
+  double stopAfter_ = std::numeric_limits<double>::infinity();  // filter stop, from time zero [s]
   YAML::Node scen_;
+
+  const Recording& header() const { return reader_ ? reader_->header() : data_->data; }
 
   // records read ahead (before the runner exists)
   std::deque<ImuRecord> imuQ_;
@@ -281,9 +293,14 @@ void ReplayDriver::foldRefFlags(const RefFlags& f) {
 // Read one record and hand it on: to the runner once it exists, else to the queues.
 bool ReplayDriver::readOne() {
   rawlog::RawlogRecord rec;
-  const auto c0 = Clock::now();
-  const bool got = reader_.next(rec);
-  readS_ += std::chrono::duration<double>(Clock::now() - c0).count();
+  bool got = false;
+  if (reader_) {
+    const auto c0 = Clock::now();
+    got = reader_->next(rec);
+    readS_ += std::chrono::duration<double>(Clock::now() - c0).count();
+  } else {
+    got = cursor_->next(rec);
+  }
   if (!got) {
     eof_ = true;
     refTail_.clear();  // reference entries after the data's end count for nothing
@@ -456,7 +473,7 @@ void ReplayDriver::decideWindows(double t_now) {
 void ReplayDriver::run() {
   ReplayResult& r = r_;
   const ReplayConfig& cfg = cfg_;
-  const Recording& head = reader_.header();
+  const Recording& head = header();
   r.cfg = cfg;
   r.scenario_yaml = head.metadata;
   origin_ = head.origin;
@@ -699,6 +716,10 @@ void ReplayDriver::run() {
   run.start();
   ins::ImuSample s;
   while (nextSample(s)) {
+    if (s.t - r.t_zero > stopAfter_) {
+      while (!eof_) readOne();  // what depends on the whole data (reference content, data end) as in a full replay
+      break;
+    }
     decideWindows(s.t + s.dt);
     fillTo(s.t + 0.5 * s.dt);
     run.step(s);
@@ -716,7 +737,7 @@ void ReplayDriver::run() {
   if (hasTruth_ && truthInside_ == 0)
     throw Error(cfg.rawlog + ": the reference (GT) has no entry inside the IMU data");
   // notices in one order: the reader's, gaps, the reference, the alignment, the outages, the model
-  r.notices = reader_.header().notices;
+  r.notices = header().notices;
   if (gaps_ > 0)
     r.notices.push_back(std::to_string(gaps_) + " IMU gap(s) longer than " + g10(kImuGapSteps) +
                         " nominal steps accepted (longest " + g10(longest_) + " s, ending at t = " + g10(longestAt_) +
@@ -741,6 +762,14 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
   InputScope scope(cfg.rawlog);
   ReplayResult r;
   ReplayDriver(cfg, r, nullptr).run();
+  return r;
+}
+
+ReplayResult runReplay(const ReplayConfig& cfg, const rawlog::RawlogRecords& data, double stop_after_s) {
+  if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
+  InputScope scope(cfg.rawlog);
+  ReplayResult r;
+  ReplayDriver(cfg, r, data, stop_after_s).run();
   return r;
 }
 

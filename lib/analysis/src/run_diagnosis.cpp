@@ -19,7 +19,7 @@
 #include "navimpact/emulation/sensor_effects.hpp"
 #include "navimpact/emulation/sensors.hpp"
 #include "navimpact/core/imu_series.hpp"
-#include "navimpact/rawlog/writer.hpp"
+#include "navimpact/rawlog/reader.hpp"
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/simulate.hpp"
@@ -51,7 +51,7 @@ double meanSquare(const std::vector<double>& v) {
 
 /// The trajectory of the run as the emulation's smooth truth.
 emulation::SmoothTrajectory buildTrajectory(const ReplayResult& scored, const RunDiagnosisOptions& opt,
-                                            std::string& source) {
+                                            const rawlog::RawlogRecords& data, std::string& source) {
   emulation::SampledTrajectory s;
   s.source = scored.cfg.rawlog;
   bool dense = scored.score && scored.score->reference.has_velocity && scored.score->reference.has_attitude &&
@@ -69,7 +69,7 @@ emulation::SmoothTrajectory buildTrajectory(const ReplayResult& scored, const Ru
     c.outages_every.reset();
     c.use_reference = false;
     c.record_interval_s = 0.1;
-    const ReplayResult aided = runReplay(c);
+    const ReplayResult aided = runReplay(c, data);
     for (const auto& e : aided.run.epochs) x.push_back(e.est);
     source = "the GNSS-aided filter solution of the run without outages (the reference lacks velocity, attitude or "
              "density), every 0.1 s, smoothed by P-splines";
@@ -405,7 +405,8 @@ std::string extraExtension(ExtraCause kind) {
 
 /// The causes: fitted per fold outside the held-out block, scored on the held-out outages.
 template <class SimOutages, class Progress>
-void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std::vector<ReplayResult>& measured,
+void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords& data, RunDiagnosis& out,
+                    const std::vector<ReplayResult>& measured,
                     const SimOutages& simOut, const std::vector<RealisationOut>& sims,
                     const emulation::SmoothTrajectory& tr, double t0, double t1, const stochastic::ImuModel& model,
                     const Progress& progress) {
@@ -457,12 +458,11 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
       }
   }
 
-  // IMU residual against the trajectory (real IMU read again from the rawlog).
+  // IMU residual against the trajectory (the real IMU of the run).
   ImuResidual res;
   {
-    const Recording rec = rawlog::readRawlog(opt.replay.rawlog, {opt.replay.imu_label, opt.replay.gnss_label});
     const double dt = 1.0 / rate;
-    for (const auto& s : rec.imu) {
+    for (const auto& s : data.data.imu) {
       if (s.t - dt < tr.tBegin() || s.t > tr.tEnd()) continue;
       Eigen::Vector3d dv, dth;
       tr.increments(s.t - dt, s.t, dv, dth);
@@ -689,7 +689,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
         if (b > a) c.outages.push_back(Outage{a, b});
       }
       c.extra_states = withFitPrior(kind, base.extra_states);
-      const ReplayResult r = runReplay(c);
+      const ReplayResult r = runReplay(c, data);
       const filter::SensorParams& e = r.run.extra_estimates;
       const filter::SensorParams& sg = r.run.extra_sigmas;
       ReplayConfig x = base;
@@ -715,19 +715,39 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
 
   // Held-out scores: task (cause, fold) replays every duration with the fold's
   // extension; task (cause, K) fits the cause on the whole run (its findings).
+  // The extended replay's outages are paired with today's by their order in
+  // the run. A held-out replay of fold f stops 1 s after the end of its last
+  // held-out outage (the filter is causal: those outages score as in a full
+  // replay) when its outages there are today's; when the extension moved them
+  // (a filter that aligns at another time lays its outages from there), it
+  // runs to the end of the run.
   using Ends = std::vector<std::pair<filter::Vector9d, filter::Vector9d>>;
   struct Scored {
-    std::vector<std::vector<OutageScore>> per;  // [duration] scored outages
+    std::vector<std::vector<OutageScore>> per;  // [duration] scored outages in the run's order
     std::vector<Ends> ends;                     // [duration] end errors and sigmas
   };
-  auto replayScored = [&](ReplayConfig cfg) {
+  std::vector<double> stopAfter(K, -1e300);  // [fold] from time zero [s]
+  for (const auto& it : items)
+    stopAfter[it.fold] = std::max(stopAfter[it.fold], it.b - measured[it.i].t_zero + 1.0);
+  auto replayScored = [&](ReplayConfig cfg, int f) {
     Scored sc;
     for (std::size_t i = 0; i < D; ++i) {
       cfg.outages.clear();
       cfg.outages_every = measured[i].cfg.outages_every;
-      const ReplayResult r = runReplay(cfg);
-      if (!r.score || r.score->outages.size() != measured[i].score->outages.size())
-        throw Error("diagnose --run: the extended replay scored other outages than today's");
+      const auto& today_i = measured[i].score->outages;
+      ReplayResult r = runReplay(cfg, data, stopAfter[f]);
+      bool same = r.score.has_value();
+      for (const auto& it : items) {
+        if (!same || it.fold != f || it.i != i) continue;
+        const std::size_t si = simOut[i][it.j].score_index;
+        same = si < r.score->outages.size() && r.score->outages[si].start_s == today_i[si].start_s &&
+               r.score->outages[si].end_s == today_i[si].end_s;
+      }
+      if (!same) {
+        r = runReplay(cfg, data);
+        if (!r.score || r.score->outages.size() != today_i.size())
+          throw Error("diagnose --run: the extended replay scored other outages than today's");
+      }
       sc.per.push_back(r.score->outages);
       sc.ends.push_back(scoredEnds(r));
     }
@@ -752,7 +772,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
     const int task = c * K + f;
     if (heldCount[f] == 0) return;
     foldCfg[task] = cands[c].second(opt.replay, excl[f], nullptr, nullptr);
-    after[task] = replayScored(foldCfg[task]);
+    after[task] = replayScored(foldCfg[task], f);
   }, [&](std::size_t done, std::size_t count) { progress(0.80 + 0.17 * double(done) / double(count), "causes"); });
 
   // Paired held-out comparison: every outage scored by @p before and @p after of its fold.
@@ -829,7 +849,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, RunDiagnosis& out, const std
     parallelFor(std::size_t(O * K), threads, [&](std::size_t t) {
       const int c = others[t / K], f = static_cast<int>(t % K);
       if (heldCount[f] == 0) return;
-      both[t] = replayScored(cands[c].second(foldCfg[top * K + f], excl[f], nullptr, nullptr));
+      both[t] = replayScored(cands[c].second(foldCfg[top * K + f], excl[f], nullptr, nullptr), f);
     }, [&](std::size_t done, std::size_t count) { progress(0.97 + 0.02 * double(done) / double(count), "causes"); });
     for (int k = 0; k < O; ++k) {
       const int c = others[k];
@@ -866,6 +886,11 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   const std::size_t D = opt.durations_s.size();
   // Progress: the measured replays count as 10 %, the trajectory 5 %, the simulation 85 %.
 
+  // The run, read and decoded once: every replay below runs from these records.
+  if (opt.replay.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
+  const rawlog::RawlogRecords data =
+      rawlog::readRawlogRecords(opt.replay.rawlog, {opt.replay.imu_label, opt.replay.gnss_label});
+
   RunDiagnosis out;
   out.rawlog = opt.replay.rawlog;
   out.realisations = opt.realisations;
@@ -880,7 +905,7 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
     c.outages.clear();
     c.outages_every = OutagePattern{opt.durations_s[i] + opt.reconverge_s, opt.durations_s[i]};
     progress(0.10 * double(i) / double(D), "replay");
-    measured.push_back(runReplay(c));
+    measured.push_back(runReplay(c, data));
     const ReplayResult& r = measured.back();
     if (!r.score)
       throw Error(opt.replay.rawlog + ": the rawlog has no reference (GT): a run diagnosis compares outage errors "
@@ -904,7 +929,7 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
 
   // 2. The trajectory and the emulation span.
   progress(0.10, "trajectory");
-  const emulation::SmoothTrajectory tr = buildTrajectory(r0, opt, out.trajectory_source);
+  const emulation::SmoothTrajectory tr = buildTrajectory(r0, opt, data, out.trajectory_source);
   const double rate = r0.imu_rate_hz;
   const double t0 = std::max(tr.tBegin(), r0.t_zero + r0.aided_from_s);
   const auto n = static_cast<std::size_t>(std::floor((tr.tEnd() - t0) * rate + 1e-9));
@@ -1135,7 +1160,7 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   }
   out.verdict = out.reasons.empty() ? "adequate" : "inadequate";
   out.model_before = model;
-  if (opt.causes) diagnoseCauses(opt, out, measured, simOut, sims, tr, t0, t1, model, progress);
+  if (opt.causes) diagnoseCauses(opt, data, out, measured, simOut, sims, tr, t0, t1, model, progress);
   progress(1.0, "done");
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return out;

@@ -342,10 +342,12 @@ bool RawlogReader::next(RawlogRecord& out) {
   return true;
 }
 
-Recording readRawlog(const std::string& path, const RawlogReadOptions& opt) {
+RawlogRecords readRawlogRecords(const std::string& path, const RawlogReadOptions& opt) {
   InputScope scope(path);
   RawlogReader reader(path, opt);
-  Recording d = reader.header();
+  RawlogRecords out;
+  Recording& d = out.data;
+  d = reader.header();
   RawlogRecord r;
   while (reader.next(r)) {
     switch (r.kind) {
@@ -354,6 +356,7 @@ Recording readRawlog(const std::string& path, const RawlogReadOptions& opt) {
       case RawlogRecord::Kind::Baro: d.baro.push_back(r.baro); break;
       case RawlogRecord::Kind::Reference: d.reference.push_back(r.reference); break;
     }
+    out.order.push_back(r.kind);
   }
   const Recording& h = reader.header();
   d.origin = h.origin;
@@ -361,7 +364,36 @@ Recording readRawlog(const std::string& path, const RawlogReadOptions& opt) {
   d.notices = h.notices;
   d.start_unix_s = h.start_unix_s;
   d.t_start_s = h.t_start_s;
-  return d;
+  return out;
+}
+
+Recording readRawlog(const std::string& path, const RawlogReadOptions& opt) {
+  return std::move(readRawlogRecords(path, opt).data);
+}
+
+bool RawlogRecordCursor::next(RawlogRecord& out) {
+  if (pos_ >= r_.order.size()) return false;
+  const Recording& d = r_.data;
+  out.kind = r_.order[pos_++];
+  switch (out.kind) {
+    case RawlogRecord::Kind::Imu:
+      out.imu = d.imu.at(imu_++);
+      out.t = out.imu.t;
+      break;
+    case RawlogRecord::Kind::Gnss:
+      out.gnss = d.gnss.at(gnss_++);
+      out.t = out.gnss.t;
+      break;
+    case RawlogRecord::Kind::Baro:
+      out.baro = d.baro.at(baro_++);
+      out.t = out.baro.t;
+      break;
+    case RawlogRecord::Kind::Reference:
+      out.reference = d.reference.at(ref_++);
+      out.t = out.reference.t;
+      break;
+  }
+  return true;
 }
 
 }  // namespace navimpact::rawlog

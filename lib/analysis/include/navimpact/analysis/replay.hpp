@@ -63,6 +63,7 @@
  */
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,6 +74,10 @@
 #include "navimpact/core/recording.hpp"
 #include "navimpact/filter/alignment.hpp"
 #include "navimpact/stochastic/model_file.hpp"
+
+namespace navimpact::rawlog {
+struct RawlogRecords;  // rawlog/reader.hpp: a rawlog's records in memory
+}  // namespace navimpact::rawlog
 
 namespace navimpact::analysis {
 
@@ -185,6 +190,21 @@ class ReplayObserver {
  *         GNSS fix at time zero, an outage outside the data, a missing model.
  */
 ReplayResult runReplay(const ReplayConfig& cfg);
+
+/**
+ * The same replay from the rawlog's records read into memory once
+ * (rawlog::readRawlogRecords of cfg.rawlog with cfg's labels; cfg.rawlog names
+ * it in messages), for a run replayed many times (diagnose --run): the same
+ * result as runReplay(cfg) except read_s = 0.
+ * With @p stop_after_s the filter stops at the first IMU sample later than
+ * that time from time zero; the rest of the data is still read, so what
+ * depends on the whole data (the reference's content and sigma, the data's
+ * end) is as in the full replay. Epochs, and outages that end by then, are
+ * those of the full replay; later epochs and outages are absent, or cut for
+ * an outage not over by then (so use only outages ending by stop_after_s).
+ */
+ReplayResult runReplay(const ReplayConfig& cfg, const rawlog::RawlogRecords& data,
+                       double stop_after_s = std::numeric_limits<double>::infinity());
 
 /**
  * The same replay in bounded memory: each epoch goes to @p observer and is not

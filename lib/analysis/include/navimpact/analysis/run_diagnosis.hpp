@@ -6,6 +6,10 @@
  *
  * Data only (lib/report writes run_diagnosis.json, report.md and figures).
  *
+ * The rawlog is read and decoded once (rawlog::readRawlogRecords); every replay
+ * below runs from those records (analysis/replay.hpp), and a held-out replay
+ * stops after its fold's last held-out outage (the filter is causal).
+ *
  * Measured: for each outage duration D the rawlog is replayed (analysis/replay.hpp)
  * with outages laid all along the run as `replay --outages-every P:D` does,
  * P = D + reconverge_s (reconverge_s of GNSS before each outage), and scored

@@ -31,7 +31,7 @@ namespace navimpact::rawlog {
 
 /// One record of a rawlog.
 struct RawlogRecord {
-  enum class Kind { Imu, Gnss, Baro, Reference };
+  enum class Kind : unsigned char { Imu, Gnss, Baro, Reference };
   Kind kind = Kind::Imu;
   double t = 0.0;               ///< its time on the recording's axis [s]
   ImuRecord imu;                ///< Kind::Imu
@@ -68,6 +68,34 @@ class RawlogReader {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+/**
+ * A rawlog read once into memory and read again record by record, in file
+ * order, as often as needed (a run replayed many times, e.g. by
+ * `diagnose --run`, is read and decoded once). The records are kept by kind
+ * in a Recording (what readRawlog() returns) plus the order of their kinds,
+ * so memory is that of readRawlog() and one byte per record.
+ */
+struct RawlogRecords {
+  Recording data;                              ///< header as RawlogReader::header() at the end of the file, and every record
+  std::vector<RawlogRecord::Kind> order;       ///< the kind of each record, in file order
+};
+
+/// Read every record of @p path. @throws navimpact::Error as RawlogReader.
+RawlogRecords readRawlogRecords(const std::string& path, const RawlogReadOptions& opt = {});
+
+/// The records of a RawlogRecords again, in file order (the same sequence
+/// RawlogReader::next() returned). Holds a reference: @p r must outlive it.
+class RawlogRecordCursor {
+ public:
+  explicit RawlogRecordCursor(const RawlogRecords& r) : r_(r) {}
+  /// The next record; false after the last.
+  bool next(RawlogRecord& out);
+
+ private:
+  const RawlogRecords& r_;
+  std::size_t pos_ = 0, imu_ = 0, gnss_ = 0, baro_ = 0, ref_ = 0;
 };
 
 }  // namespace navimpact::rawlog
