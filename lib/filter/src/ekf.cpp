@@ -579,8 +579,17 @@ void ErrorStateEkf::checkPositiveDefinite(const char* where) {
   inv.resize(N);
   for (int i = 0; i < N; ++i) inv(i) = 1.0 / std::sqrt(std::max(P_(i, i), floor_(i)));
   MatrixXd& Pc = c.Pc;
-  Pc = inv.asDiagonal() * P_ * inv.asDiagonal();
-  if (!Pc.allFinite())
+  // the lower triangle only (P is symmetric after an update; the factorisation
+  // reads the lower triangle), each entry (inv_i P_ij) inv_j as in
+  // inv.asDiagonal() * P * inv.asDiagonal()
+  Pc.resize(N, N);
+  bool finite = true;
+  for (int j = 0; j < N; ++j) {
+    auto q = Pc.col(j).tail(N - j);
+    q = (inv.tail(N - j).array() * P_.col(j).tail(N - j).array()) * inv(j);
+    finite = finite && q.allFinite();
+  }
+  if (!finite)
     throw Error("filter covariance is not finite at t = " + formatNumber(state().t, 9) + " s after " + where);
   Pc.diagonal().array() += PdCheck::tolerance;
   // Factorised in place: the decomposition Eigen::LLT::compute() runs, without
