@@ -170,5 +170,9 @@ TEST(Mechanization, CarriedLatitudeTermsGiveTheSameBits) {
     const Vector3d v(12.0, -7.0, 1.0);
     EXPECT_TRUE(earth::w_IE_N(l) == earth::w_IE_N(lat));
     EXPECT_TRUE(earth::w_EN_N(l, 300.0, v) == earth::w_EN_N(lat, 300.0, v));
+    double a_lat = 0, a_h = 0, b_lat = 0, b_h = 0;
+    earth::gravityGradient(l, 300.0, a_lat, a_h);
+    earth::gravityGradient(lat, 300.0, b_lat, b_h);
+    EXPECT_TRUE(a_lat == b_lat && a_h == b_h);
   }
 }

@@ -58,20 +58,30 @@ Eigen::Vector3d LocalGravity::operator()(double lat, double h) {
   return g0_ + dg_dlat_ * (lat - lat0_) + dg_dh_ * (h - h0_);
 }
 
-void gravityGradient(double lat, double h, double& dgD_dlat, double& dgD_dh) {
+namespace {
+void gravityGradientOf(double lat, double s, double h, double& dgD_dlat, double& dgD_dh) {
   static const GeographicLib::NormalGravity& ng = GeographicLib::NormalGravity::WGS84();
   // Somigliana: gamma = gamma_e (1 + k s2) / sqrt(1 - e2 s2), k = b gamma_p / (a gamma_e) - 1.
   static const double ge = ng.SurfaceGravity(0.0), gp = ng.SurfaceGravity(90.0);
   static const double b = kA * (1.0 - kF);
   static const double k = b * gp / (kA * ge) - 1.0;
   static const double m = kOmegaIE * kOmegaIE * kA * kA * b / kGM;
-  const double s = std::sin(lat), s2 = s * s;
+  const double s2 = s * s;
   const double w2 = 1.0 - kE2 * s2;
   const double dgamma_ds2 = ge * (k / std::sqrt(w2) + (1.0 + k * s2) * 0.5 * kE2 / (w2 * std::sqrt(w2)));
   const double gamma0 = ge * (1.0 + k * s2) / std::sqrt(w2);
   dgD_dlat = dgamma_ds2 * std::sin(2.0 * lat);
   // Free-air gradient (Heiskanen & Moritz 1967 eq. 2-124), first order in h.
   dgD_dh = -2.0 * gamma0 / kA * (1.0 + kF + m - 2.0 * kF * s2) + 6.0 * gamma0 * h / (kA * kA);
+}
+}  // namespace
+
+void gravityGradient(double lat, double h, double& dgD_dlat, double& dgD_dh) {
+  gravityGradientOf(lat, std::sin(lat), h, dgD_dlat, dgD_dh);
+}
+
+void gravityGradient(const LatitudeTerms& l, double h, double& dgD_dlat, double& dgD_dh) {
+  gravityGradientOf(l.lat, l.sin_lat, h, dgD_dlat, dgD_dh);
 }
 
 namespace {

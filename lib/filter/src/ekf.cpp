@@ -8,6 +8,7 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <sstream>
@@ -57,6 +58,8 @@ struct ErrorStateEkf::Cache {
   Transition T;
   Transition tmp;                   // scratch
   MatrixXd Fni, FniFii, FniQii, FniQiiFii, FniFiiQii, Qni;  // scratch of the series form
+  /// per IMU state of a multi-state block: h F, h Qc, h Qc F', h F Qc (its column)
+  std::vector<std::array<double, 4>> rows_of;
   MatrixXd Mni;                     // scratch of the propagation
   MatrixXd PHt, K, KS, Pc;          // scratch of the update (KS holds K L)
   VectorXd inv;
@@ -334,19 +337,30 @@ void ErrorStateEkf::buildTransition(const Lin& L, double dt, Transition& T) cons
       FniFiiQii.block<3, 1>(row, o) = col * (h * f * q);
       continue;
     }
-    // multi-state block (DR, SIN): (3 x 1) column times (1 x n) rows, n small
-    for (int j = 0; j < n; ++j) {
-      const double hF = b.ss.H.dot(b.ss.F.col(j)), hQ = b.ss.H.dot(b.ss.Qc.col(j));
-      double hQFt = 0.0, hFQ = 0.0;
-      for (int i = 0; i < n; ++i) {
-        hQFt += b.ss.H.dot(b.ss.Qc.col(i)) * b.ss.F(j, i);
-        hFQ += b.ss.H.dot(b.ss.F.col(i)) * b.ss.Qc(i, j);
+    // multi-state block (DR, SIN): (3 x 1) column times (1 x n) rows, n small;
+    // the rows h F, h Qc, h Qc F', h F Qc of the block's constant model, once
+    if (c.rows_of.size() != static_cast<std::size_t>(m)) {
+      c.rows_of.assign(m, {});
+      for (const ProcessBlock& bb : blocks) {
+        if (bb.ss.n == 1) continue;
+        for (int j = 0; j < bb.ss.n; ++j) {
+          const double hF = bb.ss.H.dot(bb.ss.F.col(j)), hQ = bb.ss.H.dot(bb.ss.Qc.col(j));
+          double hQFt = 0.0, hFQ = 0.0;
+          for (int i = 0; i < bb.ss.n; ++i) {
+            hQFt += bb.ss.H.dot(bb.ss.Qc.col(i)) * bb.ss.F(j, i);
+            hFQ += bb.ss.H.dot(bb.ss.F.col(i)) * bb.ss.Qc(i, j);
+          }
+          c.rows_of[bb.offset - kNav + j] = {hF, hQ, hQFt, hFQ};
+        }
       }
+    }
+    for (int j = 0; j < n; ++j) {
+      const std::array<double, 4>& r = c.rows_of[o + j];
       Fni.block<3, 1>(row, o + j) = col * b.ss.H(j);
-      FniFii.block<3, 1>(row, o + j) = col * hF;
-      FniQii.block<3, 1>(row, o + j) = col * hQ;
-      FniQiiFii.block<3, 1>(row, o + j) = col * hQFt;
-      FniFiiQii.block<3, 1>(row, o + j) = col * hFQ;
+      FniFii.block<3, 1>(row, o + j) = col * r[0];
+      FniQii.block<3, 1>(row, o + j) = col * r[1];
+      FniQiiFii.block<3, 1>(row, o + j) = col * r[2];
+      FniFiiQii.block<3, 1>(row, o + j) = col * r[3];
     }
   }
   // extra states: random constants (Fii = 0, Qii = 0), only their Fni columns

@@ -17,13 +17,16 @@ Matrix9d navErrorDynamics(const ins::NavState& x, const Vector3d& f_B) {
 }
 
 Matrix9d navErrorDynamicsN(const ins::NavState& x, const Vector3d& f_N) {
-  const earth::Radii r = earth::radii(x.lat);
+  // sin, cos, tan and the radii once (the values earth::radii, w_IE_N and w_EN_N
+  // of x.lat compute, bit for bit)
+  const earth::LatitudeTerms lt(x.lat);
+  const earth::Radii& r = lt.r;
   const double rN = r.R_N + x.h, rE = r.R_E + x.h;
-  const double sL = std::sin(x.lat), cL = std::cos(x.lat), tL = sL / cL;
+  const double sL = lt.sin_lat, cL = lt.cos_lat, tL = sL / cL;
   const double vN = x.v_N.x(), vE = x.v_N.y(), vD = x.v_N.z();
   const double W = earth::kOmegaIE;
-  const Vector3d w_ie = earth::w_IE_N(x.lat);
-  const Vector3d w_en = earth::w_EN_N(x.lat, x.h, x.v_N);
+  const Vector3d w_ie = earth::w_IE_N(lt);
+  const Vector3d w_en = earth::w_EN_N(lt, x.h, x.v_N);
 
   // d(omega)/d(dp): column 0 = d/dlat / rN, column 2 = -d/dh (dp_D = -dh).
   Matrix3d Wie_r = Matrix3d::Zero();
@@ -41,7 +44,7 @@ Matrix9d navErrorDynamicsN(const ins::NavState& x, const Vector3d& f_N) {
 
   // Gravity error (Groves 14.69 with the ellipsoidal gradient).
   double dgD_dlat = 0, dgD_dh = 0;
-  earth::gravityGradient(x.lat, x.h, dgD_dlat, dgD_dh);
+  earth::gravityGradient(lt, x.h, dgD_dlat, dgD_dh);
   const double dgN_dh = earth::gravity_N(x.lat, x.h + 1.0).x() - earth::gravity_N(x.lat, x.h).x();
   Matrix3d G_r = Matrix3d::Zero();
   G_r(2, 0) = dgD_dlat / rN;

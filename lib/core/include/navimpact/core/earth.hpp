@@ -137,6 +137,8 @@ struct LatitudeTerms {
 };
 Eigen::Vector3d w_IE_N(const LatitudeTerms& l);
 Eigen::Vector3d w_EN_N(const LatitudeTerms& l, double h, const Eigen::Vector3d& v_N);
+/// gravityGradient() with the sine of l.lat taken from @p l (the same values).
+void gravityGradient(const LatitudeTerms& l, double h, double& dgD_dlat, double& dgD_dh);
 
 /**
  * Rotation matrix from ECEF to NED at (lat, lon) (Groves 2.150 transposed).
