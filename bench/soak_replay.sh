@@ -6,8 +6,8 @@
 # 1. writes a turning-flight trajectory of HOURS hours (a lemniscate of 300 m, 2 min a
 #    lap, 20 m up and down, coordinated turns; 10 Hz NED CSV made with awk);
 # 2. `navimpact emulate`s it at 200 Hz with the NavChip Table 1 Ref IMU errors, GNSS at
-#    1 Hz, baro and reference at 10 Hz (emulate holds the whole run in memory: about
-#    150 MB per hour);
+#    1 Hz, baro and reference at 10 Hz (emulate streams the run into the rawlog block by
+#    block: its memory does not grow with the run);
 # 3. `navimpact replay`s it with 30 s GNSS outages every 120 s under GNU time, and checks
 #    - peak resident memory of the replay <= LIMIT_MB (default 1024),
 #    - exit 0 and the covariance positive definite all along: every predicted sigma in
@@ -69,7 +69,7 @@ EOF
 peak_mb() { awk '/Maximum resident set size/ { printf "%.0f", $NF / 1024 }' "$1"; }
 wall_s() { awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, p, ":"); s = 0; for (i = 1; i <= n; i++) s = s * 60 + p[i]; printf "%.1f", s }' "$1"; }
 
-echo "== emulate (holds the run in memory)"
+echo "== emulate (streams)"
 rm -f "$WORK/run.rawlog"
 nice -n 10 /usr/bin/time -v "$NI" emulate --config "$WORK/emulation.yaml" --out "$WORK/run.rawlog" 2> "$WORK/emulate.time" | tail -2
 echo "emulate: $(wall_s "$WORK/emulate.time") s wall, peak RSS $(peak_mb "$WORK/emulate.time") MB"

@@ -79,6 +79,18 @@ foreach(_case "baro_sigma|imu: {errors: none}\nbaro: {sigma_m: 1e308}|key 'baro.
     REGEX "${_re}" NOOUT ${_edir}/range_${_n}.rawlog)
 endforeach()
 
+# Work budget: a run above 10^8 IMU samples (here 12,000 s at 10 kHz) is refused before
+# it starts, naming the key and the flag that lifts it; nothing is written.
+file(WRITE ${_edir}/long_traj.csv "time_s,x_N_m,x_E_m,x_D_m,roll_rad,pitch_rad,yaw_rad\n0,0,0,0,0,0,0\n1500,0,0,0,0,0,0\n3000,0,0,0,0,0,0\n4500,0,0,0,0,0,0\n6000,0,0,0,0,0,0\n7500,0,0,0,0,0,0\n9000,0,0,0,0,0,0\n10500,0,0,0,0,0,0\n12000,0,0,0,0,0,0\n")
+file(WRITE ${_edir}/long.yaml "
+trajectory: {file: long_traj.csv, system: ned, origin: {lat_deg: 46.5, lon_deg: 6.5, height_m: 400}, max_gap_s: 20000}
+imu: {rate_hz: 10000, errors: none}
+")
+navimpact_cli_fail(cli_emulate_budget
+  ARGS emulate --config ${_edir}/long.yaml --out ${_edir}/long.rawlog
+  REGEX "long.yaml: key 'imu.rate_hz': the run is 1.2e.08 IMU samples .12000 s at 10000 Hz; about 8.04 GB of rawlog.*above the budget of 1e.08: .*--allow-large"
+  NOOUT ${_edir}/long.rawlog)
+
 # Sensor effects in an emulation (effects: ...): a 240 s run whose gyros read
 # 1 % too much (a scale factor 5x the detection limit of README "Run diagnosis"),
 # then diagnose --run with the model the sensor was emulated with names

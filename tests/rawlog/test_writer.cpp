@@ -1,8 +1,13 @@
 // Rawlog writer + reader of navimpact::Recording: every field of every label
 // round-trips (optional fields as present or absent), and malformed files are
 // reported with the offending entry.
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
+#include <random>
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/obs/CObservationGPS.h>
@@ -402,5 +407,58 @@ TEST(RawlogReader, RecordsInMemoryComeBackInTheReadersOrder) {
     EXPECT_EQ(mem.data.origin.h, reader.header().origin.h);
     EXPECT_EQ(mem.data.start_unix_s, reader.header().start_unix_s);
     EXPECT_EQ(mem.data.t_start_s, reader.header().t_start_s);
+  }
+}
+
+// A rawlog written in blocks (RawlogWriter, how emulate streams a long run) is the file
+// writeRawlog makes of the whole recording, byte for byte: blocks cut at random IMU
+// samples (seed printed), records of other streams at the same time as an IMU sample or
+// within its 100 ns tick on either side (ties that only the whole-run order settles).
+TEST(RawlogWriter, BlocksMakeTheSameFileAsTheWholeRecording) {
+  const std::uint64_t seed = 20261125;
+  std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
+  std::mt19937_64 rng(seed);
+  Recording d = sample();
+  // ties: GT and GNSS at an IMU time, and 3e-8 s after or before it (the same tick)
+  const double tImu = d.imu[150].t;
+  d.reference.insert(d.reference.begin() + 8, d.reference[8]);
+  d.reference[8].t = tImu - 3e-8;
+  d.reference[9].t = tImu + 3e-8;
+  for (std::size_t i = 10; i < d.reference.size(); ++i) d.reference[i].t = std::max(d.reference[i].t, tImu + 1e-3 * double(i));
+  d.gnss[1].t = tImu + 3e-8;
+  d.baro.insert(d.baro.begin() + 8, d.baro[8]);
+  d.baro[8].t = tImu;
+  d.baro[9].t = tImu + 2e-8;
+  for (std::size_t i = 10; i < d.baro.size(); ++i) d.baro[i].t = std::max(d.baro[i].t, tImu + 1e-3 * double(i));
+  const auto whole = (navimpact::test::tempDir() / "whole.rawlog").string();
+  navimpact::rawlog::writeRawlog(whole, d, {true, 1});
+  auto bytes = [](const std::string& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  for (int trial = 0; trial < 8; ++trial) {
+    // cut points: IMU indices, each block's records = those of time <= its last IMU sample
+    std::vector<std::size_t> cuts{150};  // the tie above is at a cut
+    for (int c = 0; c < 1 + trial; ++c) cuts.push_back(1 + rng() % (d.imu.size() - 1));
+    std::sort(cuts.begin(), cuts.end());
+    cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+    const auto p = (navimpact::test::tempDir() / "blocks.rawlog").string();
+    navimpact::rawlog::RawlogWriter w(p, d, {true, 1});
+    std::size_t i0 = 0, g = 0, b = 0, r = 0;
+    for (std::size_t c = 0; c <= cuts.size(); ++c) {
+      const bool last = c == cuts.size();
+      const std::size_t i1 = last ? d.imu.size() : cuts[c] + 1;
+      const double until = last ? std::numeric_limits<double>::infinity() : d.imu[i1 - 1].t;
+      Recording blk;
+      blk.imu.assign(d.imu.begin() + i0, d.imu.begin() + i1);
+      for (; g < d.gnss.size() && d.gnss[g].t <= until; ++g) blk.gnss.push_back(d.gnss[g]);
+      for (; b < d.baro.size() && d.baro[b].t <= until; ++b) blk.baro.push_back(d.baro[b]);
+      for (; r < d.reference.size() && d.reference[r].t <= until; ++r) blk.reference.push_back(d.reference[r]);
+      w.append(blk, until);
+      i0 = i1;
+    }
+    w.close();
+    SCOPED_TRACE("trial " + std::to_string(trial) + ", " + std::to_string(cuts.size()) + " cuts");
+    EXPECT_TRUE(bytes(p) == bytes(whole));
   }
 }

@@ -6,6 +6,8 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
+#include <cstdio>
+#include <random>
 #include <set>
 
 #include "navimpact/core/error.hpp"
@@ -157,4 +159,37 @@ TEST(Simulate, RejectsInvalidModel) {
   EXPECT_THROW(simulate(model(100, {Process::gm(1.0, -1.0)}), 10, 1), navimpact::Error);
   EXPECT_THROW(simulate(model(0, {Process::wn(1.0)}), 10, 1), navimpact::Error);
   EXPECT_TRUE(simulate(model(0, {}), 10, 1) == std::vector<double>(10, 0.0));
+}
+
+// ModelStream gives simulate's samples in blocks of any size, bit for bit: every kind,
+// parameters and block sizes drawn at random (seed printed), blocks across the SIN
+// re-anchoring points (every 1024th sample) and of size 0 and 1.
+TEST(Simulate, StreamInBlocksIsTheWholeSimulationBitForBit) {
+  const std::uint64_t seed = 20261125;
+  std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
+  std::mt19937_64 rng(seed);
+  auto uni = [&](double a, double b) { return a + (b - a) * double(rng() >> 11) * 0x1.0p-53; };
+  for (int trial = 0; trial < 12; ++trial) {
+    const double rate = uni(50.0, 1000.0);
+    const Model m = model(rate, {Process::wn(uni(1e-4, 1.0)), Process::qn(uni(1e-4, 0.1)),
+                                 Process::rw(uni(1e-6, 1e-3)), Process::dr(uni(1e-8, 1e-4)),
+                                 Process::gm(uni(1e-3, 1.0), uni(2.0 / rate, 100.0)),
+                                 Process::sin(uni(1e-3, 1.0), uni(0.01, 0.45 * rate))});
+    const std::size_t n = 3000 + rng() % 5000;
+    const std::uint64_t s = rng();
+    const auto whole = simulate(m, n, s);
+    ModelStream stream(m, s);
+    std::vector<double> joined;
+    while (joined.size() < n) {
+      std::size_t b = rng() % 4 == 0 ? rng() % 2 : 1 + rng() % 1500;
+      b = std::min(b, n - joined.size());
+      std::vector<double> block(b, 0.0);
+      stream.addNext(block.data(), b);
+      joined.insert(joined.end(), block.begin(), block.end());
+    }
+    SCOPED_TRACE("trial " + std::to_string(trial) + ": rate " + std::to_string(rate) + " Hz, " + std::to_string(n) +
+                 " samples");
+    ASSERT_EQ(joined.size(), whole.size());
+    for (std::size_t k = 0; k < n; ++k) ASSERT_EQ(joined[k], whole[k]) << "sample " << k;
+  }
 }

@@ -3,12 +3,16 @@
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
+#include <limits>
+#include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/imu_series.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/core/limits.hpp"
@@ -104,68 +108,13 @@ EmulationConfig loadEmulationConfig(const std::string& path) {
   return cfg;
 }
 
-Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
-  Ctx c{cfg.config_file};
-  const long long startUnix = parseUtc(cfg.start_utc, c);
-  Recording d;
-  d.source = cfg.config_file.empty() ? "emulation" : cfg.config_file;
-  const SmoothTrajectory tr(readTrajectoryCsv(cfg.trajectory), cfg.smoothing);
-  d.origin = tr.origin();
-  d.imu_rate_hz = cfg.imu_rate_hz;
-  d.start_unix_s = startUnix;
-  d.t_start_s = tr.tBegin();
-  const auto perfect = perfectImu(tr, cfg.imu_rate_hz);
-  const std::size_t n = perfect.size();
+namespace {
 
-  ImuErrors err;
-  stochastic::ImuModel model;
-  if (cfg.imu_errors == "model") {
-    model = stochastic::loadImuModel(cfg.model_spec);
-    err = modelImuErrors(model, cfg.imu_rate_hz, n, cfg.imu_seed);
-  } else if (cfg.imu_errors == "static") {
-    err = staticImuErrors(cfg.static_rec, cfg.imu_rate_hz, n);
-  } else {
-    for (auto& a : err.axis) a.assign(n, 0.0);
-    err.description = "none (perfect IMU)";
-  }
-  d.notices = err.notices;
-  d.imu.resize(n);
-  std::string effects = "none";
-  if (cfg.effects.none()) {
-    for (std::size_t k = 0; k < n; ++k) {
-      const auto& s = perfect[k];
-      ImuRecord& r = d.imu[k];
-      r.t = s.t;
-      r.w_IB_B = s.dtheta_B / s.dt + Eigen::Vector3d(err.axis[0][k], err.axis[1][k], err.axis[2][k]);
-      r.f_B = s.dv_B / s.dt + Eigen::Vector3d(err.axis[3][k], err.axis[4][k], err.axis[5][k]);
-    }
-  } else {
-    // the sensor's output with the effects (sensor_effects.hpp); the white noise the
-    // motion factors inflate is the model's
-    std::array<double, 6> ws{};
-    if (cfg.imu_errors == "model") ws = whiteNoiseSigma(model, cfg.imu_rate_hz);
-    const EffectedImu e = applySensorEffects(perfect, err.axis, cfg.effects, ws, cfg.effects_seed);
-    for (std::size_t k = 0; k < n; ++k) {
-      ImuRecord& r = d.imu[k];
-      r.t = e.imu[k].t;
-      r.w_IB_B = e.imu[k].dtheta_B / e.imu[k].dt;
-      r.f_B = e.imu[k].dv_B / e.imu[k].dt;
-    }
-    effects = e.description;
-  }
-  const double t0 = tr.tBegin(), t1 = perfect.back().t;
-  // GNSS of the true antenna (told - lever-arm error); the rawlog states the told one
-  d.gnss = simulateGnss(tr, gnssWithEffects(cfg.gnss, cfg.effects), t0, t1);
-  d.baro = simulateBaro(tr, cfg.baro, t0, t1);
-  const auto nt = static_cast<std::size_t>(std::floor((t1 - t0) * cfg.truth_rate_hz + 1e-9)) + 1;
-  d.reference.resize(nt);
-  for (std::size_t k = 0; k < nt; ++k) {
-    const double t = t0 + double(k) / cfg.truth_rate_hz;
-    const TruthState s = tr.at(t);
-    d.reference[k] = {t, s.p_L, s.v_N, Eigen::Quaterniond(s.C_BtoN).normalized(), {}, {}, {}};
-  }
-
-  // Scenario text (YAML), stored as the rawlog's first entry.
+/// The scenario text (YAML), stored as the rawlog's first entry.
+std::string scenarioText(const EmulationConfig& cfg, const std::string& version, long long startUnix,
+                         const earth::Geodetic& origin, double t0, double t1, const std::string& err_description,
+                         const std::string& effects, const std::vector<std::string>& notices,
+                         const stochastic::ImuModel& model) {
   std::ostringstream y;
   const auto& g = cfg.gnss;
   y << "navimpact_scenario:\n"
@@ -176,8 +125,8 @@ Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
        " BARO: \"IMU_ALTITUDE m above the WGS84 ellipsoid\","
        " GNSS: \"GGA lat/lon deg, altitude_meters ellipsoidal, geoidal_distance 0; TOPCON_PZS ECEF m, m/s, covariances m^2, m^2/s^2\","
        " GT: \"IMU_X..IMU_Z m (tangent NED at origin), IMU_X_VEL..IMU_Z_VEL m/s (local NED), IMU_ORI_QUAT_X..W of C_BtoN\"}\n"
-    << "  origin: {lat_deg: " << formatNumber(d.origin.lat * 180 / M_PI, 17) << ", lon_deg: " << formatNumber(d.origin.lon * 180 / M_PI, 17)
-    << ", height_m: " << formatNumber(d.origin.h, 17) << "}\n"
+    << "  origin: {lat_deg: " << formatNumber(origin.lat * 180 / M_PI, 17) << ", lon_deg: " << formatNumber(origin.lon * 180 / M_PI, 17)
+    << ", height_m: " << formatNumber(origin.h, 17) << "}\n"
     << "  time: {start_utc: " << quote(cfg.start_utc) << ", start_unix_s: " << startUnix
     << ", trajectory_time_at_start_s: " << formatNumber(t0, 17) << ", duration_s: " << formatNumber(t1 - t0, 17) << "}\n"
     << "  trajectory: {file: " << quote(cfg.trajectory.file) << ", system: " << cfg.trajectory.system
@@ -186,7 +135,7 @@ Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
     << ", knot_step_s: " << formatNumber(cfg.smoothing.knot_step_s, 17) << ", penalty_order: " << cfg.smoothing.penalty_order << "}\n"
     << "  imu: {rate_hz: " << formatNumber(cfg.imu_rate_hz, 17) << ", errors: " << cfg.imu_errors
     << ", model: " << quote(cfg.model_spec) << ", seed: " << cfg.imu_seed
-    << ", description: " << quote(err.description) << "}\n"
+    << ", description: " << quote(err_description) << "}\n"
     << "  gnss: {rate_hz: " << formatNumber(g.rate_hz, 17) << ", sigma_pos_h_m: " << formatNumber(g.sigma_pos_h_m, 17)
     << ", sigma_pos_v_m: " << formatNumber(g.sigma_pos_v_m, 17) << ", sigma_vel_h_mps: " << formatNumber(g.sigma_vel_h_mps, 17)
     << ", sigma_vel_v_mps: " << formatNumber(g.sigma_vel_v_mps, 17) << ", lever_arm_B_m: [" << formatNumber(g.lever_arm_B[0], 17) << ", "
@@ -198,8 +147,8 @@ Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
     y << "  effects: {description: " << quote(effects) << ", seed: " << cfg.effects_seed << "}\n";
   y
     << "  notices:\n";
-  for (const auto& nline : d.notices) y << "    - " << quote(nline) << "\n";
-  if (d.notices.empty()) y << "    []\n";
+  for (const auto& nline : notices) y << "    - " << quote(nline) << "\n";
+  if (notices.empty()) y << "    []\n";
   if (cfg.imu_errors == "model") {
     std::string mt = stochastic::toYaml(model, "IMU error model " + model.source);
     y << "  imu_model_yaml: |\n";
@@ -207,9 +156,178 @@ Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
     std::string line;
     while (std::getline(in, line)) y << "    " << line << "\n";
   }
-  d.metadata = y.str();
-  d.lever_arm_B = g.lever_arm_B;
-  return d;
+  return y.str();
+}
+
+constexpr std::size_t kBlockSamples = std::size_t(1) << 16;  // IMU samples per block of a streamed run
+
+/// Collects the blocks into one Recording.
+class Collect : public RecordingSink {
+ public:
+  Recording d;
+  void begin(const Recording& header) override { d = header; }
+  void append(const Recording& b, double) override {
+    d.imu.insert(d.imu.end(), b.imu.begin(), b.imu.end());
+    d.gnss.insert(d.gnss.end(), b.gnss.begin(), b.gnss.end());
+    d.baro.insert(d.baro.end(), b.baro.begin(), b.baro.end());
+    d.reference.insert(d.reference.end(), b.reference.begin(), b.reference.end());
+  }
+};
+
+std::string g3(double v) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%.3g", v);
+  return s;
+}
+
+}  // namespace
+
+EmulationBudget emulationBudget(const EmulationConfig& cfg, double duration_s) {
+  EmulationBudget b;
+  b.duration_s = duration_s;
+  b.imu_samples = std::max(0.0, duration_s) * cfg.imu_rate_hz;
+  b.rawlog_bytes = b.imu_samples * kRawlogBytesPerSample;
+  b.work_s = b.imu_samples * kCpuSecondsPerSample;
+  if (!cfg.effects.none()) b.memory_bytes = b.imu_samples * kEffectsBytesPerSample;
+  if (cfg.allow_large) return b;
+  const std::string what = "the run is " + g3(b.imu_samples) + " IMU samples (" + formatNumber(duration_s) + " s at " +
+                           formatNumber(cfg.imu_rate_hz) + " Hz; about " + g3(b.rawlog_bytes / 1e9) + " GB of rawlog, " +
+                           g3(b.work_s / 60.0) + " min of CPU)";
+  if (b.imu_samples > kSampleBudget)
+    throw keyError(cfg.config_file, "imu.rate_hz",
+                   what + ", above the budget of " + g3(kSampleBudget) +
+                       ": lower it, shorten the trajectory (start_s, end_s) or pass --allow-large");
+  if (b.memory_bytes > limits::kDefaultMemoryBudgetBytes)
+    throw keyError(cfg.config_file, "effects",
+                   what + ", held in memory with sensor effects: about " + g3(b.memory_bytes / 1e9) +
+                       " GB, above the budget of " + g3(limits::kDefaultMemoryBudgetBytes / 1e9) +
+                       " GB: shorten the run or pass --allow-large");
+  return b;
+}
+
+Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
+  Collect c;
+  runEmulation(cfg, version, c);
+  return std::move(c.d);
+}
+
+void runEmulation(const EmulationConfig& cfg, const std::string& version, RecordingSink& sink) {
+  Ctx c{cfg.config_file};
+  const long long startUnix = parseUtc(cfg.start_utc, c);
+  std::optional<SmoothTrajectory> trOpt;
+  {
+    const SampledTrajectory samples = readTrajectoryCsv(cfg.trajectory);
+    emulationBudget(cfg, samples.t.empty() ? 0.0 : samples.t.back() - samples.t.front());
+    trOpt.emplace(samples, cfg.smoothing);
+  }  // the samples are freed here; the spline holds the trajectory
+  const SmoothTrajectory& tr = *trOpt;
+  Recording d;
+  d.source = cfg.config_file.empty() ? "emulation" : cfg.config_file;
+  d.origin = tr.origin();
+  d.imu_rate_hz = cfg.imu_rate_hz;
+  d.start_unix_s = startUnix;
+  d.t_start_s = tr.tBegin();
+  d.lever_arm_B = cfg.gnss.lever_arm_B;
+  const double t0 = tr.tBegin();
+  stochastic::ImuModel model;
+  if (cfg.imu_errors == "model") model = stochastic::loadImuModel(cfg.model_spec);
+
+  if (!cfg.effects.none()) {  // the effects are applied to the whole run (time shift, motion test)
+    const auto perfect = perfectImu(tr, cfg.imu_rate_hz);
+    const std::size_t n = perfect.size();
+    ImuErrors err;
+    if (cfg.imu_errors == "model") {
+      err = modelImuErrors(model, cfg.imu_rate_hz, n, cfg.imu_seed);
+    } else if (cfg.imu_errors == "static") {
+      err = staticImuErrors(cfg.static_rec, cfg.imu_rate_hz, n);
+    } else {
+      for (auto& a : err.axis) a.assign(n, 0.0);
+      err.description = "none (perfect IMU)";
+    }
+    d.notices = err.notices;
+    // the sensor's output with the effects (sensor_effects.hpp); the white noise the
+    // motion factors inflate is the model's
+    std::array<double, 6> ws{};
+    if (cfg.imu_errors == "model") ws = whiteNoiseSigma(model, cfg.imu_rate_hz);
+    const EffectedImu e = applySensorEffects(perfect, err.axis, cfg.effects, ws, cfg.effects_seed);
+    d.imu.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      ImuRecord& r = d.imu[k];
+      r.t = e.imu[k].t;
+      r.w_IB_B = e.imu[k].dtheta_B / e.imu[k].dt;
+      r.f_B = e.imu[k].dv_B / e.imu[k].dt;
+    }
+    const double t1 = perfect.back().t;
+    // GNSS of the true antenna (told - lever-arm error); the rawlog states the told one
+    d.gnss = simulateGnss(tr, gnssWithEffects(cfg.gnss, cfg.effects), t0, t1);
+    d.baro = simulateBaro(tr, cfg.baro, t0, t1);
+    const auto nt = static_cast<std::size_t>(std::floor((t1 - t0) * cfg.truth_rate_hz + 1e-9)) + 1;
+    d.reference.resize(nt);
+    for (std::size_t k = 0; k < nt; ++k) {
+      const double t = t0 + double(k) / cfg.truth_rate_hz;
+      const TruthState s = tr.at(t);
+      d.reference[k] = {t, s.p_L, s.v_N, Eigen::Quaterniond(s.C_BtoN).normalized(), {}, {}, {}};
+    }
+    d.metadata = scenarioText(cfg, version, startUnix, d.origin, t0, t1, err.description, e.description, d.notices,
+                              model);
+    Recording header = d;
+    header.imu.clear();
+    header.gnss.clear();
+    header.baro.clear();
+    header.reference.clear();
+    sink.begin(header);
+    sink.append(d, std::numeric_limits<double>::infinity());
+    return;
+  }
+
+  // Without effects the run streams: the perfect IMU, its errors, GNSS, barometer and
+  // truth block by block, each record as the whole-run computation makes it.
+  const double a = tr.tBegin(), rate = cfg.imu_rate_hz;
+  const std::size_t n = perfectImuCount(rate, a, tr.tEnd());
+  if (n == 0) perfectImu(tr, rate);  // throws its error: no whole IMU interval
+  const double t1 = a + double(n) * (1.0 / rate);  // the last sample's time, as perfectImu computes it
+  ImuErrorStream err = cfg.imu_errors == "model"    ? ImuErrorStream::fromModel(model, rate, n, cfg.imu_seed)
+                       : cfg.imu_errors == "static" ? ImuErrorStream::fromStatic(
+                                                          std::make_shared<const ImuSeries>(
+                                                              readImuCsv(cfg.static_rec.file, cfg.static_rec.csv)),
+                                                          cfg.static_rec, rate, n)
+                                                    : ImuErrorStream::none(n);
+  d.notices = err.notices();
+  d.metadata = scenarioText(cfg, version, startUnix, d.origin, t0, t1, err.description(), "none", d.notices, model);
+  sink.begin(d);
+  GnssSimulator gnss(tr, cfg.gnss, t0, t1);
+  BaroSimulator baro(tr, cfg.baro, t0, t1);
+  const auto nt = static_cast<std::size_t>(std::floor((t1 - t0) * cfg.truth_rate_hz + 1e-9)) + 1;
+  std::size_t kt = 0;
+  std::vector<ins::ImuSample> perfect;
+  std::array<std::vector<double>, 6> e;
+  Recording blk;
+  for (std::size_t k0 = 0; k0 < n; k0 += kBlockSamples) {
+    const std::size_t k1 = std::min(n, k0 + kBlockSamples);
+    perfectImuBlock(tr, rate, a, k0, k1, perfect);
+    err.next(k1 - k0, e);
+    blk.imu.resize(k1 - k0);
+    blk.gnss.clear();
+    blk.baro.clear();
+    blk.reference.clear();
+    for (std::size_t k = 0; k < k1 - k0; ++k) {
+      const auto& s = perfect[k];
+      ImuRecord& r = blk.imu[k];
+      r.t = s.t;
+      r.w_IB_B = s.dtheta_B / s.dt + Eigen::Vector3d(e[0][k], e[1][k], e[2][k]);
+      r.f_B = s.dv_B / s.dt + Eigen::Vector3d(e[3][k], e[4][k], e[5][k]);
+    }
+    const double until = k1 == n ? std::numeric_limits<double>::infinity() : perfect.back().t;
+    gnss.next(until, blk.gnss);
+    baro.next(until, blk.baro);
+    for (; kt < nt; ++kt) {
+      const double t = t0 + double(kt) / cfg.truth_rate_hz;
+      if (t > until) break;
+      const TruthState s = tr.at(t);
+      blk.reference.push_back({t, s.p_L, s.v_N, Eigen::Quaterniond(s.C_BtoN).normalized(), {}, {}, {}});
+    }
+    sink.append(blk, until);
+  }
 }
 
 }  // namespace navimpact::emulation

@@ -1,6 +1,8 @@
 #include "navimpact/emulation/sensors.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
@@ -13,34 +15,45 @@
 namespace navimpact::emulation {
 
 namespace {
-}  // namespace
 
-std::vector<double> standardNormal(std::size_t n, std::uint64_t seed) {
+stochastic::Model unitWhiteNoise() {
   stochastic::Model wn;
   wn.rate_hz = 1.0;
   wn.terms.push_back(stochastic::Process::wn(1.0));
-  return stochastic::simulate(wn, n, seed);
+  return wn;
 }
 
-ImuErrors modelImuErrors(const stochastic::ImuModel& model, double imu_rate_hz, std::size_t n,
-                         std::uint64_t seed) {
-  ImuErrors e;
-  const stochastic::ImuModel m = stochastic::atRate(model, imu_rate_hz, &e.notices);
-  for (std::size_t i = 0; i < 6; ++i) {
-    e.axis[i].assign(n, 0.0);
-    if (!m.axis[i].empty()) stochastic::simulateAdd(m.axis[i], stochastic::deriveSeed(seed, i), e.axis[i].data(), n);
-  }
-  e.description = "simulated from model " + model.source + " at " + formatNumber(imu_rate_hz) + " Hz, seed " +
-                  std::to_string(seed) + " (axis i: deriveSeed(seed, i))";
+}  // namespace
+
+std::vector<double> standardNormal(std::size_t n, std::uint64_t seed) {
+  return stochastic::simulate(unitWhiteNoise(), n, seed);
+}
+
+ImuErrorStream ImuErrorStream::none(std::size_t n) {
+  ImuErrorStream e;
+  e.n_ = n;
+  e.description_ = "none (perfect IMU)";
   return e;
 }
 
-ImuErrors staticImuErrors(const StaticRecordingSpec& spec, double imu_rate_hz, std::size_t n) {
-  return staticImuErrors(readImuCsv(spec.file, spec.csv), spec, imu_rate_hz, n);
+ImuErrorStream ImuErrorStream::fromModel(const stochastic::ImuModel& model, double imu_rate_hz, std::size_t n,
+                                         std::uint64_t seed) {
+  ImuErrorStream e;
+  e.n_ = n;
+  e.kind_ = 1;
+  const stochastic::ImuModel m = stochastic::atRate(model, imu_rate_hz, &e.notices_);
+  e.model_.resize(6);
+  for (std::size_t i = 0; i < 6; ++i)
+    if (!m.axis[i].empty() && !m.axis[i].terms.empty())
+      e.model_[i].emplace(m.axis[i], stochastic::deriveSeed(seed, i));
+  e.description_ = "simulated from model " + model.source + " at " + formatNumber(imu_rate_hz) + " Hz, seed " +
+                   std::to_string(seed) + " (axis i: deriveSeed(seed, i))";
+  return e;
 }
 
-ImuErrors staticImuErrors(const ImuSeries& rec, const StaticRecordingSpec& spec, double imu_rate_hz,
-                          std::size_t n) {
+ImuErrorStream ImuErrorStream::fromStatic(std::shared_ptr<const ImuSeries> recp, const StaticRecordingSpec& spec,
+                                          double imu_rate_hz, std::size_t n) {
+  const ImuSeries& rec = *recp;
   const double ratio = rec.rate_hz / imu_rate_hz;
   const double m_real = std::round(ratio);
   if (m_real < 1.0 || std::abs(ratio - m_real) > 1e-6 * ratio)
@@ -52,7 +65,9 @@ ImuErrors staticImuErrors(const ImuSeries& rec, const StaticRecordingSpec& spec,
     throw Error(spec.file + ": static recording too short: " + formatNumber(have / rec.rate_hz) + " s available, " +
                 formatNumber(need / rec.rate_hz) + " s needed for " + std::to_string(n) + " IMU samples");
   std::size_t start = 0;
-  ImuErrors e;
+  ImuErrorStream e;
+  e.n_ = n;
+  e.kind_ = 2;
   if (spec.offset_s) {
     if (*spec.offset_s < 0.0) throw Error(spec.file + ": static recording offset must be >= 0 s");
     start = static_cast<std::size_t>(std::llround(*spec.offset_s * rec.rate_hz));
@@ -63,69 +78,143 @@ ImuErrors staticImuErrors(const ImuSeries& rec, const StaticRecordingSpec& spec,
   } else {
     const std::uint64_t r = stochastic::deriveSeed(spec.seed, 0);
     start = static_cast<std::size_t>(r % (have - need + 1));
-    e.notices.push_back("static recording window chosen by seed " + std::to_string(spec.seed) + ": offset " +
-                        formatNumber(start / rec.rate_hz) + " s");
+    e.notices_.push_back("static recording window chosen by seed " + std::to_string(spec.seed) + ": offset " +
+                         formatNumber(start / rec.rate_hz) + " s");
   }
   if (m > 1)
-    e.notices.push_back("static recording at " + formatNumber(rec.rate_hz) + " Hz decimated by " + std::to_string(m) +
-                        " (block means) to the IMU rate " + formatNumber(imu_rate_hz) + " Hz");
+    e.notices_.push_back("static recording at " + formatNumber(rec.rate_hz) + " Hz decimated by " + std::to_string(m) +
+                         " (block means) to the IMU rate " + formatNumber(imu_rate_hz) + " Hz");
+  e.start_ = start;
+  e.m_ = m;
   for (std::size_t i = 0; i < 6; ++i) {
-    auto& out = e.axis[i];
-    out.assign(n, 0.0);
     if (!rec.has(kChannelNames[i])) {
-      e.notices.push_back(std::string("static recording has no ") + kChannelNames[i] + ": no error on that axis");
+      e.notices_.push_back(std::string("static recording has no ") + kChannelNames[i] + ": no error on that axis");
       continue;
     }
+    e.has_[i] = true;
+    // the window's mean of the block means (removed from every value)
     const auto& x = rec.channel(kChannelNames[i]).x;
     double mean = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
-      double s = 0.0;
-      for (std::size_t j = 0; j < m; ++j) s += x[start + k * m + j];
-      out[k] = s / double(m);
-      mean += out[k];
+      double sum = 0.0;
+      for (std::size_t j = 0; j < m; ++j) sum += x[start + k * m + j];
+      mean += sum / double(m);
     }
-    mean /= double(n);
-    for (auto& v : out) v -= mean;
+    e.mean_[i] = mean / double(n);
   }
-  e.description = "measured static recording " + spec.file + ", window from " + formatNumber(start / rec.rate_hz) +
-                  " s, mean removed per axis";
+  e.description_ = "measured static recording " + spec.file + ", window from " + formatNumber(start / rec.rate_hz) +
+                   " s, mean removed per axis";
+  e.rec_ = std::move(recp);
   return e;
+}
+
+void ImuErrorStream::next(std::size_t count, std::array<std::vector<double>, 6>& out) {
+  if (count > n_ - k_) throw Error("IMU errors: " + std::to_string(count) + " samples asked, " +
+                                   std::to_string(n_ - k_) + " left");
+  for (std::size_t i = 0; i < 6; ++i) {
+    out[i].assign(count, 0.0);
+    if (kind_ == 1 && model_[i]) model_[i]->addNext(out[i].data(), count);
+    if (kind_ == 2 && has_[i]) {
+      const auto& x = rec_->channel(kChannelNames[i]).x;
+      for (std::size_t c = 0; c < count; ++c) {
+        const std::size_t k = k_ + c;
+        double sum = 0.0;
+        for (std::size_t j = 0; j < m_; ++j) sum += x[start_ + k * m_ + j];
+        out[i][c] = sum / double(m_) - mean_[i];
+      }
+    }
+  }
+  k_ += count;
+}
+
+namespace {
+
+ImuErrors collect(ImuErrorStream s) {
+  ImuErrors e;
+  s.next(s.size(), e.axis);
+  e.notices = s.notices();
+  e.description = s.description();
+  return e;
+}
+
+}  // namespace
+
+ImuErrors modelImuErrors(const stochastic::ImuModel& model, double imu_rate_hz, std::size_t n,
+                         std::uint64_t seed) {
+  return collect(ImuErrorStream::fromModel(model, imu_rate_hz, n, seed));
+}
+
+ImuErrors staticImuErrors(const StaticRecordingSpec& spec, double imu_rate_hz, std::size_t n) {
+  return staticImuErrors(readImuCsv(spec.file, spec.csv), spec, imu_rate_hz, n);
+}
+
+ImuErrors staticImuErrors(const ImuSeries& rec, const StaticRecordingSpec& spec, double imu_rate_hz,
+                          std::size_t n) {
+  // the recording is the caller's: an aliasing pointer that owns nothing
+  return collect(ImuErrorStream::fromStatic(std::shared_ptr<const ImuSeries>(std::shared_ptr<const ImuSeries>(), &rec),
+                                            spec, imu_rate_hz, n));
+}
+
+GnssSimulator::GnssSimulator(const SmoothTrajectory& tr, const GnssOptions& opt, double t_start, double t_end)
+    : tr_(tr), opt_(opt), t_start_(t_start), z_(unitWhiteNoise(), opt.seed) {
+  if (!(opt.rate_hz > 0.0)) throw Error("gnss.rate_hz must be > 0");
+  n_ = static_cast<std::size_t>(std::floor((t_end - t_start) * opt.rate_hz + 1e-9)) + 1;
+}
+
+void GnssSimulator::next(double t_until, std::vector<GnssFix>& out) {
+  const Eigen::Vector3d sp(opt_.sigma_pos_h_m, opt_.sigma_pos_h_m, opt_.sigma_pos_v_m);
+  const Eigen::Vector3d sv(opt_.sigma_vel_h_mps, opt_.sigma_vel_h_mps, opt_.sigma_vel_v_mps);
+  double z[6];
+  for (; k_ < n_; ++k_) {
+    const double t = t_start_ + double(k_) / opt_.rate_hz;
+    if (t > t_until) break;
+    std::fill(z, z + 6, 0.0);
+    z_.addNext(z, 6);  // the fix's six draws of standardNormal(6 n, seed)
+    const TruthState s = tr_.at(t);
+    GnssFix f;
+    f.t = t;
+    const Eigen::Vector3d lever_N = s.C_BtoN * opt_.lever_arm_B;
+    const Eigen::Vector3d dpos_N = lever_N + sp.cwiseProduct(Eigen::Vector3d(z[0], z[1], z[2]));
+    f.pos = earth::nedToGeodetic(s.pos, dpos_N);
+    f.v_N = Eigen::Vector3d(s.v_N + s.C_BtoN * s.w_NB_B.cross(opt_.lever_arm_B) +
+                            sv.cwiseProduct(Eigen::Vector3d(z[3], z[4], z[5])));
+    f.cov_pos_N = Eigen::Matrix3d(sp.cwiseAbs2().asDiagonal());
+    f.cov_vel_N = Eigen::Matrix3d(sv.cwiseAbs2().asDiagonal());
+    out.push_back(f);
+  }
+}
+
+BaroSimulator::BaroSimulator(const SmoothTrajectory& tr, const BaroOptions& opt, double t_start, double t_end)
+    : tr_(tr), opt_(opt), t_start_(t_start), z_(unitWhiteNoise(), opt.seed) {
+  if (!(opt.rate_hz > 0.0)) throw Error("baro.rate_hz must be > 0");
+  n_ = static_cast<std::size_t>(std::floor((t_end - t_start) * opt.rate_hz + 1e-9)) + 1;
+}
+
+void BaroSimulator::next(double t_until, std::vector<BaroSample>& out) {
+  for (; k_ < n_; ++k_) {
+    const double t = t_start_ + double(k_) / opt_.rate_hz;
+    if (t > t_until) break;
+    double z = 0.0;
+    z_.addNext(&z, 1);
+    out.push_back({t, tr_.at(t).pos.h + opt_.sigma_m * z, opt_.sigma_m});
+  }
 }
 
 std::vector<GnssFix> simulateGnss(const SmoothTrajectory& tr, const GnssOptions& opt, double t_start,
                                   double t_end) {
-  if (!(opt.rate_hz > 0.0)) throw Error("gnss.rate_hz must be > 0");
-  const auto n = static_cast<std::size_t>(std::floor((t_end - t_start) * opt.rate_hz + 1e-9)) + 1;
-  const auto z = standardNormal(6 * n, opt.seed);
-  std::vector<GnssFix> out(n);
-  const Eigen::Vector3d sp(opt.sigma_pos_h_m, opt.sigma_pos_h_m, opt.sigma_pos_v_m);
-  const Eigen::Vector3d sv(opt.sigma_vel_h_mps, opt.sigma_vel_h_mps, opt.sigma_vel_v_mps);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = t_start + double(k) / opt.rate_hz;
-    const TruthState s = tr.at(t);
-    GnssFix& f = out[k];
-    f.t = t;
-    const Eigen::Vector3d lever_N = s.C_BtoN * opt.lever_arm_B;
-    const Eigen::Vector3d dpos_N = lever_N + sp.cwiseProduct(Eigen::Vector3d(z[6 * k], z[6 * k + 1], z[6 * k + 2]));
-    f.pos = earth::nedToGeodetic(s.pos, dpos_N);
-    f.v_N = Eigen::Vector3d(s.v_N + s.C_BtoN * s.w_NB_B.cross(opt.lever_arm_B) +
-                            sv.cwiseProduct(Eigen::Vector3d(z[6 * k + 3], z[6 * k + 4], z[6 * k + 5])));
-    f.cov_pos_N = Eigen::Matrix3d(sp.cwiseAbs2().asDiagonal());
-    f.cov_vel_N = Eigen::Matrix3d(sv.cwiseAbs2().asDiagonal());
-  }
+  GnssSimulator g(tr, opt, t_start, t_end);
+  std::vector<GnssFix> out;
+  out.reserve(g.size());
+  g.next(std::numeric_limits<double>::infinity(), out);
   return out;
 }
 
 std::vector<BaroSample> simulateBaro(const SmoothTrajectory& tr, const BaroOptions& opt, double t_start,
                                      double t_end) {
-  if (!(opt.rate_hz > 0.0)) throw Error("baro.rate_hz must be > 0");
-  const auto n = static_cast<std::size_t>(std::floor((t_end - t_start) * opt.rate_hz + 1e-9)) + 1;
-  const auto z = standardNormal(n, opt.seed);
-  std::vector<BaroSample> out(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = t_start + double(k) / opt.rate_hz;
-    out[k] = {t, tr.at(t).pos.h + opt.sigma_m * z[k], opt.sigma_m};
-  }
+  BaroSimulator b(tr, opt, t_start, t_end);
+  std::vector<BaroSample> out;
+  out.reserve(b.size());
+  b.next(std::numeric_limits<double>::infinity(), out);
   return out;
 }
 

@@ -28,6 +28,12 @@ struct AliasValueError {
   std::string expected, found;
 };
 
+/// What a process carries from one block of simulated samples to the next.
+struct SimState {
+  std::size_t k = 0;             ///< samples simulated so far
+  double x = 0.0, y = 0.0, z = 0.0;  ///< the kind's state (its own meaning per kind)
+};
+
 class KindDef {
  public:
   virtual ~KindDef() = default;
@@ -58,8 +64,11 @@ class KindDef {
   /// Haar WV at scale @p tau samples (>= 2, checked by the caller).
   virtual double haarWv(const Process& p, double rate_hz, double tau) const = 0;
 
-  /// Add @p n samples of the process to @p out, drawing from @p rng.
-  virtual void simulateAdd(const Process& p, double rate_hz, Rng& rng, double* out,
+  /// Add the next @p n samples of the process to @p out, drawing from @p rng.
+  /// @p st carries the process between calls (st.k: samples given so far; a
+  /// kind's start draws happen when st.k == 0), so consecutive calls give the
+  /// samples of one call over their total length, bit for bit.
+  virtual void simulateAdd(const Process& p, double rate_hz, Rng& rng, SimState& st, double* out,
                            std::size_t n) const = 0;
 
   /// Fill the state-space block (F, Qc, H, P0, white_psd, state labels);

@@ -56,13 +56,34 @@ std::uint64_t deriveSeed(std::uint64_t seed, std::uint64_t index) {
   return mix64(mix64(seed) + 0x9E3779B97F4A7C15ULL * (index + 1));
 }
 
+struct ModelStream::Impl {
+  Model m;
+  std::vector<detail::Rng> rng;        // one stream per term: deriveSeed(seed, term)
+  std::vector<detail::SimState> state;  // one state per term
+};
+
+ModelStream::ModelStream(const Model& m, std::uint64_t seed) : impl_(std::make_unique<Impl>()) {
+  if (!m.terms.empty()) validate(m);
+  impl_->m = m;
+  impl_->rng.reserve(m.terms.size());
+  for (std::size_t i = 0; i < m.terms.size(); ++i) impl_->rng.emplace_back(deriveSeed(seed, i));
+  impl_->state.resize(m.terms.size());
+}
+
+ModelStream::~ModelStream() = default;
+ModelStream::ModelStream(ModelStream&&) noexcept = default;
+ModelStream& ModelStream::operator=(ModelStream&&) noexcept = default;
+
+void ModelStream::addNext(double* out, std::size_t n) {
+  if (n == 0) return;
+  const Model& m = impl_->m;
+  for (std::size_t i = 0; i < m.terms.size(); ++i)  // processes/<name>.cpp
+    detail::kindDef(m.terms[i].kind).simulateAdd(m.terms[i], m.rate_hz, impl_->rng[i], impl_->state[i], out, n);
+}
+
 void simulateAdd(const Model& m, std::uint64_t seed, double* out, std::size_t n) {
   if (m.terms.empty() || n == 0) return;
-  validate(m);
-  for (std::size_t i = 0; i < m.terms.size(); ++i) {
-    detail::Rng rng(deriveSeed(seed, i));
-    detail::kindDef(m.terms[i].kind).simulateAdd(m.terms[i], m.rate_hz, rng, out, n);  // processes/<name>.cpp
-  }
+  ModelStream(m, seed).addNext(out, n);
 }
 
 std::vector<double> simulate(const Model& m, std::size_t n, std::uint64_t seed) {

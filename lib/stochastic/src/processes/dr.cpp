@@ -29,8 +29,9 @@ class Drift final : public KindDef {
     return p.omega * p.omega * tau * tau / 16.0;  // omega^2 tau^2/16
   }
 
-  void simulateAdd(const Process& p, double, Rng&, double* out, std::size_t n) const override {
-    for (std::size_t k = 0; k < n; ++k) out[k] += p.omega * static_cast<double>(k);
+  void simulateAdd(const Process& p, double, Rng&, SimState& st, double* out, std::size_t n) const override {
+    for (std::size_t k = 0; k < n; ++k) out[k] += p.omega * static_cast<double>(st.k + k);
+    st.k += n;
   }
 
   int stateCount() const override { return 2; }

@@ -166,18 +166,21 @@ class GaussMarkov final : public KindDef {
     return haarWvStationaryAr1(p.sigma * p.sigma, L, 0.5 * tau);
   }
 
-  void simulateAdd(const Process& p, double rate_hz, Rng& rng, double* out,
+  void simulateAdd(const Process& p, double rate_hz, Rng& rng, SimState& st, double* out,
                    std::size_t n) const override {
     // Exact discretisation: phi = exp(-dt/T), innovation std sigma sqrt(1-phi^2);
-    // stationary start x_0 ~ N(0, sigma^2).
+    // stationary start x_0 ~ N(0, sigma^2). st.x: the next sample.
     const double L = 1.0 / (rate_hz * p.T);
     const double phi = std::exp(-L);
     const double q = p.sigma * std::sqrt(-std::expm1(-2.0 * L));
-    double x = p.sigma * rng.normal();
+    if (st.k == 0) st.x = p.sigma * rng.normal();
+    double x = st.x;
     for (std::size_t k = 0; k < n; ++k) {
       out[k] += x;
       x = phi * x + q * rng.normal();
     }
+    st.x = x;
+    st.k += n;
   }
 
   std::optional<SampledArma> sampledArma(const Process& p, double rate_hz) const override {

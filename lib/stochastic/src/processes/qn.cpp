@@ -31,15 +31,19 @@ class QuantizationNoise final : public KindDef {
     return 6.0 * p.Q * p.Q / (tau * tau);  // 6 Q^2/tau^2 (telescoping Haar sum)
   }
 
-  void simulateAdd(const Process& p, double, Rng& rng, double* out, std::size_t n) const override {
+  void simulateAdd(const Process& p, double, Rng& rng, SimState& st, double* out, std::size_t n) const override {
     // R gmwm gen_qn: sqrt(12 Q^2) (u_k - u_{k-1}), u ~ U(0,1); var = 2 Q^2.
+    // st.x: the last uniform drawn.
     const double c = std::sqrt(12.0) * p.Q;
-    double prev = rng.uniform();
+    if (st.k == 0) st.x = rng.uniform();
+    double prev = st.x;
     for (std::size_t k = 0; k < n; ++k) {
       const double u = rng.uniform();
       out[k] += c * (u - prev);
       prev = u;
     }
+    st.x = prev;
+    st.k += n;
   }
 
   std::optional<SampledArma> sampledArma(const Process& p, double) const override {

@@ -37,13 +37,15 @@ class RandomWalk final : public KindDef {
     return p.gamma * p.gamma * (tau * tau + 2.0) / (12.0 * tau);
   }
 
-  void simulateAdd(const Process& p, double, Rng& rng, double* out, std::size_t n) const override {
-    // Starts at 0 before the first increment: x_0 = gamma z_0 (cumsum as in R).
-    double x = 0.0;
+  void simulateAdd(const Process& p, double, Rng& rng, SimState& st, double* out, std::size_t n) const override {
+    // Starts at 0 before the first increment: x_0 = gamma z_0 (cumsum as in R). st.x: the walk.
+    double x = st.x;
     for (std::size_t k = 0; k < n; ++k) {
       x += p.gamma * rng.normal();
       out[k] += x;
     }
+    st.x = x;
+    st.k += n;
   }
 
   std::optional<SampledArma> sampledArma(const Process& p, double) const override {

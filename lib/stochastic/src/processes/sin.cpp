@@ -62,24 +62,31 @@ class Sinusoid final : public KindDef {
     return 0.5 * p.amp * p.amp * s * s * s * s / (n * n * sw * sw);
   }
 
-  void simulateAdd(const Process& p, double rate_hz, Rng& rng, double* out,
+  void simulateAdd(const Process& p, double rate_hz, Rng& rng, SimState& st, double* out,
                    std::size_t n) const override {
     // amp sin(w k + theta), theta ~ U(0, 2 pi). Rotation recurrence,
-    // re-anchored exactly every 1024 samples so rounding cannot accumulate.
+    // re-anchored exactly at every 1024th sample so rounding cannot accumulate.
+    // st.z: theta; st.x, st.y: sin and cos of the next sample's angle.
     const double w = kTwoPi * p.freq_hz / rate_hz;
-    const double theta = kTwoPi * rng.uniform();
+    if (st.k == 0) st.z = kTwoPi * rng.uniform();
+    const double theta = st.z;
     const double cw = std::cos(w), sw = std::sin(w);
-    for (std::size_t k0 = 0; k0 < n; k0 += 1024) {
-      const double a0 = w * static_cast<double>(k0) + theta;
-      double s = std::sin(a0), c = std::cos(a0);
-      const std::size_t k1 = std::min(n, k0 + 1024);
-      for (std::size_t k = k0; k < k1; ++k) {
-        out[k] += p.amp * s;
-        const double s1 = s * cw + c * sw;
-        c = c * cw - s * sw;
-        s = s1;
+    double s = st.x, c = st.y;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t k = st.k + i;
+      if (k % 1024 == 0) {
+        const double a0 = w * static_cast<double>(k) + theta;
+        s = std::sin(a0);
+        c = std::cos(a0);
       }
+      out[i] += p.amp * s;
+      const double s1 = s * cw + c * sw;
+      c = c * cw - s * sw;
+      s = s1;
     }
+    st.x = s;
+    st.y = c;
+    st.k += n;
   }
 
   int stateCount() const override { return 2; }

@@ -30,8 +30,9 @@ class WhiteNoise final : public KindDef {
     return p.sigma * p.sigma / tau;  // sigma^2/tau
   }
 
-  void simulateAdd(const Process& p, double, Rng& rng, double* out, std::size_t n) const override {
+  void simulateAdd(const Process& p, double, Rng& rng, SimState& st, double* out, std::size_t n) const override {
     for (std::size_t k = 0; k < n; ++k) out[k] += p.sigma * rng.normal();
+    st.k += n;
   }
 
   std::optional<SampledArma> sampledArma(const Process& p, double) const override {

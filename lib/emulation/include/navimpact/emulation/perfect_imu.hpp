@@ -26,6 +26,17 @@ namespace navimpact::emulation {
 std::vector<ins::ImuSample> perfectImu(const SmoothTrajectory& tr, double rate_hz,
                                        double t_start = -1e300, double t_end = 1e300);
 
+/**
+ * Samples k0 .. k1-1 of perfectImu(tr, rate_hz, t_first) (the same values; t_first
+ * already clamped into the span, k1 at most its sample count), into @p out
+ * (cleared first): the perfect IMU of a long run block by block.
+ */
+void perfectImuBlock(const SmoothTrajectory& tr, double rate_hz, double t_first, std::size_t k0, std::size_t k1,
+                     std::vector<ins::ImuSample>& out);
+
+/// Number of samples perfectImu gives over [t_first, t_last] at @p rate_hz.
+std::size_t perfectImuCount(double rate_hz, double t_first, double t_last);
+
 /// The true navigation state (lib/ins type) at time @p t.
 ins::NavState truthNavState(const SmoothTrajectory& tr, double t);
 

@@ -72,6 +72,54 @@ struct EmulationConfig {
   std::uint64_t effects_seed = 4;   ///< seed of the in-motion noise
   double truth_rate_hz = 10.0;      ///< ground-truth record rate [Hz]
   std::string start_utc = "2026-01-01T00:00:00Z";  ///< UTC of the first trajectory time
+  bool allow_large = false;         ///< run above the budget of emulationBudget (--allow-large)
+};
+
+/// Budget of one emulation (navimpact emulate), in IMU samples: 10^8 (about
+/// 6 days at 200 Hz or 2.8 h at 10 kHz; a rawlog of about 6.7 GB and about
+/// 8 minutes of one core here). The IMU samples stream, so their memory does
+/// not grow with the run; the budget bounds its time and disk use
+/// (--allow-large lifts it). README "Ranges and budgets".
+inline constexpr double kSampleBudget = 1.0e8;
+/// Measured cost per IMU sample of an emulation (24 h at 200 Hz with GNSS 1 Hz,
+/// baro and ground truth 10 Hz, gzip level 1: 1.149 GB, 86 s of CPU), and the
+/// bytes held per sample when sensor effects make the run be held in memory
+/// (perfect and shifted increments, errors, in-motion noise, records).
+inline constexpr double kRawlogBytesPerSample = 67.0;
+inline constexpr double kCpuSecondsPerSample = 5.0e-6;
+inline constexpr double kEffectsBytesPerSample = 350.0;
+
+/// Size of an emulated run, known before it runs (emulationBudget).
+struct EmulationBudget {
+  double duration_s = 0.0;      ///< span of the trajectory used [s]
+  double imu_samples = 0.0;     ///< IMU samples (duration x imu.rate_hz)
+  double rawlog_bytes = 0.0;    ///< expected rawlog size (gzip level 1) [bytes]
+  double work_s = 0.0;          ///< expected CPU time on one core [s]
+  double memory_bytes = 0.0;    ///< memory that grows with the run (0 when it streams) [bytes]
+};
+
+/**
+ * The size of the run of @p cfg over a trajectory of @p duration_s seconds, and
+ * a check against the documented budget (kSampleBudget IMU samples; with sensor
+ * effects, which are applied to the whole run in memory, also
+ * limits::kDefaultMemoryBudgetBytes).
+ * @throws navimpact::Error (keyError naming imu.rate_hz) above the budget
+ *         unless cfg.allow_large.
+ */
+EmulationBudget emulationBudget(const EmulationConfig& cfg, double duration_s);
+
+/**
+ * Receives an emulated run in time order (runEmulation with a sink): begin()
+ * once with the recording's header (origin, time base, IMU rate, metadata,
+ * notices, lever arm; no records), then append() with consecutive blocks: each
+ * stream's records continue those of the earlier blocks, and every record of
+ * time <= complete_until_s has been given (infinity with the last block).
+ */
+class RecordingSink {
+ public:
+  virtual ~RecordingSink() = default;
+  virtual void begin(const Recording& header) = 0;
+  virtual void append(const Recording& block, double complete_until_s) = 0;
 };
 
 /**
@@ -93,5 +141,13 @@ EmulationConfig loadEmulationConfig(const std::string& path);
  * @throws navimpact::Error for any bad input (trajectory, model, recording).
  */
 Recording runEmulation(const EmulationConfig& cfg, const std::string& version);
+
+/**
+ * Run a scenario block by block into @p sink (the records of runEmulation(cfg,
+ * version), bit for bit): memory is bounded by a block (2^16 IMU samples) and
+ * the trajectory, whatever the duration; a run with sensor effects is made
+ * whole first (see emulationBudget). Checks emulationBudget before the run.
+ */
+void runEmulation(const EmulationConfig& cfg, const std::string& version, RecordingSink& sink);
 
 }  // namespace navimpact::emulation

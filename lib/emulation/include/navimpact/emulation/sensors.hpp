@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@
 #include "navimpact/core/recording.hpp"
 #include "navimpact/emulation/trajectory.hpp"
 #include "navimpact/stochastic/model_file.hpp"
+#include "navimpact/stochastic/simulate.hpp"
 
 namespace navimpact::emulation {
 
@@ -77,6 +79,44 @@ ImuErrors staticImuErrors(const StaticRecordingSpec& spec, double imu_rate_hz, s
 ImuErrors staticImuErrors(const ImuSeries& rec, const StaticRecordingSpec& spec, double imu_rate_hz,
                           std::size_t n);
 
+/**
+ * The IMU errors of modelImuErrors / staticImuErrors in consecutive blocks, for a
+ * run too long to hold them (the blocks joined are those sequences bit for bit):
+ * a model's axes are stochastic::ModelStream's; a static recording's window mean
+ * is computed first (one pass), its block means then come block by block.
+ */
+class ImuErrorStream {
+ public:
+  /// As modelImuErrors (the model converted to the IMU rate, notice in notices()).
+  static ImuErrorStream fromModel(const stochastic::ImuModel& model, double imu_rate_hz, std::size_t n,
+                                  std::uint64_t seed);
+  /// As staticImuErrors; keeps @p rec (shared) until the end. @throws as staticImuErrors.
+  static ImuErrorStream fromStatic(std::shared_ptr<const ImuSeries> rec, const StaticRecordingSpec& spec,
+                                   double imu_rate_hz, std::size_t n);
+  /// No error (a perfect IMU).
+  static ImuErrorStream none(std::size_t n);
+
+  const std::vector<std::string>& notices() const { return notices_; }
+  const std::string& description() const { return description_; }
+  std::size_t size() const { return n_; }   ///< samples in all
+  std::size_t done() const { return k_; }   ///< samples given so far
+
+  /// The next @p count samples (at most size() - done()) of every axis, into out[a] (resized to count).
+  void next(std::size_t count, std::array<std::vector<double>, 6>& out);
+
+ private:
+  ImuErrorStream() = default;
+  std::size_t n_ = 0, k_ = 0;
+  std::vector<std::string> notices_;
+  std::string description_;
+  int kind_ = 0;  // 0 none, 1 model, 2 static
+  std::vector<std::optional<stochastic::ModelStream>> model_;  // per axis (empty: no error)
+  std::shared_ptr<const ImuSeries> rec_;
+  std::size_t start_ = 0, m_ = 1;
+  std::array<bool, 6> has_{};
+  std::array<double, 6> mean_{};
+};
+
 /// GNSS receiver options (defaults: Khaghani & Skaloud 2019 Table 2).
 struct GnssOptions {
   double rate_hz = 1.0;             ///< fix rate [Hz]
@@ -102,6 +142,42 @@ struct BaroOptions {
   /// Read rate_hz (aiding rate), sigma_m (altitude sigma) and, when @p with_seed,
   /// seed of a `baro:` map; keys in @p extra_keys are accepted and left to the caller.
   void loadFrom(const ConfigNode& n, bool with_seed = true, const std::vector<std::string>& extra_keys = {});
+};
+
+/**
+ * The fixes of simulateGnss (or samples of simulateBaro) in consecutive blocks
+ * (the blocks joined are its result bit for bit): next() gives the records of
+ * time <= t_until that are not given yet.
+ */
+class GnssSimulator {
+ public:
+  GnssSimulator(const SmoothTrajectory& tr, const GnssOptions& opt, double t_start, double t_end);
+  std::size_t size() const { return n_; }  ///< fixes in all
+  /// Append the fixes of time <= @p t_until not given yet (all the rest for t_until = infinity) to @p out.
+  void next(double t_until, std::vector<GnssFix>& out);
+
+ private:
+  const SmoothTrajectory& tr_;
+  GnssOptions opt_;
+  double t_start_;
+  std::size_t n_ = 0, k_ = 0;
+  stochastic::ModelStream z_;
+};
+
+/// The samples of simulateBaro in blocks (as GnssSimulator).
+class BaroSimulator {
+ public:
+  BaroSimulator(const SmoothTrajectory& tr, const BaroOptions& opt, double t_start, double t_end);
+  std::size_t size() const { return n_; }  ///< samples in all
+  /// Append the samples of time <= @p t_until not given yet to @p out.
+  void next(double t_until, std::vector<BaroSample>& out);
+
+ private:
+  const SmoothTrajectory& tr_;
+  BaroOptions opt_;
+  double t_start_;
+  std::size_t n_ = 0, k_ = 0;
+  stochastic::ModelStream z_;
 };
 
 /**

@@ -35,6 +35,7 @@
  */
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "navimpact/core/recording.hpp"
@@ -58,6 +59,38 @@ struct RawlogReadOptions {
  * @throws navimpact::Error naming the file when it cannot be written.
  */
 void writeRawlog(const std::string& path, const Recording& data, const RawlogWriteOptions& opt = {});
+
+/**
+ * A rawlog written in blocks, for a run too long to hold (navimpact emulate):
+ * the same file as writeRawlog() of all the blocks joined, with memory bounded
+ * by one block. The constructor writes the comment (the header's metadata, time
+ * base and lever arm; its records are ignored); append() merges a block's
+ * records into the time order above and writes every entry that no later
+ * record can precede; close() writes the rest.
+ */
+class RawlogWriter {
+ public:
+  /// @throws navimpact::Error naming @p path when it cannot be written.
+  RawlogWriter(const std::string& path, const Recording& header, const RawlogWriteOptions& opt = {});
+  ~RawlogWriter();  ///< without close(): the file is incomplete (stage it; OutputSet removes it)
+  RawlogWriter(const RawlogWriter&) = delete;
+  RawlogWriter& operator=(const RawlogWriter&) = delete;
+
+  /**
+   * Append @p block: each stream's records in time order and after that stream's
+   * records of earlier blocks; every record of time <= @p complete_until_s (s, the
+   * records' axis) has been given by now (later blocks hold only later times;
+   * infinity: nothing follows).
+   */
+  void append(const Recording& block, double complete_until_s);
+
+  /// Write what is pending and close the file. @throws navimpact::Error naming it.
+  void close();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /**
  * Read a rawlog. A rawlog navimpact wrote (its first entry is the comment

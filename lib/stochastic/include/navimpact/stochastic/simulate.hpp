@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "navimpact/stochastic/process.hpp"
@@ -29,6 +30,29 @@ std::vector<double> simulate(const Model& m, std::size_t n, std::uint64_t seed);
 
 /// Simulate into an existing buffer (added to its content: out[k] += model_k).
 void simulateAdd(const Model& m, std::uint64_t seed, double* out, std::size_t n);
+
+/**
+ * The samples of simulate(m, N, seed) in consecutive blocks, for a record too
+ * long to hold: addNext(out, n) adds the next n samples to out[0..n). The
+ * blocks joined are simulate(m, N, seed) bit for bit, whatever their sizes
+ * (each term keeps its own stream and state between blocks); memory does not
+ * grow with N.
+ */
+class ModelStream {
+ public:
+  /// @throws navimpact::Error for an invalid model (as simulate).
+  ModelStream(const Model& m, std::uint64_t seed);
+  ~ModelStream();
+  ModelStream(ModelStream&&) noexcept;
+  ModelStream& operator=(ModelStream&&) noexcept;
+
+  /// Add the next @p n samples to @p out.
+  void addNext(double* out, std::size_t n);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// Deterministic sub-seed (SplitMix64 of seed and index): independent streams
 /// per run/channel that do not depend on execution order.
