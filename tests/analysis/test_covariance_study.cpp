@@ -171,3 +171,54 @@ TEST(CovarianceStudy, WorkAboveTheBudgetIsRefusedBeforeTheRun) {
                                               "filter: {propagate_every: 1000}", true);
   EXPECT_NE(r.find(": key 'output_rate_hz': the results need about 4.84e+05 MB, above the budget of 2e+03 MB"), std::string::npos) << r;
 }
+
+// Sigmas beyond the filter's small-error range are flagged: a white-noise gyro model's
+// attitude sigma grows as N sqrt(t) (closed form, checked above), so the run must be
+// flagged exactly when N sqrt(T) exceeds the limit, from t* = (limit / N)^2 on (within
+// the output step), and not flagged otherwise. Noise densities drawn log-uniform so
+// that N sqrt(T) / limit lies in [0.2, 5] (seed printed); the yaw/roll closed form is
+// the same on every attitude axis at rest, so the first column to cross is any of them.
+TEST(CovarianceStudy, SigmasBeyondTheSmallErrorRangeAreFlagged) {
+  const std::uint64_t seed = 20261125;
+  std::printf("seed %llu, limit %g rad\n", static_cast<unsigned long long>(seed),
+              analysis::kSmallErrorAttitudeSigmaRad);
+  std::mt19937_64 rng(seed);
+  const double T = 60.0, rate = 200.0, dt = 1.0 / rate;
+  int flagged = 0, clear = 0;
+  for (int trial = 0; trial < 8; ++trial) {
+    const double ratio = std::exp(std::log(0.2) + (std::log(5.0) - std::log(0.2)) * double(rng() >> 11) * 0x1.0p-53);
+    const double N = ratio * analysis::kSmallErrorAttitudeSigmaRad / std::sqrt(T);  // [rad/sqrt(s)]
+    const double sigma_wn = N / std::sqrt(dt);                                        // per sample at 200 Hz
+    const std::string models = (test::tempDir() / "wide_gyro.yaml").string();
+    std::ofstream(models) << std::setprecision(17) << "rate_hz: 200\nmodels:\n  wide:\n    gyroscope: \"WN(sigma="
+                          << sigma_wn << ")\"\n    accelerometer: none\n";
+    const std::string path = (test::tempDir() / "cov_wide.yaml").string();
+    std::ofstream(path) << "model_file: " << models << "\nduration_s: " << T
+                        << "\nimu_rate_hz: 200\noutput_rate_hz: 10\nsummary_times_s: [1]\n"
+                           "static_state: {lat_deg: 46.52, lon_deg: 6.57, h_m: 400, yaw_deg: 20}\n"
+                           "baro: {rate_hz: 0, sigma_m: 1}\n"
+                           "model_sets:\n  - {name: gyroscope, models: [wide]}\n";
+    const analysis::CovarianceStudyResult r =
+        analysis::runCovarianceStudy(analysis::loadCovarianceStudyConfig(path));
+    ASSERT_EQ(r.runs.size(), 1u);
+    const analysis::CovarianceRun& run = r.runs[0];
+    const double tStar = std::pow(analysis::kSmallErrorAttitudeSigmaRad / N, 2.0);
+    std::printf("trial %d: N sqrt(T) / limit = %.3f, t* = %.2f s, flagged at %g s (%s)\n", trial, ratio, tStar,
+                run.small_error_exceeded_s, run.small_error_column < 0 ? "-" : run.small_error_column == 6 ? "roll"
+                                                                         : run.small_error_column == 7 ? "pitch" : "yaw");
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    if (std::abs(ratio - 1.0) < 0.03) continue;  // at the limit the 2 % closed-form agreement decides nothing
+    if (ratio > 1.0) {
+      ++flagged;
+      ASSERT_GE(run.small_error_column, 6);
+      EXPECT_NEAR(run.small_error_exceeded_s, tStar, 0.03 * tStar + 0.1);  // output every 0.1 s
+      EXPECT_GT(run.max_attitude_sigma_rad, analysis::kSmallErrorAttitudeSigmaRad);
+    } else {
+      ++clear;
+      EXPECT_LT(run.small_error_column, 0);
+      EXPECT_TRUE(std::isnan(run.small_error_exceeded_s));
+      EXPECT_LE(run.max_attitude_sigma_rad, analysis::kSmallErrorAttitudeSigmaRad);
+    }
+  }
+  std::printf("%d flagged, %d within the range\n", flagged, clear);
+}

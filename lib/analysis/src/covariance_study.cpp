@@ -173,6 +173,21 @@ Eigen::Vector3d eulerSigmas(const Matrix3d& P_psi, const ins::NavState& x) {
 
 void checkBudget(const CovarianceStudyConfig& cfg, long n);
 
+void assessSmallError(CovarianceRun& run) {
+  run.small_error_exceeded_s = std::numeric_limits<double>::quiet_NaN();
+  run.small_error_column = -1;
+  run.max_attitude_sigma_rad = 0.0;
+  for (std::size_t i = 0; i < run.sigma.size(); ++i)
+    for (int c = 6; c < 9; ++c) {
+      const double v = run.sigma[i][c];
+      run.max_attitude_sigma_rad = std::max(run.max_attitude_sigma_rad, v);
+      if (run.small_error_column < 0 && !(v <= kSmallErrorAttitudeSigmaRad)) {
+        run.small_error_exceeded_s = run.t[i];
+        run.small_error_column = c;
+      }
+    }
+}
+
 namespace {
 /// Nominal state and rates at sample k (k = 0 .. n) of the horizon.
 using NominalFn = std::function<void(long k, ins::NavState& x, Vector3d& w_B, Vector3d& f_B)>;
@@ -236,6 +251,7 @@ CovarianceStudyResult runAlong(const CovarianceStudyConfig& cfg, long n, const N
       run.pd_repairs = ekf.pdRepairs();
       run.pd_worst_eigenvalue = ekf.pdWorstRepaired();
       run.pd_first_repair_s = ekf.pdFirstRepairTime() - x0.t;
+      assessSmallError(run);
       res.runs.push_back(std::move(run));
       if (progress) progress(++done, total);
     }

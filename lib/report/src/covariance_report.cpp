@@ -52,6 +52,11 @@ void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStud
     j["config_file"] = cfg.source;
     j["config"] = nlohmann::json::parse(cfg.echo);
     j["units"] = "SI: m, m/s, rad (roll, pitch, yaw sigmas from the N, E, D attitude-error covariance)";
+    j["small_error_limit"] = {
+        {"attitude_sigma_rad", kSmallErrorAttitudeSigmaRad},
+        {"reason", "the filter's attitude error model is first order in psi: at 3 sigma of this limit (0.15 rad) the "
+                   "neglected second-order part (|psi|/2 of the first-order one) is 7.5 %; beyond it the sigmas are "
+                   "the propagated covariance of a linearisation that no longer holds, not an error bound"}};
     j["runs"] = nlohmann::json::array();
     for (const CovarianceRun& r : res.runs) {
       nlohmann::json jr;
@@ -66,6 +71,13 @@ void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStud
         jr["covariance_first_repair_s"] = r.pd_first_repair_s;
       }
       if (!r.notes.empty()) jr["notes"] = r.notes;  // how the model entered the filter (filter::layoutFor)
+      // the small-error range of the linearisation (analysis::kSmallErrorAttitudeSigmaRad)
+      jr["max_attitude_sigma_rad"] = r.max_attitude_sigma_rad;
+      jr["within_small_error_range"] = r.small_error_column < 0;
+      if (r.small_error_column >= 0) {
+        jr["small_error_exceeded_s"] = r.small_error_exceeded_s;
+        jr["small_error_exceeded_by"] = kCols[r.small_error_column];
+      }
       jr["at"] = nlohmann::json::array();
       for (double ts : cfg.summary_times_s) {
         const std::size_t i = nearest(r.t, ts);
@@ -120,7 +132,7 @@ void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStud
 
 std::string covarianceSummary(const CovarianceStudyResult& res) {
   std::string out;
-  char b[256];
+  char b[512];
   std::snprintf(b, sizeof b, "%-14s %-12s %9s %9s %9s %10s %9s\n", "set", "model", "t [s]", "pos N [m]",
                 "vel N[m/s]", "roll [deg]", "yaw [deg]");
   out += b;
@@ -131,6 +143,17 @@ std::string covarianceSummary(const CovarianceStudyResult& res) {
     out += b;
     for (const auto& n : r.notes) out += "  note (" + r.model_set + " / " + r.model + "): " + n + "\n";
   }
+  for (const auto& r : res.runs)
+    if (r.small_error_column >= 0) {
+      std::snprintf(b, sizeof b,
+                    "warning: %s / %s: %s sigma above the filter's small-error range (%.3g deg) from t = %.1f s on "
+                    "(largest attitude sigma %.3g deg): from there on the sigmas are not an error bound\n",
+                    r.model_set.c_str(), r.model.c_str(),
+                    r.small_error_column == 6 ? "roll" : r.small_error_column == 7 ? "pitch" : "yaw",
+                    kSmallErrorAttitudeSigmaRad / units::kDeg, r.small_error_exceeded_s,
+                    r.max_attitude_sigma_rad / units::kDeg);
+      out += b;
+    }
   for (const auto& r : res.runs)
     if (r.pd_repairs > 0) {
       std::snprintf(b, sizeof b,
