@@ -80,7 +80,8 @@ ConfigNode loadYaml(const std::string& file) {
 void splitSpec(const std::string& spec, std::string& file, std::string& name) {
   file = spec;
   name.clear();
-  if (std::filesystem::is_regular_file(spec)) return;
+  std::error_code ec;  // (the throwing form fails on a name longer than the system allows)
+  if (std::filesystem::is_regular_file(spec, ec)) return;
   const auto c = spec.rfind(':');
   if (c != std::string::npos && c > 0) {
     file = spec.substr(0, c);
