@@ -6,7 +6,6 @@
 
 #include "cli_common.hpp"
 #include "navimpact/analysis/covariance_study.hpp"
-#include "navimpact/filter/model_entry.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/report/covariance_report.hpp"
@@ -45,16 +44,8 @@ navimpact::cli::Registrar reg({
         navimpact::OutputSet out(o->out, navimpact::cli::overwriteMode(o->overwrite));
         an::CovarianceStudyConfig cfg = an::loadCovarianceStudyConfig(o->config);
         cfg.allow_large = o->allow_large;
-        if (o->print_states) {
-          for (const auto& set : cfg.model_sets)
-            for (const auto& m : set.models) {
-              const auto entry = navimpact::filter::layoutFor(
-                  navimpact::stochastic::loadImuModel(cfg.model_file + ":" + m), cfg.filter, cfg.imu_rate_hz);
-              std::printf("# %s / %s: %d states\n", set.name.c_str(), m.c_str(), entry.layout.size());
-              for (const auto& n : entry.notes) std::printf("# note: %s\n", n.c_str());
-              std::fputs(entry.layout.describe().c_str(), stdout);
-            }
-        }
+        if (o->print_states)
+          std::fputs(navimpact::report::covarianceStateLayouts(an::covarianceModels(cfg)).c_str(), stdout);
         int total = 0;
         for (const auto& s : cfg.model_sets) total += static_cast<int>(s.models.size());
         navimpact::cli::Progress bar("covariance", static_cast<std::size_t>(total));

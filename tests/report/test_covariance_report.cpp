@@ -4,11 +4,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <random>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "navimpact/filter/ekf.hpp"
 #include "navimpact/report/covariance_report.hpp"
+#include "navimpact/stochastic/model_file.hpp"
 #include "test_support.hpp"
 
 using namespace navimpact;
@@ -103,4 +107,43 @@ TEST(CovarianceReport, TheSummaryListsHowEachModelEnteredTheFilter) {
   const std::string s = report::covarianceSummary(r);
   EXPECT_NE(s.find("note (gyro / short_gm): " + r.runs[0].notes.front()), std::string::npos) << s;
   EXPECT_EQ(s.find("note (gyro / plain)"), std::string::npos) << s;
+}
+
+// --print-states lists what the filter builds: per model, the state count and
+// layout of the ErrorStateEkf its run uses, with the notes, at a propagation
+// interval drawn at random (seeded, printed): a GM too fast for it enters as
+// white noise and is not listed as a state.
+TEST(CovarianceReport, PrintStatesListTheLayoutTheFilterBuilds) {
+  const std::uint64_t seed = 20261125;
+  std::mt19937_64 g(seed);
+  analysis::CovarianceStudyConfig cfg =
+      analysis::loadCovarianceStudyConfig(test::sourcePath("config/paper/covariance_static.yaml"));
+  for (int trial = 0; trial < 4; ++trial) {
+    cfg.filter.propagate_every = std::uniform_int_distribution<int>(1, 400)(g);
+    std::cout << "seed " << seed << " trial " << trial << ": propagate_every " << cfg.filter.propagate_every << "\n";
+    const auto models = analysis::covarianceModels(cfg);
+    std::size_t expected = 0;
+    for (const auto& s : cfg.model_sets) expected += s.models.size();
+    ASSERT_EQ(models.size(), expected);
+    const std::string text = report::covarianceStateLayouts(models);
+    std::size_t at = 0;
+    for (const auto& m : models) {
+      const filter::ErrorStateEkf ekf(cfg.nominal, filter::Matrix9d::Identity(),
+                                      stochastic::loadImuModel(cfg.model_file + ":" + m.model), cfg.filter);
+      EXPECT_EQ(m.entry.layout.size(), ekf.size()) << m.model;
+      const std::string head = "# " + m.model_set + " / " + m.model + ": " + std::to_string(ekf.size()) + " states\n";
+      const std::size_t h = text.find(head, at);
+      ASSERT_NE(h, std::string::npos) << head << text;
+      at = h + head.size();
+      for (const auto& n : m.entry.notes) {
+        const std::string line = "# note: " + n + "\n";
+        ASSERT_EQ(text.compare(at, line.size(), line), 0) << text.substr(at, 200);
+        at += line.size();
+      }
+      const std::string layout = m.entry.layout.describe();
+      ASSERT_EQ(text.compare(at, layout.size(), layout), 0) << m.model;
+      at += layout.size();
+    }
+    EXPECT_EQ(at, text.size());
+  }
 }

@@ -210,69 +210,74 @@ CovarianceStudyResult runAlong(const CovarianceStudyConfig& cfg, long n, const N
   Vector3d w_B, f_B;
   nominal(0, x0, w_B, f_B);
 
-  for (const ModelSet& set : cfg.model_sets) {
-    for (const std::string& name : set.models) {
-      const filter::ModelEntry entry =
-          filter::layoutFor(stochastic::loadImuModel(cfg.model_file + ":" + name), cfg.filter, cfg.imu_rate_hz);
-      const stochastic::ImuModel& model = entry.model;
-      filter::ErrorStateEkf ekf(x0, P0, model, cfg.filter);
-      CovarianceRun run;
-      run.model_set = set.name;
-      run.model = name;
-      run.model_text = modelText(model);
-      run.states = ekf.size();
-      run.notes = entry.notes;
-      const Eigen::MatrixXd Rb = Eigen::MatrixXd::Constant(1, 1, cfg.baro_sigma_m * cfg.baro_sigma_m);
-      const Eigen::VectorXd dz0 = Eigen::VectorXd::Zero(1);
-      ins::NavState xk = x0;
-      auto record = [&](double t) {
-        ekf.flushPropagation();
-        const Eigen::MatrixXd& P = ekf.P();
-        std::array<double, 9> s{};
-        for (int i = 0; i < 6; ++i) s[i] = std::sqrt(std::max(0.0, P(i, i)));
-        const Vector3d e = eulerSigmas(P.block<3, 3>(filter::kAtt, filter::kAtt), xk);
-        s[6] = e.x();
-        s[7] = e.y();
-        s[8] = e.z();
-        run.t.push_back(t);
-        run.sigma.push_back(s);
-      };
-      record(0.0);
-      try {
-        for (long k = 1; k <= n; ++k) {
-          nominal(k, xk, w_B, f_B);
-          ekf.predictCovariance(xk, w_B, f_B, dt);
-          if (every_baro > 0 && k % every_baro == 0) ekf.update(dz0, ekf.H_baro(), Rb, /*feedback=*/false);
-          if (k % every_out == 0) record(k * dt);
-        }
-      } catch (const Error& e) {  // say which model of which set (the filter knows neither)
-        throw Error(cfg.source + ": model set " + set.name + ", model " + name + ": " + e.what());
+  for (const CovarianceModel& cm : covarianceModels(cfg)) {
+    const std::string& name = cm.model;
+    const filter::ModelEntry& entry = cm.entry;
+    const stochastic::ImuModel& model = entry.model;
+    filter::ErrorStateEkf ekf(x0, P0, model, cfg.filter);
+    CovarianceRun run;
+    run.model_set = cm.model_set;
+    run.model = name;
+    run.model_text = modelText(model);
+    run.states = ekf.size();
+    run.notes = entry.notes;
+    const Eigen::MatrixXd Rb = Eigen::MatrixXd::Constant(1, 1, cfg.baro_sigma_m * cfg.baro_sigma_m);
+    const Eigen::VectorXd dz0 = Eigen::VectorXd::Zero(1);
+    ins::NavState xk = x0;
+    auto record = [&](double t) {
+      ekf.flushPropagation();
+      const Eigen::MatrixXd& P = ekf.P();
+      std::array<double, 9> s{};
+      for (int i = 0; i < 6; ++i) s[i] = std::sqrt(std::max(0.0, P(i, i)));
+      const Vector3d e = eulerSigmas(P.block<3, 3>(filter::kAtt, filter::kAtt), xk);
+      s[6] = e.x();
+      s[7] = e.y();
+      s[8] = e.z();
+      run.t.push_back(t);
+      run.sigma.push_back(s);
+    };
+    record(0.0);
+    try {
+      for (long k = 1; k <= n; ++k) {
+        nominal(k, xk, w_B, f_B);
+        ekf.predictCovariance(xk, w_B, f_B, dt);
+        if (every_baro > 0 && k % every_baro == 0) ekf.update(dz0, ekf.H_baro(), Rb, /*feedback=*/false);
+        if (k % every_out == 0) record(k * dt);
       }
-      run.pd_repairs = ekf.pdRepairs();
-      run.pd_worst_eigenvalue = ekf.pdWorstRepaired();
-      run.pd_first_repair_s = ekf.pdFirstRepairTime() - x0.t;
-      assessSmallError(run);
-      res.runs.push_back(std::move(run));
-      if (progress) progress(++done, total);
+    } catch (const Error& e) {  // say which model of which set (the filter knows neither)
+      throw Error(cfg.source + ": model set " + cm.model_set + ", model " + name + ": " + e.what());
     }
+    run.pd_repairs = ekf.pdRepairs();
+    run.pd_worst_eigenvalue = ekf.pdWorstRepaired();
+    run.pd_first_repair_s = ekf.pdFirstRepairTime() - x0.t;
+    assessSmallError(run);
+    res.runs.push_back(std::move(run));
+    if (progress) progress(++done, total);
   }
   return res;
 }
 }  // namespace
 
+std::vector<CovarianceModel> covarianceModels(const CovarianceStudyConfig& cfg) {
+  std::vector<CovarianceModel> out;
+  for (const ModelSet& set : cfg.model_sets)
+    for (const std::string& name : set.models)
+      out.push_back({set.name, name,
+                     filter::layoutFor(stochastic::loadImuModel(cfg.model_file + ":" + name), cfg.filter,
+                                       cfg.imu_rate_hz)});
+  return out;
+}
+
 CovarianceBudget estimateCovarianceBudget(const CovarianceStudyConfig& cfg, long n) {
   CovarianceBudget b;
   const double k = cfg.filter.propagate_every;
   const double rows = std::floor(double(n) * cfg.output_rate_hz / cfg.imu_rate_hz) + 1.0;
-  for (const ModelSet& set : cfg.model_sets)
-    for (const std::string& name : set.models) {
-      const double N =
-          filter::layoutFor(stochastic::loadImuModel(cfg.model_file + ":" + name), cfg.filter, cfg.imu_rate_hz)
-              .layout.size();
-      // per IMU step: the nominal-rate Jacobian and noise (N^2); per propagation: Phi P Phi^T (2 N^3)
-      b.work += double(n) * (N * N + 2.0 * N * N * N / k);
-      b.memory_bytes += rows * (sizeof(double) + 9 * sizeof(double));
-    }
+  for (const CovarianceModel& cm : covarianceModels(cfg)) {
+    const double N = cm.entry.layout.size();
+    // per IMU step: the nominal-rate Jacobian and noise (N^2); per propagation: Phi P Phi^T (2 N^3)
+    b.work += double(n) * (N * N + 2.0 * N * N * N / k);
+    b.memory_bytes += rows * (sizeof(double) + 9 * sizeof(double));
+  }
   return b;
 }
 

@@ -130,6 +130,16 @@ void writeCovarianceStudy(const CovarianceStudyConfig& cfg, const CovarianceStud
   }
 }
 
+std::string covarianceStateLayouts(const std::vector<analysis::CovarianceModel>& models) {
+  std::string out;
+  for (const auto& m : models) {
+    out += "# " + m.model_set + " / " + m.model + ": " + std::to_string(m.entry.layout.size()) + " states\n";
+    for (const auto& n : m.entry.notes) out += "# note: " + n + "\n";
+    out += m.entry.layout.describe();
+  }
+  return out;
+}
+
 std::string covarianceSummary(const CovarianceStudyResult& res) {
   std::string out;
   char b[512];

@@ -32,6 +32,7 @@
 
 #include "navimpact/core/config.hpp"
 #include "navimpact/filter/ekf.hpp"
+#include "navimpact/filter/model_entry.hpp"
 
 namespace navimpact::analysis {
 
@@ -63,6 +64,19 @@ struct CovarianceStudyConfig {
   /// with the ranges of core/limits.hpp; every model named is loaded once to check it.
   void loadFrom(const ConfigNode& root);
 };
+
+/// One model of the study as the filter takes it.
+struct CovarianceModel {
+  std::string model_set;     ///< ModelSet::name
+  std::string model;         ///< its name in model_file
+  filter::ModelEntry entry;  ///< layoutFor(model, filter, imu_rate_hz): the model at the rate, its layout, the notes
+};
+
+/// Every model of @p cfg, set by set, as the filter takes it (filter::layoutFor
+/// with cfg.filter at cfg.imu_rate_hz, so the GMs the filter turns into white
+/// noise at cfg.filter.propagate_every are listed as such): the one place the
+/// study's models enter the filter, for its runs, its budget and --print-states.
+std::vector<CovarianceModel> covarianceModels(const CovarianceStudyConfig& cfg);
 
 /// Work and memory a covariance run needs (checked before it starts).
 struct CovarianceBudget {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "navimpact/analysis/covariance_study.hpp"
 #include "navimpact/core/output.hpp"
@@ -19,6 +20,10 @@ namespace navimpact::report {
  */
 void writeCovarianceStudy(const analysis::CovarianceStudyConfig& cfg,
                           const analysis::CovarianceStudyResult& res, OutputSet& out);
+
+/// `covariance --print-states`: per model "# SET / MODEL: N states", its notes
+/// ("# note: ..."), then the filter's state layout (StateLayout::describe()).
+std::string covarianceStateLayouts(const std::vector<analysis::CovarianceModel>& models);
 
 /// The sigmas at the end of every run, one line per model (human units: deg).
 std::string covarianceSummary(const analysis::CovarianceStudyResult& res);
