@@ -9,11 +9,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <random>
 #include <string>
 
 #include "navimpact/analysis/run_plan.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 #include "test_support.hpp"
 
@@ -127,4 +129,49 @@ TEST(RunPlan, AnEmulatedRunRecordsEveryPlannedEpoch) {
   EXPECT_EQ(r.baro_updates, 0u);
   ASSERT_EQ(r.outages.size(), 1u);
   EXPECT_EQ(r.outages[0].end_epoch, static_cast<int>(p.outage_end_epoch[0]));
+}
+
+// A plan along a trajectory already smoothed (a run diagnosis plans along the
+// replayed run's own), from a later start, without record epochs: t0 is the
+// start, n the whole IMU intervals to the trajectory's end, the perfect IMU
+// that of the span, no epoch but the outage ends, and a start past the end is
+// refused. Start, rate and outage drawn at random (seeded, printed).
+TEST(RunPlan, AlongASmoothedTrajectoryFromALaterStartWithOnlyTheOutageEnds) {
+  const std::uint64_t seed = 20261126;
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const an::RunPlanOptions file = options(60.0);
+  const auto tr = std::make_shared<const navimpact::emulation::SmoothTrajectory>(
+      navimpact::emulation::readTrajectoryCsv(file.trajectory), file.smoothing);
+  for (int trial = 0; trial < 3; ++trial) {
+    an::RunPlanOptions o;
+    o.smoothed = tr;
+    o.start_s = tr->tBegin() + 20.0 * U(g);
+    o.imu_rate_hz = 50.0 + 200.0 * U(g);
+    o.record_rate_hz = 0.0;
+    o.outage_record_rate_hz = 0.0;
+    o.outages = {Outage::fromStartDuration(5.0 + 10.0 * U(g), 1.0 + 10.0 * U(g))};
+    std::printf("seed %llu trial %d: start %.3f s, IMU %.3f Hz, outage %s\n", static_cast<unsigned long long>(seed),
+                trial, *o.start_s, o.imu_rate_hz, navimpact::outageText(o.outages[0]).c_str());
+    const an::RunPlan p = an::planRuns(o);
+    EXPECT_EQ(p.traj, tr);  // shared, not read again
+    EXPECT_EQ(p.t0, *o.start_s);
+    EXPECT_EQ(p.samples(), an::imuSamples(p.t0, tr->tEnd(), o.imu_rate_hz));
+    EXPECT_EQ(p.samples(), static_cast<std::size_t>(std::floor((tr->tEnd() - p.t0) * o.imu_rate_hz + 1e-9)));
+    const auto perfect = navimpact::emulation::perfectImu(*tr, o.imu_rate_hz, p.t0, p.t1);
+    ASSERT_EQ(perfect.size(), p.perfect.size());
+    for (std::size_t k = 0; k < perfect.size(); k += 97) {
+      EXPECT_EQ(perfect[k].t, p.perfect[k].t);
+      EXPECT_EQ(perfect[k].dv_B, p.perfect[k].dv_B);
+    }
+    ASSERT_EQ(p.truth.t.size(), 1u);
+    ASSERT_EQ(p.outage_end_epoch, std::vector<std::size_t>{0});
+    EXPECT_NEAR(p.truth.t[0], p.t0 + o.outages[0].end_s, 0.5 / o.imu_rate_hz + 1e-9);
+  }
+  an::RunPlanOptions late;
+  late.smoothed = tr;
+  late.imu_rate_hz = 100.0;
+  late.start_s = tr->tEnd() + 1.0;
+  EXPECT_EQ(an::imuSamples(*late.start_s, tr->tEnd(), 100.0), 0u);
+  EXPECT_THROW(an::planRuns(late), navimpact::Error);
 }

@@ -15,6 +15,7 @@
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/limits.hpp"
 #include "navimpact/core/parallel.hpp"
+#include "navimpact/analysis/run_plan.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/emulation/sensor_effects.hpp"
 #include "navimpact/emulation/sensors.hpp"
@@ -927,15 +928,27 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   }
   const stochastic::ImuModel model = stochastic::loadImuModel(opt.replay.model_spec);
 
-  // 2. The trajectory and the emulation span.
+  // 2. The trajectory and the emulation span: the run plan (run_plan.hpp) along the
+  // run's own trajectory from the start of GNSS aiding, with the filter's initial
+  // sigmas. It holds no outages and no record epochs: the outages differ per
+  // duration and are the measured ones (below), and the GNSS and barometer of
+  // each realisation are the run's own (section 3), with the filter options of
+  // the measured replay.
   progress(0.10, "trajectory");
-  const emulation::SmoothTrajectory tr = buildTrajectory(r0, opt, data, out.trajectory_source);
-  const double rate = r0.imu_rate_hz;
-  const double t0 = std::max(tr.tBegin(), r0.t_zero + r0.aided_from_s);
-  const auto n = static_cast<std::size_t>(std::floor((tr.tEnd() - t0) * rate + 1e-9));
-  if (n < 16) throw Error(opt.replay.rawlog + ": the emulated span is too short");
-  const double t1 = t0 + double(n) / rate;
-  const std::vector<ins::ImuSample> perfect = emulation::perfectImu(tr, rate, t0, t1);
+  RunPlanOptions po;
+  po.smoothed =
+      std::make_shared<const emulation::SmoothTrajectory>(buildTrajectory(r0, opt, data, out.trajectory_source));
+  po.start_s = r0.t_zero + r0.aided_from_s;
+  po.imu_rate_hz = r0.imu_rate_hz;
+  po.record_rate_hz = 0.0;
+  po.outage_record_rate_hz = 0.0;
+  po.initial_sigma = r0.nav.P0_nav.diagonal().cwiseSqrt();
+  if (imuSamples(runStart(*po.smoothed, po.start_s), po.smoothed->tEnd(), po.imu_rate_hz) < 16)
+    throw Error(opt.replay.rawlog + ": the emulated span is too short");
+  const RunPlan plan = planRuns(po);
+  const emulation::SmoothTrajectory& tr = *plan.traj;
+  const double rate = plan.rate_hz, t0 = plan.t0, t1 = plan.t1;
+  const std::size_t n = plan.samples();
 
   // Outages of each duration in the emulation: the measured ones inside the span,
   // ends at the measured end epochs snapped to the IMU grid.
@@ -969,8 +982,6 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
                   " s falls inside the emulated span");
     navs[i] = nav;
   }
-  const ins::NavState truth0 = emulation::truthNavState(tr, t0);
-  filter::Vector9d sigma0 = r0.nav.P0_nav.diagonal().cwiseSqrt();
 
   // Static recording (optional), loaded once.
   std::optional<ImuSeries> rec;
@@ -1000,8 +1011,7 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
     } else {
       err = emulation::modelImuErrors(model, rate, n, stochastic::deriveSeed(seed, 0)).axis;
     }
-    EmulatedRun run = emulateRun(perfect, err, tr, t0, t1, emulation::GnssOptions{}, emulation::BaroOptions{},
-                                 truth0, sigma0, seed);
+    EmulatedRun run = plan.emulate(err, seed);
     // GNSS and baro at the run's own epochs with its own sigmas.
     run.gnss.clear();
     run.baro.clear();

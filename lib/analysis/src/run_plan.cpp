@@ -11,6 +11,15 @@
 
 namespace navimpact::analysis {
 
+double runStart(const emulation::SmoothTrajectory& tr, std::optional<double> start_s) {
+  return start_s ? std::max(tr.tBegin(), *start_s) : tr.tBegin();
+}
+
+std::size_t imuSamples(double t0, double t_end, double rate_hz) {
+  const double k = std::floor((t_end - t0) * rate_hz + 1e-9);
+  return k > 0.0 ? static_cast<std::size_t>(k) : 0;
+}
+
 RunPlan planRuns(const RunPlanOptions& opt) {
   const double rate = opt.imu_rate_hz;
   if (!(rate > 0.0) || !std::isfinite(rate))
@@ -19,17 +28,23 @@ RunPlan planRuns(const RunPlanOptions& opt) {
   plan.opt = opt;
   plan.rate_hz = rate;
 
-  // Trajectory and its smooth truth; n whole IMU intervals from its first time.
-  plan.traj.emplace(emulation::readTrajectoryCsv(opt.trajectory), opt.smoothing);
+  // Trajectory and its smooth truth; n whole IMU intervals from the start.
+  plan.traj = opt.smoothed ? opt.smoothed
+                           : std::make_shared<const emulation::SmoothTrajectory>(
+                                 emulation::readTrajectoryCsv(opt.trajectory), opt.smoothing);
   const emulation::SmoothTrajectory& tr = *plan.traj;
-  plan.t0 = tr.tBegin();
-  const std::size_t n = static_cast<std::size_t>(std::floor((tr.tEnd() - tr.tBegin()) * rate + 1e-9));
+  plan.t0 = runStart(tr, opt.start_s);
+  if (plan.t0 > tr.tEnd())
+    throw Error("run plan: the run starts at " + formatNumber(plan.t0) + " s, after the end of the trajectory (" +
+                formatNumber(tr.tEnd()) + " s)");
+  const std::size_t n = imuSamples(plan.t0, tr.tEnd(), rate);
   plan.t1 = plan.t0 + double(n) / rate;
   const double duration = plan.duration_s();
 
   // Outages inside the run.
   checkOutages(opt.outages, duration,
-               "the end of the trajectory " + opt.trajectory.file + " (" + formatNumber(duration) + " s)",
+               "the end of the trajectory " + (opt.smoothed ? std::string() : opt.trajectory.file + " ") + "(" +
+                   formatNumber(duration) + " s)",
                opt.outage_name);
 
   // Perfect IMU.
@@ -40,13 +55,17 @@ RunPlan planRuns(const RunPlanOptions& opt) {
 
   // Record epochs (IMU sample indices): record rate over the run, outage rate inside outages.
   std::vector<std::size_t> ks, ends;
-  const auto step_out = std::max<std::size_t>(1, std::size_t(std::llround(rate / opt.record_rate_hz)));
-  const auto step_in = std::max<std::size_t>(1, std::size_t(std::llround(rate / opt.outage_record_rate_hz)));
-  for (std::size_t k = 0; k <= n; k += step_out) ks.push_back(k);
+  auto stepOf = [rate](double record_hz) {  // 0: no epochs at that rate
+    return record_hz > 0.0 ? std::max<std::size_t>(1, std::size_t(std::llround(rate / record_hz))) : 0;
+  };
+  const std::size_t step_out = stepOf(opt.record_rate_hz), step_in = stepOf(opt.outage_record_rate_hz);
+  if (step_out > 0)
+    for (std::size_t k = 0; k <= n; k += step_out) ks.push_back(k);
   for (const auto& o : opt.outages) {
     const auto ka = std::size_t(std::llround(o.start_s * rate));
     const auto ke = std::min(n, std::size_t(std::llround(o.end_s * rate)));
-    for (std::size_t k = ka; k < ke; k += step_in) ks.push_back(k);
+    if (step_in > 0)
+      for (std::size_t k = ka; k < ke; k += step_in) ks.push_back(k);
     ks.push_back(ke);
     ends.push_back(ke);
   }
