@@ -433,21 +433,45 @@ StudyResults runStudy(const std::shared_ptr<const StudyPlan>& plan, const Shard&
 // ---------------------------------------------------------------------------
 // Shards
 
-namespace {
-constexpr char kMagic[8] = {'N', 'I', 'S', 'T', 'U', 'D', 'Y', '1'};
+namespace detail {
 
 void putU64(std::ostream& o, std::uint64_t v) { o.write(reinterpret_cast<const char*>(&v), 8); }
 void putD(std::ostream& o, const double* v, std::size_t n) {
   o.write(reinterpret_cast<const char*>(v), static_cast<std::streamsize>(8 * n));
 }
-std::uint64_t getU64(std::istream& i, const std::string& f) {
+std::uint64_t getU64(std::istream& i, const std::string& file) {
   std::uint64_t v = 0;
-  if (!i.read(reinterpret_cast<char*>(&v), 8)) throw Error(f + ": truncated");
+  if (!i.read(reinterpret_cast<char*>(&v), 8)) throw Error(file + ": truncated");
   return v;
 }
-void getD(std::istream& i, double* v, std::size_t n, const std::string& f) {
-  if (!i.read(reinterpret_cast<char*>(v), static_cast<std::streamsize>(8 * n))) throw Error(f + ": truncated");
+void getD(std::istream& i, double* v, std::size_t n, const std::string& file) {
+  if (!i.read(reinterpret_cast<char*>(v), static_cast<std::streamsize>(8 * n))) throw Error(file + ": truncated");
 }
+
+json readShardJson(const std::string& dir, const std::string& file, const std::string& marker,
+                   const std::string& writer) {
+  const std::string path = dir + "/" + file;
+  std::ifstream f(path);
+  if (!f) throw Error(path + ": cannot open (is " + dir + " a folder written by navimpact " + writer + "?)");
+  json j;
+  try {
+    f >> j;
+  } catch (const json::exception& e) {
+    throw Error(path + ": not valid JSON (" + printable(e.what(), 120) + ")");
+  }
+  if (!j.is_object() || !j.contains(marker))
+    throw Error(path + ": not a navimpact " + writer.substr(0, writer.find(' ')) + " shard");
+  return j;
+}
+
+}  // namespace detail
+
+namespace {
+constexpr char kMagic[8] = {'N', 'I', 'S', 'T', 'U', 'D', 'Y', '1'};
+using detail::getD;
+using detail::getU64;
+using detail::putD;
+using detail::putU64;
 }  // namespace
 
 void writeShard(const StudyResults& r, OutputSet& out) {
@@ -491,15 +515,7 @@ StudyResults mergeShards(const std::vector<std::string>& dirs) {
   json first_meta;
   for (const auto& d : dirs) {
     const std::string sj = d + "/shard.json";
-    std::ifstream fj(sj);
-    if (!fj) throw Error(sj + ": cannot open (is " + d + " a folder written by navimpact study --shard?)");
-    json j;
-    try {
-      fj >> j;
-    } catch (const json::exception& e) {
-      throw Error(sj + ": not valid JSON (" + e.what() + ")");
-    }
-    if (!j.contains("navimpact_study_shard")) throw Error(sj + ": not a navimpact study shard");
+    const json j = detail::readShardJson(d, "shard.json", "navimpact_study_shard", "study --shard");
     const json meta = j.at("meta");
     if (ins.empty()) {
       first_meta = meta;

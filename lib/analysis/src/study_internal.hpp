@@ -3,6 +3,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
 #include "navimpact/analysis/study.hpp"
 
 namespace navimpact::analysis::detail {
@@ -17,6 +21,20 @@ void headerFromJson(const nlohmann::json& j, StudyHeader& h);
 
 nlohmann::json metaToJson(const StudyMeta& m);
 StudyMeta metaFromJson(const nlohmann::json& j, const std::string& where);
+
+/// Run files of shards (runs.bin, sweep_runs.bin): 64-bit counts and doubles
+/// as the machine holds them; a short read is "FILE: truncated".
+void putU64(std::ostream& o, std::uint64_t v);
+void putD(std::ostream& o, const double* v, std::size_t n);
+std::uint64_t getU64(std::istream& i, const std::string& file);
+void getD(std::istream& i, double* v, std::size_t n, const std::string& file);
+
+/// DIR/FILE of a shard folder, parsed: a JSON object holding the key @p marker.
+/// @param writer  the command that writes it ("study --shard"), named when the file is missing.
+/// @throws navimpact::Error "DIR/FILE: cannot open (is DIR a folder written by navimpact WRITER?)",
+///         "...: not valid JSON (...)" or "...: not a navimpact KIND shard" (KIND: the writer's first word).
+nlohmann::json readShardJson(const std::string& dir, const std::string& file, const std::string& marker,
+                             const std::string& writer);
 
 /// chi2inv(p, dof) (boost::math).
 double chi2Quantile(double p, double dof);

@@ -306,12 +306,8 @@ SweepMeta metaFromJson(const json& j, const std::string& where) {
   }
 }
 
-void putU64(std::ostream& o, std::uint64_t v) { o.write(reinterpret_cast<const char*>(&v), 8); }
-std::uint64_t getU64(std::istream& i, const std::string& f) {
-  std::uint64_t v = 0;
-  if (!i.read(reinterpret_cast<char*>(&v), 8)) throw Error(f + ": truncated");
-  return v;
-}
+using detail::getU64;
+using detail::putU64;
 
 std::string rangesText(const std::vector<std::size_t>& v) {
   std::string s;
@@ -374,15 +370,7 @@ SweepRuns mergeSweepShards(const std::vector<std::string>& dirs, const std::stri
   }
   for (const auto& d : dirs) {
     const std::string sj = d + "/sweep_shard.json";
-    std::ifstream fj(sj);
-    if (!fj) throw Error(sj + ": cannot open (is " + d + " a folder written by navimpact sweep --shard?)");
-    json j;
-    try {
-      fj >> j;
-    } catch (const json::exception& e) {
-      throw Error(sj + ": not valid JSON (" + std::string(e.what()).substr(0, 120) + ")");
-    }
-    if (!j.is_object() || !j.contains("navimpact_sweep_shard")) throw Error(sj + ": not a navimpact sweep shard");
+    const json j = detail::readShardJson(d, "sweep_shard.json", "navimpact_sweep_shard", "sweep --shard");
     In in;
     in.dir = d;
     try {
