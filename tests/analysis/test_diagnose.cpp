@@ -137,6 +137,47 @@ TEST(DiagnoseThreads, ResultDoesNotDependOnTheThreadCount) {
   }
 }
 
+// diagnose-power's records go over the worker pool: every run (cause, SNR,
+// rate, length, verdict and why) and the null alarms are the same on 1 and 3
+// threads. Three causes drawn at random (seeded; printed), short records.
+TEST(DiagnoseThreads, PowerDoesNotDependOnTheThreadCount) {
+  const std::uint64_t s = ns::deriveSeed(rootSeed(), 771000u);
+  std::vector<na::Cause> all = {na::Cause::WhiteNoise, na::Cause::QuantizationNoise, na::Cause::RandomWalk,
+                                na::Cause::Drift,      na::Cause::GaussMarkov,       na::Cause::Sinusoid,
+                                na::Cause::LevelShift, na::Cause::Outliers};
+  std::mt19937_64 g(s);
+  std::shuffle(all.begin(), all.end(), g);
+  pw::PowerOptions o;
+  o.causes.assign(all.begin(), all.begin() + 3);
+  o.runs_per_cause = 1;
+  o.null_runs = 2;
+  o.min_snr = 1.0;
+  o.max_snr = 10.0;
+  o.ranges.min_samples = 1 << 13;
+  o.ranges.max_samples = 1 << 14;
+  o.seed = s;
+  std::cout << "seed " << s << ": causes";
+  for (auto c : o.causes) std::cout << " " << na::causeName(c);
+  std::cout << "\n";
+  o.threads = 1;
+  const pw::PowerResult one = pw::runPower(o);
+  o.threads = 3;
+  const pw::PowerResult three = pw::runPower(o);
+  EXPECT_EQ(three.null_runs, one.null_runs);
+  EXPECT_EQ(three.null_alarms, one.null_alarms);
+  ASSERT_EQ(three.runs.size(), one.runs.size());
+  for (std::size_t i = 0; i < one.runs.size(); ++i) {
+    const pw::PowerRun &a = one.runs[i], &b = three.runs[i];
+    EXPECT_EQ(b.cause, a.cause) << i;
+    EXPECT_EQ(b.snr, a.snr) << i;
+    EXPECT_EQ(b.rate_hz, a.rate_hz) << i;
+    EXPECT_EQ(b.duration_s, a.duration_s) << i;
+    EXPECT_EQ(b.detected, a.detected) << i;
+    EXPECT_EQ(b.right, a.right) << i;
+    EXPECT_EQ(b.why, a.why) << i;
+  }
+}
+
 class HiddenCause : public ::testing::TestWithParam<na::Cause> {};
 
 TEST_P(HiddenCause, FoundAtFiveTimesTheLimitWithTheRightCauseAndParameter) {
