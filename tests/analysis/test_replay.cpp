@@ -31,6 +31,18 @@ navimpact::Recording emulate60(const std::string& errors) {
   return emu::runEmulation(c, "test");
 }
 
+// The 60 s emulated run written twice under @p dir: with its reference (GT) and
+// without it (an aligning phase first); returns {with, without}.
+std::pair<std::string, std::string> writeWithAndWithoutGt(const std::filesystem::path& dir, const std::string& stem) {
+  navimpact::Recording rec = emulate60("model");
+  const auto withGt = (dir / (stem + "gt.rawlog")).string();
+  navimpact::rawlog::writeRawlog(withGt, rec);
+  rec.reference.clear();
+  const auto noGt = (dir / (stem + "nogt.rawlog")).string();
+  navimpact::rawlog::writeRawlog(noGt, rec);
+  return {withGt, noGt};
+}
+
 std::string errorOf(const an::ReplayConfig& c) {
   try {
     an::runReplay(c);
@@ -374,12 +386,7 @@ TEST(Replay, ExtraStatesFromTheConfigurationAreEstimated) {
 // and without a reference (aligning phase), with an explicit outage besides.
 TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) {
   const auto dir = navimpact::test::tempDir();
-  navimpact::Recording rec = emulate60("model");
-  const auto withGt = (dir / "gt.rawlog").string();
-  navimpact::rawlog::writeRawlog(withGt, rec);
-  rec.reference.clear();
-  const auto noGt = (dir / "nogt.rawlog").string();
-  navimpact::rawlog::writeRawlog(noGt, rec);
+  const auto [withGt, noGt] = writeWithAndWithoutGt(dir, "");
   const std::uint64_t seed = std::random_device{}();
   std::mt19937_64 rng(seed);
   for (int draw = 0; draw < 3; ++draw) {
@@ -422,12 +429,7 @@ TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) 
 // patterns and the stop drawn at random (seed printed).
 TEST(Replay, ReplayFromRecordsInMemoryIsTheReplayAndStopsWhereAsked) {
   const auto dir = navimpact::test::tempDir();
-  navimpact::Recording rec = emulate60("model");
-  const auto withGt = (dir / "mem_gt.rawlog").string();
-  navimpact::rawlog::writeRawlog(withGt, rec);
-  rec.reference.clear();
-  const auto noGt = (dir / "mem_nogt.rawlog").string();
-  navimpact::rawlog::writeRawlog(noGt, rec);
+  const auto [withGt, noGt] = writeWithAndWithoutGt(dir, "mem_");
   const std::uint64_t seed = std::random_device{}();
   std::mt19937_64 rng(seed);
   for (int draw = 0; draw < 2; ++draw) {
