@@ -543,11 +543,12 @@ Finding broadbandFinding(const std::string& ch, const Candidate& c, const Model&
   std::ostringstream ex;
   const bool above = ratio >= 1;
   f.direction = (c.retune && c.scale < 1) ? "overstated" : "missing";
+  const double factor = above ? ratio : 1.0 / ratio;
   if (count > 0)
     ex << "the measured WV is "
-       << ((above ? ratio : 1.0 / ratio) < 1.5  // a small excess as a percentage ("1x" says nothing)
+       << (factor < 1.5  // a small excess as a percentage ("1x" says nothing)
                ? formatNumber(100.0 * std::abs(ratio - 1.0), 2) + " % "
-               : formatNumber(above ? ratio : 1.0 / ratio, 2) + "x ")
+               : formatNumber(factor, 2) + "x ")
        << (above ? "above" : "below") << " the model at " << scaleRange(lo, hi) << " ("
        << count << " scale" << (count > 1 ? "s" : "") << " outside the 95 % CI); ";
   switch (c.kind) {
