@@ -79,7 +79,7 @@ struct RawlogReader::Impl {
         head.lever_arm_B = Eigen::Vector3d(l[0].as<double>(), l[1].as<double>(), l[2].as<double>());
       }
     } catch (const YAML::Exception& e) {
-      throw Error(where("SCENARIO", NAN) + ": scenario comment is not valid YAML (" + e.msg + ")");
+      throw Error(where("SCENARIO", NAN) + ": scenario comment is not valid YAML (" + printable(e.msg) + ")");
     }
   }
 
