@@ -72,7 +72,7 @@ ImuModel readModel(const ConfigNode& node, double default_rate) {
 
 ConfigNode loadYaml(const std::string& file) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw Error(file + ": cannot open model file (no such file)");
+  if (!std::filesystem::is_regular_file(file, ec)) throw Error(printable(file, 1024) + ": cannot open model file (no such file)");
   return ConfigNode::load(file);
 }
 
