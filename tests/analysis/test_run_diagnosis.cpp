@@ -14,6 +14,7 @@
 #include "navimpact/core/limits.hpp"
 #include "navimpact/emulation/scenario.hpp"
 #include "navimpact/emulation/sensor_effects.hpp"
+#include "navimpact/rawlog/reader.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/report/run_diagnosis_report.hpp"
 #include "navimpact/stochastic/model_file.hpp"
@@ -27,16 +28,23 @@ namespace {
 
 const std::string kModel = "config/models/navchip_table1.yaml:ref";
 
-/// A 120 s emulated run of the UAV trajectory with the sensor errors of @p model_spec.
-std::string emulateRun(const std::string& name, const std::string& model_spec, std::uint64_t imu_seed) {
+/// The emulation of the first @p end_s of the UAV trajectory with the sensor
+/// errors of @p model_spec, IMU, GNSS and baro seeds from @p imu_seed.
+emu::EmulationConfig uavEmulation(double end_s, const std::string& model_spec, std::uint64_t imu_seed) {
   emu::EmulationConfig c;
   c.trajectory.file = navimpact::test::sourcePath("datasets/uav_flight_260s.csv.gz");
-  c.trajectory.end_s = 240.0;
+  c.trajectory.end_s = end_s;
   c.imu_errors = "model";
   c.model_spec = model_spec;
   c.imu_seed = imu_seed;
   c.gnss.seed = imu_seed + 11;
   c.baro.seed = imu_seed + 12;
+  return c;
+}
+
+/// A 240 s emulated run of the UAV trajectory with the sensor errors of @p model_spec.
+std::string emulateRun(const std::string& name, const std::string& model_spec, std::uint64_t imu_seed) {
+  const emu::EmulationConfig c = uavEmulation(240.0, model_spec, imu_seed);
   const auto path = (navimpact::test::tempDir() / (name + ".rawlog")).string();
   navimpact::rawlog::writeRawlog(path, emu::runEmulation(c, "test"));
   return path;
@@ -44,14 +52,7 @@ std::string emulateRun(const std::string& name, const std::string& model_spec, s
 
 /// The same run with sensor effects applied to its IMU (the model's errors are already in it).
 std::string emulateWithEffects(const std::string& name, std::uint64_t imu_seed, const emu::SensorEffects& fx) {
-  emu::EmulationConfig c;
-  c.trajectory.file = navimpact::test::sourcePath("datasets/uav_flight_260s.csv.gz");
-  c.trajectory.end_s = 240.0;
-  c.imu_errors = "model";
-  c.model_spec = navimpact::test::sourcePath(kModel);
-  c.imu_seed = imu_seed;
-  c.gnss.seed = imu_seed + 11;
-  c.baro.seed = imu_seed + 12;
+  emu::EmulationConfig c = uavEmulation(240.0, navimpact::test::sourcePath(kModel), imu_seed);
   const Eigen::Vector3d told = c.gnss.lever_arm_B;
   c.gnss = emu::gnssWithEffects(c.gnss, fx);  // GNSS of the true antenna; the rawlog states the told one
   navimpact::Recording d = emu::runEmulation(c, "test");
@@ -164,6 +165,98 @@ TEST(RunDiagnosis, BadInputIsAClearError) {
   o = options("", 1);
   o.realisations = 1;
   EXPECT_THROW(an::diagnoseRun(o), navimpact::Error);
+}
+
+// The held-out replays score an extension on the measured run's outage
+// windows, paired by window: an extension whose aligning phase ends later (here
+// larger GNSS sigmas, as the gnss_noise cause fits on the Katwijk run: the
+// heading from a chord course needs a longer chord) would lay its own outages
+// later from its own filter start (replay --outages-every), so pairing by
+// order would compare other outages. Outage
+// period and duration drawn at random (seeded, printed).
+TEST(RunDiagnosis, AnExtensionThatAlignsLaterIsScoredOnTheMeasuredOutageWindows) {
+  const std::uint64_t seed = std::random_device{}();
+  std::mt19937_64 rng(seed);
+  const double duration = std::uniform_real_distribution<double>(2.0, 15.0)(rng);
+  const double reconverge = std::uniform_real_distribution<double>(5.0, 15.0)(rng);
+  std::cout << "seed " << seed << ": outages of " << duration << " s after " << reconverge << " s of GNSS\n";
+  navimpact::Recording d = emu::runEmulation(uavEmulation(120.0, navimpact::test::sourcePath(kModel), seed), "test");
+  for (auto& g : d.reference) g.v_N.reset();  // no velocity: the filter starts after an aligning phase
+  const auto path = (navimpact::test::tempDir() / "aligns_later.rawlog").string();
+  navimpact::rawlog::writeRawlog(path, d);
+  const navimpact::rawlog::RawlogRecords data = navimpact::rawlog::readRawlogRecords(path);
+
+  an::ReplayConfig c;
+  c.rawlog = path;
+  c.model_spec = navimpact::test::sourcePath(kModel);
+  c.outages_every = navimpact::OutagePattern{duration + reconverge, duration};
+  c.use_gnss_velocity = false;              // heading from the course of a chord between fixes
+  c.alignment_yaw_from_reference = false;
+  an::ReplayConfig ext = c;
+  // the gnss_noise extension: larger GNSS sigmas (3 x the fixes'), so a longer chord for the course
+  ext.sigma_pos_h_m = 3.0 * std::sqrt((*d.gnss.front().cov_pos_N)(0, 0));
+  const an::ReplayResult measured = an::runReplay(c, data);
+  ASSERT_TRUE(measured.alignment && measured.score);
+  ASSERT_GE(measured.score->outages.size(), 3u);
+  const an::ReplayResult laid = an::runReplay(ext, data);  // its outages laid from its own start
+  std::cout << "filter start: measured " << measured.aided_from_s << " s (heading " << measured.alignment->heading
+            << "), extension " << laid.aided_from_s << " s (heading " << laid.alignment->heading << ")\n";
+  ASSERT_GT(laid.aided_from_s, measured.aided_from_s + 1e-3);
+  ASSERT_TRUE(laid.score && !laid.score->outages.empty());
+  EXPECT_NE(laid.score->outages.front().start_s, measured.score->outages.front().start_s);
+
+  const an::PairedOutageScores p = an::replayOnMeasuredOutages(ext, measured, data);
+  // GNSS is dropped in the measured windows also while aligning: a window inside
+  // the extension's aligning phase delays it further
+  bool windowWhileAligning = false;
+  for (const auto& o : measured.cfg.outages) windowWhileAligning = windowWhileAligning || o.start_s < laid.aided_from_s;
+  std::cout << "extension's filter start on the measured windows " << p.aided_from_s << " s\n";
+  if (windowWhileAligning) EXPECT_GE(p.aided_from_s, laid.aided_from_s);
+  else EXPECT_EQ(p.aided_from_s, laid.aided_from_s);
+  ASSERT_EQ(p.outages.size(), measured.score->outages.size());
+  ASSERT_EQ(p.ends.size(), measured.score->outages.size());
+  // the same windows scored by the extension in a full replay given them explicitly
+  an::ReplayConfig explicitWindows = ext;
+  explicitWindows.outages = measured.cfg.outages;
+  explicitWindows.outages_every.reset();
+  const an::ReplayResult full = an::runReplay(explicitWindows, data);
+  std::size_t paired = 0;
+  for (std::size_t k = 0; k < p.outages.size(); ++k) {
+    const navimpact::analysis::OutageScore& m = measured.score->outages[k];
+    SCOPED_TRACE("outage " + std::to_string(k) + " at " + std::to_string(m.start_s) + " s");
+    // an outage that starts before the extension's filter is not the same outage: unpaired
+    ASSERT_EQ(p.outages[k].has_value(), m.start_s > p.aided_from_s);
+    if (!p.outages[k]) continue;
+    ++paired;
+    EXPECT_NEAR(p.outages[k]->start_s, m.start_s, 1e-9);
+    EXPECT_NEAR(p.outages[k]->duration_s, m.duration_s, 1e-9);
+    EXPECT_EQ(p.outages[k]->end_s, m.end_s);
+    const navimpact::analysis::OutageScore* o = nullptr;
+    for (const auto& f : full.score->outages)
+      if (std::abs(f.start_s - m.start_s) <= 1e-9) o = &f;
+    ASSERT_NE(o, nullptr);
+    EXPECT_EQ(p.outages[k]->err_N, o->err_N);
+    EXPECT_EQ(p.outages[k]->nees, o->nees);
+    EXPECT_EQ(p.ends[k].first.head<3>(), o->err_N);
+  }
+  EXPECT_GE(paired + 2, measured.score->outages.size());
+  EXPECT_GE(paired, 1u);
+  // today's configuration on its own windows is today's replay, bit for bit
+  const an::PairedOutageScores same = an::replayOnMeasuredOutages(c, measured, data);
+  for (std::size_t k = 0; k < same.outages.size(); ++k) {
+    ASSERT_TRUE(same.outages[k].has_value());
+    EXPECT_EQ(same.outages[k]->err_N, measured.score->outages[k].err_N);
+    EXPECT_EQ(same.outages[k]->sigma_N, measured.score->outages[k].sigma_N);
+    EXPECT_EQ(same.outages[k]->nees, measured.score->outages[k].nees);
+  }
+  // stopped: the windows that end by the stop, as in the full replay
+  const double stop = 0.5 * (p.aided_from_s + measured.run.epochs.back().t - measured.t_zero);
+  const an::PairedOutageScores cut = an::replayOnMeasuredOutages(ext, measured, data, stop);
+  for (std::size_t k = 0; k < cut.outages.size(); ++k) {
+    const auto& m = measured.score->outages[k];
+    ASSERT_EQ(cut.outages[k].has_value(), p.outages[k].has_value() && m.start_s + m.duration_s <= stop);
+    if (cut.outages[k]) EXPECT_EQ(cut.outages[k]->err_N, p.outages[k]->err_N);
+  }
 }
 
 // ---- Hidden effects -------------------------------------------------------

@@ -126,18 +126,22 @@ LogTest logTest(double x, const std::vector<double>& logs, double a) {
   return r;
 }
 
-/// Error and predicted sigma (nine navigation errors) at the end of each scored outage of @p r.
+/// Error and predicted sigma (nine navigation errors) at the end of the outage
+/// of @p r that starts at @p start_s from time zero (NaN when it has no end epoch).
+std::pair<filter::Vector9d, filter::Vector9d> endOf(const ReplayResult& r, double start_s) {
+  std::pair<filter::Vector9d, filter::Vector9d> e{filter::Vector9d::Constant(NAN), filter::Vector9d::Constant(NAN)};
+  for (const auto& ro : r.run.outages)
+    if (std::abs(ro.window.start_s - r.t_zero - start_s) <= 1e-6 && ro.end_epoch >= 0) {
+      const auto& ep = r.run.epochs[static_cast<std::size_t>(ro.end_epoch)];
+      e = {ep.err, ep.sigma};
+    }
+  return e;
+}
+
+/// endOf for each scored outage of @p r.
 std::vector<std::pair<filter::Vector9d, filter::Vector9d>> scoredEnds(const ReplayResult& r) {
   std::vector<std::pair<filter::Vector9d, filter::Vector9d>> v;
-  for (const auto& o : r.score->outages) {
-    std::pair<filter::Vector9d, filter::Vector9d> e{filter::Vector9d::Constant(NAN), filter::Vector9d::Constant(NAN)};
-    for (const auto& ro : r.run.outages)
-      if (std::abs(ro.window.start_s - r.t_zero - o.start_s) <= 1e-6 && ro.end_epoch >= 0) {
-        const auto& ep = r.run.epochs[static_cast<std::size_t>(ro.end_epoch)];
-        e = {ep.err, ep.sigma};
-      }
-    v.push_back(e);
-  }
+  for (const auto& o : r.score->outages) v.push_back(endOf(r, o.start_s));
   return v;
 }
 
@@ -403,6 +407,28 @@ std::string extraExtension(ExtraCause kind) {
 }
 
 }  // namespace
+
+PairedOutageScores replayOnMeasuredOutages(const ReplayConfig& extension, const ReplayResult& measured,
+                                           const rawlog::RawlogRecords& data, double stop_after_s) {
+  if (!measured.score) throw Error(measured.cfg.rawlog + ": the measured replay has no reference (GT) to score against");
+  ReplayConfig c = extension;
+  c.outages = measured.cfg.outages;  // every window of the measured replay, from time zero
+  c.outages_every.reset();
+  const ReplayResult r = runReplay(c, data, stop_after_s);
+  if (!r.score) throw Error(c.rawlog + ": the extended replay has no reference (GT) to score against");
+  PairedOutageScores p;
+  p.aided_from_s = r.aided_from_s;
+  for (const OutageScore& m : measured.score->outages) {
+    std::optional<OutageScore> q;
+    if (m.start_s > r.aided_from_s && m.start_s + m.duration_s <= stop_after_s)
+      for (const OutageScore& o : r.score->outages)
+        if (std::abs(o.start_s - m.start_s) <= 1e-9 && std::abs(o.duration_s - m.duration_s) <= 1e-9) q = o;
+    p.ends.push_back(q ? endOf(r, q->start_s)
+                       : std::pair{filter::Vector9d::Constant(NAN).eval(), filter::Vector9d::Constant(NAN).eval()});
+    p.outages.push_back(std::move(q));
+  }
+  return p;
+}
 
 /// The causes: fitted per fold outside the held-out block, scored on the held-out outages.
 template <class SimOutages, class Progress>
@@ -716,41 +742,37 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
 
   // Held-out scores: task (cause, fold) replays every duration with the fold's
   // extension; task (cause, K) fits the cause on the whole run (its findings).
-  // The extended replay's outages are paired with today's by their order in
-  // the run. A held-out replay of fold f stops 1 s after the end of its last
-  // held-out outage (the filter is causal: those outages score as in a full
-  // replay) when its outages there are today's; when the extension moved them
-  // (a filter that aligns at another time lays its outages from there), it
-  // runs to the end of the run.
+  // The extended replay runs on the measured run's outage windows
+  // (replayOnMeasuredOutages), so its outages are today's by construction and
+  // are paired with them by window, also when the extension's filter starts
+  // elsewhere (an aligning phase that ends later with larger GNSS sigmas). A
+  // held-out replay of fold f stops 1 s after the end of its last held-out
+  // outage (the filter is causal: those outages score as in a full replay).
   using Ends = std::vector<std::pair<filter::Vector9d, filter::Vector9d>>;
   struct Scored {
-    std::vector<std::vector<OutageScore>> per;  // [duration] scored outages in the run's order
-    std::vector<Ends> ends;                     // [duration] end errors and sigmas
+    std::vector<std::vector<OutageScore>> per;  // [duration][today's outage index] (held-out ones filled)
+    std::vector<Ends> ends;                     // [duration][today's outage index] end errors and sigmas
   };
   std::vector<double> stopAfter(K, -1e300);  // [fold] from time zero [s]
   for (const auto& it : items)
     stopAfter[it.fold] = std::max(stopAfter[it.fold], it.b - measured[it.i].t_zero + 1.0);
-  auto replayScored = [&](ReplayConfig cfg, int f) {
+  auto replayScored = [&](const ReplayConfig& cfg, int f, const std::string& cause) {
     Scored sc;
     for (std::size_t i = 0; i < D; ++i) {
-      cfg.outages.clear();
-      cfg.outages_every = measured[i].cfg.outages_every;
-      const auto& today_i = measured[i].score->outages;
-      ReplayResult r = runReplay(cfg, data, stopAfter[f]);
-      bool same = r.score.has_value();
+      PairedOutageScores r = replayOnMeasuredOutages(cfg, measured[i], data, stopAfter[f]);
+      std::vector<OutageScore> per;
+      for (std::size_t k = 0; k < r.outages.size(); ++k) per.push_back(r.outages[k].value_or(OutageScore{}));
       for (const auto& it : items) {
-        if (!same || it.fold != f || it.i != i) continue;
-        const std::size_t si = simOut[i][it.j].score_index;
-        same = si < r.score->outages.size() && r.score->outages[si].start_s == today_i[si].start_s &&
-               r.score->outages[si].end_s == today_i[si].end_s;
+        if (it.fold != f || it.i != i) continue;
+        const OutageScore& o = measured[i].score->outages[simOut[i][it.j].score_index];
+        if (!r.outages[simOut[i][it.j].score_index])
+          throw Error("diagnose --run: the " + cause + " extension's filter starts at " + formatNumber(r.aided_from_s, 6) +
+                      " s (the measured run's at " + formatNumber(measured[i].aided_from_s, 6) +
+                      " s), at or after the start of the held-out outage at " + formatNumber(o.start_s, 6) +
+                      " s: it cannot score that outage (give a longer --reconverge)");
       }
-      if (!same) {
-        r = runReplay(cfg, data);
-        if (!r.score || r.score->outages.size() != today_i.size())
-          throw Error("diagnose --run: the extended replay scored other outages than today's");
-      }
-      sc.per.push_back(r.score->outages);
-      sc.ends.push_back(scoredEnds(r));
+      sc.per.push_back(std::move(per));
+      sc.ends.push_back(std::move(r.ends));
     }
     return sc;
   };
@@ -773,7 +795,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
     const int task = c * K + f;
     if (heldCount[f] == 0) return;
     foldCfg[task] = cands[c].second(opt.replay, excl[f], nullptr, nullptr);
-    after[task] = replayScored(foldCfg[task], f);
+    after[task] = replayScored(foldCfg[task], f, cands[c].first);
   }, [&](std::size_t done, std::size_t count) { progress(0.80 + 0.17 * double(done) / double(count), "causes"); });
 
   // Paired held-out comparison: every outage scored by @p before and @p after of its fold.
@@ -850,7 +872,8 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
     parallelFor(std::size_t(O * K), threads, [&](std::size_t t) {
       const int c = others[t / K], f = static_cast<int>(t % K);
       if (heldCount[f] == 0) return;
-      both[t] = replayScored(cands[c].second(foldCfg[top * K + f], excl[f], nullptr, nullptr), f);
+      both[t] = replayScored(cands[c].second(foldCfg[top * K + f], excl[f], nullptr, nullptr), f,
+                             cands[c].first + " on top of " + cands[top].first);
     }, [&](std::size_t done, std::size_t count) { progress(0.97 + 0.02 * double(done) / double(count), "causes"); });
     for (int k = 0; k < O; ++k) {
       const int c = others[k];
@@ -1121,13 +1144,8 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
     std::vector<filter::Vector9d> mErr;
     for (const auto& so : simOut[i]) {
       const OutageScore& o = sc.outages[so.score_index];
-      filter::Vector9d e = filter::Vector9d::Constant(NAN);
+      filter::Vector9d e = endOf(mr, o.start_s).first;
       e.head<3>() = o.err_N;
-      for (const auto& ro : mr.run.outages) {
-        if (std::abs(ro.window.start_s - mr.t_zero - o.start_s) > 1e-6 || ro.end_epoch < 0) continue;
-        const auto& ep = mr.run.epochs[static_cast<std::size_t>(ro.end_epoch)];
-        e.tail<6>() = ep.err.tail<6>();
-      }
       mErr.push_back(e);
     }
     for (int q = 0; q < 4; ++q) {

@@ -54,8 +54,9 @@
  * run is cut into `folds` time blocks; the outages whose midpoint falls in
  * block f are held out, the cause is fitted on everything outside block f
  * (IMU samples, GNSS innovations, or outages that do not overlap block f),
- * the run is replayed with that extension and the held-out outage ends
- * scored. Every outage is held out exactly once. Score per outage: negative
+ * the run is replayed with that extension on the measured run's outage
+ * windows (replayOnMeasuredOutages: the same start and duration, whatever
+ * the extension's filter start) and the held-out outage ends scored. Every outage is held out exactly once. Score per outage: negative
  * log-likelihood 0.5 sum_i (e_i^2 / s_i^2 + ln s_i^2) of the errors at its
  * end, i over the position axes (s_i^2 the filter's predicted variance plus
  * the reference's) and the velocity and attitude axes when the reference has
@@ -98,6 +99,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -220,6 +222,35 @@ struct RunDiagnosis {
   stochastic::ImuModel model_before;       ///< today's model
   double wall_s = 0.0;                     ///< wall-clock time [s]
 };
+
+/// An extension's scores on the outages of a measured replay, paired by window.
+struct PairedOutageScores {
+  /// [k] the extension's score of measured.score->outages[k]: the outage with
+  /// the same window (start and duration from time zero); empty when it has
+  /// none that is the same outage: the window ends after the stop, or does not
+  /// start after the extension's filter start (its GNSS-aided history would differ).
+  std::vector<std::optional<OutageScore>> outages;
+  /// [k] the nine navigation errors (dp NED, dv NED, psi) and the filter's
+  /// sigmas at that outage's end (NaN where outages[k] is empty).
+  std::vector<std::pair<filter::Vector9d, filter::Vector9d>> ends;
+  double aided_from_s = 0.0;  ///< the extension's filter start, from time zero [s]
+};
+
+/**
+ * The held-out replay of diagnose --run: @p extension replayed from @p data
+ * with the outage windows of @p measured (measured.cfg.outages: the explicit
+ * ones and those laid by its outages_every, from time zero), not laid again
+ * from the extension's own filter start: an extension that ends the aligning
+ * phase elsewhere (larger GNSS sigmas, another heading source) scores the same
+ * outages as the measured run, so before and after are paired by window, not
+ * by order. With @p stop_after_s the replay stops there (runReplay); only
+ * windows ending by then are paired.
+ * @throws navimpact::Error when @p measured or the replay has no reference
+ *         (score), or errors of the replay.
+ */
+PairedOutageScores replayOnMeasuredOutages(const ReplayConfig& extension, const ReplayResult& measured,
+                                           const rawlog::RawlogRecords& data,
+                                           double stop_after_s = std::numeric_limits<double>::infinity());
 
 /**
  * Diagnose a real run (see the file comment).
