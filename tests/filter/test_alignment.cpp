@@ -395,6 +395,84 @@ TEST(Alignment, GivenHeadingAndNoMotionNeeded) {
   expectWithin(o, 4.0, "given heading");
 }
 
+// A heading given at a later time t_y (a reference whose attitude starts after
+// the IMU data): the aligner waits for it and carries it to the start through
+// the gyros, also when the vehicle turns in between (up to 0.05 rad/s: a yaw
+// taken as the start's would be off by up to 0.05 t_y rad). Rovers at rest
+// then driving (position-only GNSS; t_y at rest or while driving) and airborne
+// starts (GNSS velocity, a course available before t_y), drawn at random
+// (seeded, printed); the given yaw is the true one at t_y plus an error drawn
+// from its stated sigma. Every error within 4 reported sigmas, the heading
+// from the given yaw, the phase ending at or after t_y.
+TEST(Alignment, HeadingGivenLaterIsCarriedToTheStart) {
+  const std::uint64_t seed = 5154;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  std::normal_distribution<double> N01;
+  for (int trial = 0; trial < 8; ++trial) {
+    const bool airborne = trial % 2 == 1;
+    Scenario sc;
+    sc.rate = logUniform(rng, 100.0, 400.0);
+    sc.yaw0 = M_PI * U(rng);
+    sc.turn = 0.05 * U(rng);
+    sc.roll = 4.0 * kDeg * U(rng);
+    sc.pitch = 4.0 * kDeg * U(rng);
+    if (airborne) {
+      sc.t_rest = -10.0;
+      sc.speed = 8.0 + 17.0 * std::abs(U(rng));
+    } else {
+      sc.t_rest = 5.0 + 15.0 * std::abs(U(rng));
+      sc.speed = logUniform(rng, 0.5, 2.0);
+    }
+    const double t_y = airborne ? 0.5 + 14.5 * std::abs(U(rng)) : 1.0 + (sc.t_rest + 29.0) * std::abs(U(rng));
+    sc.duration = std::max(t_y, std::max(sc.t_rest, 0.0)) + 60.0;
+    filter::AlignmentOptions opt;
+    opt.lever_arm_B = Vector3d(0.5 * U(rng), 0.2 * U(rng), -0.5 * std::abs(U(rng)));
+    opt.acc_bias_sigma_mps2 = 0.01;
+    opt.gyro_bias_sigma_rad_s = airborne ? 2e-4 : 1e-5;
+    opt.detector.gyro_sigma_rad_s.setConstant(1e-3);
+    opt.detector.acc_sigma_mps2.setConstant(1e-2);
+    opt.yaw_sigma_rad = 1.0 * kDeg;
+    const ins::NavState truth_y = truthAt(makeTrajectory(sc), t_y);
+    const double yaw_true_y = truth_y.rollPitchYaw()[2], yaw_true_0 = truthAt(makeTrajectory(sc), 0.0).rollPitchYaw()[2];
+    const double yaw_err = opt.yaw_sigma_rad * N01(rng);
+    opt.yaw_rad = yaw_true_y + yaw_err;
+    opt.yaw_t_s = t_y;
+    opt.yaw_source = "reference";
+    const Vector3d bf = 0.01 * Vector3d(U(rng), U(rng), U(rng));
+    const Vector3d bw = (airborne ? 2e-4 : 1e-5) * Vector3d(U(rng), U(rng), U(rng));
+    const double gnss_dt = airborne ? 1.0 / (1.0 + 4.0 * std::abs(U(rng))) : logUniform(rng, 0.2, 3.0);
+    char buf[400];
+    std::snprintf(buf, sizeof buf,
+                  "seed %llu trial %d (%s): rate %.1f Hz, rest %.1f s, speed %.2f m/s, turn %.3f rad/s, yaw given at "
+                  "%.2f s (true yaw there %.2f deg, at the start %.2f deg), GNSS every %.2f s",
+                  static_cast<unsigned long long>(seed), trial, airborne ? "airborne" : "rover", sc.rate, sc.t_rest,
+                  sc.speed, sc.turn, t_y, yaw_true_y / kDeg, yaw_true_0 / kDeg, gnss_dt);
+    const AlignOutcome o =
+        runAligner(sc, opt, gnss_dt, airborne ? 0.5 : 0.05, airborne, 0.05, bw, bf, 1e-3, 1e-2, rng);
+    std::printf("%s\n", buf);
+    ASSERT_TRUE(o.done) << buf;
+    std::printf("  -> %s / %s at %.3f s, aligned at %.2f s, yaw error %.3f deg (sigma %.3f; given yaw's error %.3f), tilt "
+                "error %.3f %.3f deg (sigma %.3f)\n",
+                o.rep.levelling.c_str(), o.rep.heading.c_str(), o.rep.heading_t, o.rep.t_end, o.err(8) / kDeg,
+                o.sigma(8) / kDeg, yaw_err / kDeg, o.err(6) / kDeg, o.err(7) / kDeg, o.sigma(6) / kDeg);
+    EXPECT_EQ(o.rep.heading, "reference") << buf;
+    EXPECT_NEAR(o.rep.heading_t, t_y, 0.5 / sc.rate + 1e-9) << buf;
+    EXPECT_GE(o.rep.t_end, t_y) << buf;
+    EXPECT_EQ(o.rep.levelling, airborne ? "gnss_velocity" : "static") << buf;
+    expectWithin(o, 4.0, buf);
+  }
+  // a heading given later than max_align_s after the start is refused; one
+  // not reached yet is what the aligner says it misses
+  filter::AlignmentOptions opt;
+  opt.yaw_rad = 0.3;
+  opt.yaw_t_s = 700.0;
+  EXPECT_THROW(filter::CoarseAligner(opt, 0.0, 100.0), Error);
+  opt.yaw_t_s = 20.0;
+  const filter::CoarseAligner al(opt, 0.0, 100.0);
+  EXPECT_NE(al.missing().find("waiting for the configuration's yaw at t = 20 s"), std::string::npos) << al.missing();
+}
+
 // A vehicle that never moves and no heading: the aligner keeps aligning and
 // says what is missing; after max_align_s it throws naming it.
 TEST(Alignment, NoMotionNoHeadingSaysWhatIsMissing) {

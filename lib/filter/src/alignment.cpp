@@ -117,11 +117,18 @@ CoarseAligner::CoarseAligner(const AlignmentOptions& opt, double t0, double rate
       !pos(opt.level_window_s) || !pos(opt.max_course_sigma_rad) || !pos(opt.sideslip_sigma_rad) ||
       !pos(opt.accel_sigma_mps2) || !pos(opt.static_velocity_sigma_mps) || !pos(opt.max_align_s) ||
       !(opt.acc_bias_sigma_mps2 >= 0.0) || !(opt.gyro_bias_sigma_rad_s >= 0.0) ||
-      !opt.lever_arm_B.allFinite() || (opt.yaw_rad && !std::isfinite(*opt.yaw_rad)))
+      !opt.lever_arm_B.allFinite() || (opt.yaw_rad && !std::isfinite(*opt.yaw_rad)) ||
+      (opt.yaw_t_s && !std::isfinite(*opt.yaw_t_s)))
     throw Error("alignment: every sigma and duration must be finite and > 0 (biases >= 0)");
   t_last_ = t0;
   rep_.t_start = t0;
-  if (opt.yaw_rad) {
+  if (opt.yaw_rad && opt.yaw_t_s && *opt.yaw_t_s > t0 + 0.5 / rate) {
+    if (*opt.yaw_t_s - t0 > opt.max_align_s)
+      throw Error("alignment: the heading from the " + opt.yaw_source + " at t = " + formatNumber(*opt.yaw_t_s, 10) +
+                  " s comes more than max_align_s = " + formatNumber(opt.max_align_s, 6) +
+                  " s after the start of the IMU data");
+    later_yaw_ = true;
+  } else if (opt.yaw_rad) {
     heading_ = true;
     yaw0_ = *opt.yaw_rad;
     sigma_yaw_ = opt.yaw_sigma_rad;
@@ -160,6 +167,8 @@ void CoarseAligner::levelStatic(const Sums& sums) {
   const Quaterniond qi = q_rest_end_.conjugate();
   q_BtoB0_ = (qi * q_BtoB0_).normalized();
   for (FixRec& r : fixes_) r.q_BtoB0 = r.fix.t <= t_rest_end_ ? Quaterniond::Identity() : (qi * r.q_BtoB0).normalized();
+  if (later_yaw_seen_)
+    q_later_yaw_ = t_later_yaw_ <= t_rest_end_ ? Quaterniond::Identity() : (qi * q_later_yaw_).normalized();
   rep_.notes.push_back("levelled from the accelerometers over " + formatNumber(span, 4) +
                        " s at rest at the start; the mean gyro output there is removed as bias (with Earth rate)");
 }
@@ -189,16 +198,20 @@ void CoarseAligner::levelQuasiStatic() {
 int CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
   const double T = b.fix.t - a.fix.t;
   if (!(T > 0.0) || T > 10.0) return 0;
-  // Course at a (unless the heading is given at t0).
+  // Course at a (unless the heading is given at t0, or given later and reached:
+  // then that yaw; a course levels before a later yaw arrives, the heading waits for it).
   double course = 0.0, sigma_course = 0.0;
   const Vector3d va = *a.fix.v_N;
-  if (!heading_) {
+  const bool laterYaw = !heading_ && later_yaw_seen_;
+  if (!heading_ && !laterYaw) {
     const double speed = va.head<2>().norm();
     sigma_course = speed > 0.0 ? a.fix.sigma_vel_N.head<2>().maxCoeff() / speed : 1e9;
     if (sigma_course > opt_.max_course_sigma_rad) return 0;
     course = std::atan2(va.y(), va.x());
-    rep_.course_speed_mps = speed;
-    rep_.course_t = a.fix.t;
+    if (!later_yaw_) {
+      rep_.course_speed_mps = speed;
+      rep_.course_t = a.fix.t;
+    }
   }
   // C_B0toN maps the specific force integrated in B0 over (a, b] onto the
   // velocity change minus gravity (Coriolis and transport rate neglected):
@@ -207,7 +220,9 @@ int CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
   if (u_B0_.norm() < 1e-9 || v.norm() < 1e-9) return 0;
   const Vector3d uh = u_B0_.normalized(), vh = v.normalized();
   auto yawFor = [&](double r, double p) {
-    return heading_ ? yaw0_ : ins::wrapAngle(course - yawOf(quatLevel(r, p) * a.q_BtoB0));
+    if (heading_) return yaw0_;
+    if (laterYaw) return ins::wrapAngle(*opt_.yaw_rad - yawOf(quatLevel(r, p) * q_later_yaw_));
+    return ins::wrapAngle(course - yawOf(quatLevel(r, p) * a.q_BtoB0));
   };
   auto resid = [&](double r, double p) {
     return Vector3d(quatZ(yawFor(r, p)) * quatLevel(r, p) * uh - vh);
@@ -226,7 +241,9 @@ int CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
   const double sv = std::max(a.fix.sigma_vel_N.maxCoeff(), b.fix.sigma_vel_N.maxCoeff());
   double s_tilt = std::hypot(std::sqrt(2.0) * sv / (kG * T), opt_.acc_bias_sigma_mps2 / kG);
   const double yaw = yawFor(r, p);
-  double s_yaw = heading_ ? sigma_yaw_ : std::hypot(sigma_course, opt_.sideslip_sigma_rad);
+  double s_yaw = heading_    ? sigma_yaw_
+                 : laterYaw ? opt_.yaw_sigma_rad
+                            : std::hypot(sigma_course, opt_.sideslip_sigma_rad);
   const Quaterniond q = quatZ(yaw) * quatLevel(r, p);
   if (!vel_first_) {  // keep it; confirm over the next interval
     vel_first_ = VelLevel{q, s_tilt, s_yaw, b.fix.t};
@@ -251,13 +268,19 @@ int CoarseAligner::levelWithVelocities(const FixRec& a, const FixRec& b) {
   rep_.level_span_s = T;
   rep_.notes.push_back("moving at the start: levelled by matching the specific force over " + formatNumber(T, 4) +
                        " s to the GNSS velocity change minus gravity (checked against the interval before)");
-  if (!heading_) {
+  if (!heading_ && laterYaw) {
+    yaw0_ = yaw;
+    heading_ = true;
+    t_heading_ = t_later_yaw_;
+    rep_.heading = opt_.yaw_source;
+    noteLaterYaw();
+  } else if (!heading_ && !later_yaw_) {
     yaw0_ = yaw;
     heading_ = true;
     t_heading_ = a.fix.t;
     rep_.heading = "gnss_velocity_course";
   }
-  sigma_yaw_ = s_yaw;
+  if (heading_) sigma_yaw_ = s_yaw;  // a later yaw not reached yet: the heading waits for it
   return 2;
 }
 
@@ -318,6 +341,22 @@ void CoarseAligner::tryHeading(const FixRec& r) {
     rep_.course_t = r.fix.t;
     return;
   }
+}
+
+void CoarseAligner::applyLaterYaw() {
+  // yaw(t0) = yaw(t_y) - yaw(C_level C_B(t_y)toB0): a rotation about the navigation z axis adds to the ZYX yaw
+  yaw0_ = ins::wrapAngle(*opt_.yaw_rad - yawOf(quatLevel(rp0_[0], rp0_[1]) * q_later_yaw_));
+  heading_ = true;
+  sigma_yaw_ = opt_.yaw_sigma_rad;
+  t_heading_ = t_later_yaw_;
+  rep_.heading = opt_.yaw_source;
+  noteLaterYaw();
+}
+
+void CoarseAligner::noteLaterYaw() {
+  rep_.notes.push_back("heading from the " + opt_.yaw_source + "'s yaw at t = " + formatNumber(t_later_yaw_, 8) +
+                       " s (its first attitude after the start of the IMU data), carried to the start through the "
+                       "body rotation the gyros measured in between; the aligning phase waited for it");
 }
 
 void CoarseAligner::finish(const FixRec& r) {
@@ -383,6 +422,7 @@ void CoarseAligner::finish(const FixRec& r) {
   used_fix_t_ = r.fix.t;
   done_ = true;
   rep_.t_end = t_last_;
+  rep_.heading_t = t_heading_;
   rep_.rpy = x0_.rollPitchYaw();
   rep_.sigma_rpy = Vector3d(s_tilt, s_tilt, s_yaw);
   rep_.static_at_end = vnote.rfind("at rest", 0) == 0;
@@ -405,6 +445,11 @@ void CoarseAligner::addImu(const ins::ImuSample& s) {
   // 2. body rotation since t0 (after static levelling: its mean gyro output removed)
   w_last_ = w - gyro_bias_;
   q_BtoB0_ = (q_BtoB0_ * ins::quatFromRotVec(w_last_ * s.dt)).normalized();
+  if (later_yaw_ && !later_yaw_seen_ && s.t >= *opt_.yaw_t_s - 0.5 / rate_) {  // the sample nearest the later yaw
+    later_yaw_seen_ = true;
+    t_later_yaw_ = s.t;
+    q_later_yaw_ = q_BtoB0_;
+  }
 
   // 1. levelling at rest: decisions on disjoint detector windows; a window
   // called moving is left out, two in a row end the rest (one is a false
@@ -435,6 +480,7 @@ void CoarseAligner::addImu(const ins::ImuSample& s) {
     qs_T_ += s.dt;
   }
   if (want_quasi_static_ && !levelled_ && qs_T_ >= opt_.level_window_s - 0.5 / rate_) levelQuasiStatic();
+  if (levelled_ && !heading_ && later_yaw_seen_) applyLaterYaw();
   if (s.t - t0_ > opt_.max_align_s)
     throw Error("alignment not complete after " + formatNumber(opt_.max_align_s, 6) + " s of IMU data: " + missing());
 }
@@ -482,7 +528,8 @@ void CoarseAligner::addFix(const AlignmentFix& f) {
     }
     if (want_quasi_static_ && !levelled_ && qs_T_ >= opt_.level_window_s - 0.5 / rate_) levelQuasiStatic();
   }
-  if (levelled_ && !heading_) tryHeading(r);
+  if (levelled_ && !heading_ && later_yaw_seen_) applyLaterYaw();
+  if (levelled_ && !heading_ && !later_yaw_) tryHeading(r);
   if (levelled_ && heading_ && (static_now_ || f.v_N || !fixes_.empty())) {
     finish(r);
     return;
@@ -507,7 +554,10 @@ std::string CoarseAligner::missing() const {
     m.push_back(static_start_ ? "levelling (still at rest; it ends when the vehicle moves or after " +
                                     formatNumber(opt_.max_level_s, 4) + " s)"
                               : "levelling (moving at the start, waiting for GNSS fixes)");
-  if (!heading_)
+  if (!heading_ && later_yaw_)
+    m.push_back("heading (waiting for the " + opt_.yaw_source + "'s yaw at t = " + formatNumber(*opt_.yaw_t_s, 10) +
+                " s)");
+  else if (!heading_)
     m.push_back("heading (no GNSS course with a 1-sigma below " + formatNumber(opt_.max_course_sigma_rad * kRad2Deg, 3) +
                 " deg yet: the vehicle has not moved far enough between fixes; give the initial heading)");
   if (!origin_) m.push_back("position (no GNSS fix since the start of the IMU data)");

@@ -39,7 +39,14 @@
  *     else over the first level_window_s as if at rest (sigma inflated by the
  *     assumed acceleration);
  *  2. takes the heading from AlignmentOptions::yaw (configuration or a
- *     reference) or else from the GNSS course once moving: the course of a
+ *     reference): the body's yaw at t0, or at a later time yaw_t_s (a
+ *     reference whose attitude starts after the IMU data): the yaw of the
+ *     body then, carried back to t0 through the rotation the gyros measured
+ *     in between, yaw(t0) = yaw(t_y) - yaw(C_level C_B(t_y)toB0) (ZYX: a
+ *     rotation about the navigation z axis adds to the yaw); the aligner
+ *     waits for it instead of taking a GNSS course (a course still levels a
+ *     moving start with GNSS velocity before it arrives); or else from the
+ *     GNSS course once moving: the course of a
  *     GNSS velocity, or of the chord between two position fixes (IMU positions:
  *     lever arm removed), accepted when its standard deviation
  *     (sigma_v,h / speed, or sqrt(2) sigma_p,h / chord) is below
@@ -114,7 +121,11 @@ class StaticDetector {
 
 /// Options of the coarse aligner (see the file comment).
 struct AlignmentOptions {
-  std::optional<double> yaw_rad;            ///< heading at the start [rad]: no course needed
+  std::optional<double> yaw_rad;            ///< heading at the start [rad] (or at yaw_t_s): no course needed
+  /// Time of yaw_rad [s, the IMU's clock]: the body's yaw then (e.g. a
+  /// reference's first attitude epoch after the start); empty or <= t0: at t0.
+  /// At most max_align_s after t0.
+  std::optional<double> yaw_t_s;
   std::string yaw_source = "configuration"; ///< where yaw_rad came from, for the report
   double yaw_sigma_rad = 0.035;             ///< 1-sigma of a given heading [rad], > 0
   StaticDetectorOptions detector;           ///< finds the static span at the start
@@ -140,6 +151,7 @@ struct AlignmentReport {
   std::string heading;             ///< "configuration", "reference", "gnss_velocity_course", "gnss_chord_course"
   double course_speed_mps = 0.0;   ///< speed of the accepted course (0 for a given heading)
   double course_t = 0.0;           ///< time of the accepted course [s]
+  double heading_t = 0.0;          ///< time the heading was measured [s] (t0 for a heading given at the start)
   Eigen::Vector3d rpy = Eigen::Vector3d::Zero();        ///< attitude at t_end [rad]
   Eigen::Vector3d sigma_rpy = Eigen::Vector3d::Zero();  ///< its 1-sigma [rad]
   Eigen::Vector3d gyro_bias_B = Eigen::Vector3d::Zero();///< mean at-rest gyro output minus Earth rate [rad/s] (static levelling)
@@ -212,6 +224,9 @@ class CoarseAligner {
   /// interval; 2: confirmed (levelled, heading set unless given).
   int levelWithVelocities(const FixRec& a, const FixRec& b);
   void tryHeading(const FixRec& r);
+  /// The heading from the yaw given at yaw_t_s, once the IMU reached it and the attitude is levelled.
+  void applyLaterYaw();
+  void noteLaterYaw();
   void finish(const FixRec& r);
 
   AlignmentOptions opt_;
@@ -248,6 +263,10 @@ class CoarseAligner {
   // heading: yaw of the body at t0
   bool heading_ = false;
   double yaw0_ = 0.0, sigma_yaw_ = 0.0, t_heading_ = 0.0;
+  // a yaw given at a later time (yaw_t_s): awaited; once the IMU reached it, the body rotation then
+  bool later_yaw_ = false, later_yaw_seen_ = false;
+  double t_later_yaw_ = 0.0;                                    // the IMU sample nearest yaw_t_s [s]
+  Eigen::Quaterniond q_later_yaw_ = Eigen::Quaterniond::Identity();  // body at it w.r.t. B0
   // fixes
   std::optional<earth::Geodetic> origin_;
   std::vector<FixRec> fixes_;
