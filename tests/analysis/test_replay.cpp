@@ -7,6 +7,8 @@
 #include <random>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "navimpact/analysis/replay.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
@@ -247,42 +249,81 @@ TEST(Replay, WithoutGroundTruthTheFilterStartsAfterAnAligningPhase) {
   EXPECT_LT(p.norm(), 10.0);
 }
 
-// A reference with attitude but without velocity: the filter cannot start from
-// it, so an aligning phase runs; its heading comes from the reference's attitude
-// at time zero (reported), unless turned off, then from the GNSS course later.
-TEST(Replay, AligningPhaseTakesItsHeadingFromTheReferenceAtTimeZero) {
-  const auto dir = navimpact::test::tempDir();
-  auto d = emulate60("model");
-  const double yaw0 = navimpact::ins::rollPitchYaw(d.reference.front().q_BtoN->toRotationMatrix())[2];
-  for (auto& g : d.reference) g.v_N.reset();
-  const auto path = (dir / "refatt.rawlog").string();
+// The aligning phase of the run @p d (its reference without velocity) written
+// to @p path, replayed with GNSS velocity: the heading comes from the reference,
+// measured at @p heading_at_s from time zero (reported, also in summary.json),
+// and is within 3 sigma of the reference's yaw at the filter start; with
+// yaw_from_reference false, from the GNSS course. Returns {with, without}.
+std::pair<an::ReplayResult, an::ReplayResult> checkReferenceHeading(const navimpact::Recording& d,
+                                                                    const std::string& path, double heading_at_s) {
   navimpact::rawlog::writeRawlog(path, d);
   an::ReplayConfig c;
   c.rawlog = path;
   c.use_gnss_velocity = true;
-  const auto r = an::runReplay(c);
-  ASSERT_TRUE(r.alignment.has_value());
+  an::ReplayResult r = an::runReplay(c);
+  EXPECT_TRUE(r.alignment.has_value());
+  if (!r.alignment) return {};
   EXPECT_EQ(r.alignment->heading, "reference");
-  std::printf("reference heading: aligned at %.3f s, yaw %.3f deg (reference at time zero %.3f deg)\n",
-              r.aided_from_s, r.alignment->rpy[2] * 180.0 / M_PI, yaw0 * 180.0 / M_PI);
-  ASSERT_TRUE(r.score.has_value());  // scored on position and attitude
+  EXPECT_NEAR(r.alignment->heading_t - r.t_zero, heading_at_s, 0.5 / r.imu_rate_hz + 1e-9);
+  const nlohmann::json js = nlohmann::json::parse(navimpact::report::summaryJson(r));
+  EXPECT_EQ(js["alignment"]["heading"], "reference");
+  EXPECT_EQ(js["alignment"]["heading_at_s"].get<double>(), r.alignment->heading_t - r.t_zero);
   // the aligned heading at the filter start against the reference there
   const navimpact::ReferenceRecord* g = nullptr;
   for (const auto& x : d.reference)
-    if (std::abs(x.t - (r.t_zero + r.aided_from_s)) < 0.5e-2) g = &x;
-  ASSERT_NE(g, nullptr);
+    if (std::abs(x.t - (r.t_zero + r.aided_from_s)) < 0.5e-2 && x.q_BtoN) g = &x;
+  EXPECT_NE(g, nullptr);
+  if (!g) return {};
   const double yaw_ref = navimpact::ins::rollPitchYaw(g->q_BtoN->toRotationMatrix())[2];
   const double dyaw = std::remainder(r.alignment->rpy[2] - yaw_ref, 2.0 * M_PI);
-  std::printf("yaw at the start %.3f deg, reference there %.3f deg, 1-sigma %.3f deg\n", r.alignment->rpy[2] * 180 / M_PI,
-              yaw_ref * 180 / M_PI, r.alignment->sigma_rpy[2] * 180 / M_PI);
+  std::printf("reference heading at %.3f s: aligned at %.3f s, yaw %.3f deg, reference there %.3f deg, 1-sigma %.3f deg\n",
+              r.alignment->heading_t - r.t_zero, r.aided_from_s, r.alignment->rpy[2] * 180 / M_PI, yaw_ref * 180 / M_PI,
+              r.alignment->sigma_rpy[2] * 180 / M_PI);
   EXPECT_LT(std::abs(dyaw), 3.0 * r.alignment->sigma_rpy[2]);
   c.alignment_yaw_from_reference = false;
-  const auto r2 = an::runReplay(c);
-  ASSERT_TRUE(r2.alignment.has_value());
-  EXPECT_NE(r2.alignment->heading, "reference");
+  an::ReplayResult r2 = an::runReplay(c);
+  EXPECT_TRUE(r2.alignment.has_value());
+  if (!r2.alignment) return {};
   EXPECT_EQ(r2.alignment->heading.rfind("gnss_", 0), 0u) << r2.alignment->heading;
+  std::printf("without it: heading from %s, aligned at %.3f s\n", r2.alignment->heading.c_str(), r2.aided_from_s);
+  return {std::move(r), std::move(r2)};
+}
+
+// A reference with attitude but without velocity: the filter cannot start from
+// it, so an aligning phase runs; its heading comes from the reference's attitude
+// at time zero (reported), unless turned off, then from the GNSS course later.
+TEST(Replay, AligningPhaseTakesItsHeadingFromTheReferenceAtTimeZero) {
+  auto d = emulate60("model");
+  for (auto& g : d.reference) g.v_N.reset();
+  const auto [r, r2] = checkReferenceHeading(d, (navimpact::test::tempDir() / "refatt.rawlog").string(), 0.0);
+  ASSERT_TRUE(r.alignment && r2.alignment);
+  ASSERT_TRUE(r.score.has_value());  // scored on position and attitude
   // the heading at time zero is known, not waited for: the filter starts no later
   EXPECT_LE(r.aided_from_s, r2.aided_from_s);
+}
+
+// A reference whose attitude starts a few seconds after the IMU data (drawn,
+// seeded, printed), without velocity: the aligning phase takes its heading
+// from the reference's first attitude epoch, waiting for it (the yaw then,
+// carried to the start through the gyros), not from the GNSS course; turned
+// off, the GNSS course again.
+TEST(Replay, AligningPhaseWaitsForAReferenceAttitudeThatStartsLate) {
+  const std::uint64_t seed = std::random_device{}();
+  std::mt19937_64 rng(seed);
+  const double delay = std::uniform_real_distribution<double>(1.0, 8.0)(rng);
+  std::printf("seed %llu: the reference's attitude starts %.3f s after time zero\n",
+              static_cast<unsigned long long>(seed), delay);
+  auto d = emulate60("model");
+  const double t_zero = d.imu.front().t - (d.imu[1].t - d.imu[0].t);
+  double t_first = NAN;
+  for (auto& g : d.reference) {
+    g.v_N.reset();
+    if (g.t < t_zero + delay) g.q_BtoN.reset();
+    else if (!std::isfinite(t_first)) t_first = g.t - t_zero;
+  }
+  const auto [r, r2] = checkReferenceHeading(d, (navimpact::test::tempDir() / "refattlate.rawlog").string(), t_first);
+  ASSERT_TRUE(r.alignment && r2.alignment);
+  EXPECT_GE(r.aided_from_s, t_first);  // the phase waited for it
 }
 
 // The new configuration keys load with their units and ranges; bad values name the key.

@@ -615,11 +615,22 @@ void ReplayDriver::run() {
       ao.yaw_rad = (*cfg.initial_attitude_deg)[2] * kDeg;
       ao.yaw_source = "configuration (initial_attitude_deg)";
     }
-    if (!ao.yaw_rad && hasTruth_ && cfg.alignment_yaw_from_reference && !truthAhead_.t.empty() &&
-        std::abs(truthAhead_.t.front() - r.t_zero) <= 0.5 * dt_ && truthAhead_.x.front().q_BtoN.coeffs().allFinite()) {
-      // Heading from the reference's attitude at time zero (its entry there).
-      ao.yaw_rad = truthAhead_.x.front().rollPitchYaw()[2];
-      ao.yaw_source = "reference";
+    if (!ao.yaw_rad && hasTruth_ && cfg.alignment_yaw_from_reference) {
+      // Heading from the reference's attitude: its first entry with one read
+      // ahead, at time zero or later (the aligner then waits for that yaw and
+      // carries it back to the start through the gyros), unless it comes after
+      // alignment.max_align_s (then the GNSS course).
+      std::size_t k = 0;
+      while (k < truthAhead_.t.size() && !truthAhead_.x[k].q_BtoN.coeffs().allFinite()) ++k;
+      if (k < truthAhead_.t.size() && truthAhead_.t[k] - r.t_zero <= ao.max_align_s) {
+        ao.yaw_rad = truthAhead_.x[k].rollPitchYaw()[2];
+        ao.yaw_t_s = truthAhead_.t[k];
+        ao.yaw_source = "reference";
+      } else if (k < truthAhead_.t.size()) {
+        alignNotices.push_back("the reference's attitude starts at " + formatNumber(truthAhead_.t[k] - r.t_zero, 10) +
+                               " s, after alignment.max_align_s = " + formatNumber(ao.max_align_s, 10) +
+                               " s: the heading is not taken from it");
+      }
     }
     auto aligning = [&](auto&& f) {
       try {

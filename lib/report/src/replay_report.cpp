@@ -528,6 +528,7 @@ std::string summaryFrom(const ReplayResult& r, const ReplayWriter::State& st) {
                       {"levelling", a.levelling},
                       {"level_span_s", a.level_span_s},
                       {"heading", a.heading},
+                      {"heading_at_s", a.heading_t - r.t_zero},
                       {"course_speed_mps", a.course_speed_mps},
                       {"roll_pitch_yaw_deg", {a.rpy[0] / kDeg, a.rpy[1] / kDeg, a.rpy[2] / kDeg}},
                       {"roll_pitch_yaw_sigma_deg", {a.sigma_rpy[0] / kDeg, a.sigma_rpy[1] / kDeg, a.sigma_rpy[2] / kDeg}},

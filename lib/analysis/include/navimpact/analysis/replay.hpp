@@ -51,8 +51,11 @@
  * Rawlogs without ground truth (label GT absent, e.g. a real run): an
  * aligning phase (filter/alignment.hpp: static or GNSS-velocity levelling,
  * heading from `alignment.yaw_deg` / `initial_attitude_deg`'s yaw, else from
- * the reference's attitude at time zero when it has one there (unless
- * `yaw_from_reference: false`), else from the GNSS course once moving) runs from time zero until it has an attitude, a
+ * the reference's attitude (unless `yaw_from_reference: false`): at time zero
+ * when it has one there, else at its first attitude epoch read ahead, which
+ * the phase then waits for (within alignment.max_align_s; the yaw then is
+ * carried to the start through the gyros), else from the GNSS course once
+ * moving) runs from time zero until it has an attitude, a
  * position and a velocity; the filter starts there (no fix is needed at the
  * first IMU sample) and the phase is reported. The estimate and the
  * predicted sigmas are recorded every `record_interval_s` (default 0.1 s);
@@ -115,8 +118,9 @@ struct ReplayConfig {
   double reference_sigma_v_m = 0.0;             ///< its vertical 1-sigma [m]
   Eigen::Vector3d reference_lever_arm_B = Eigen::Vector3d::Zero();  ///< the reference's point from the IMU, body FRD [m]
   filter::AlignmentOptions alignment;           ///< the aligning phase without GT (lever arm and yaw set by the replay)
-  /// Heading of the aligning phase from the reference's attitude at time zero
-  /// (when it has one there and no yaw is configured); false: from the GNSS course.
+  /// Heading of the aligning phase from the reference's attitude (when it has
+  /// one and no yaw is configured): at time zero, or at its first attitude
+  /// epoch when that comes later (the phase waits for it); false: from the GNSS course.
   bool alignment_yaw_from_reference = true;
   NavRunOptions aids;                           ///< only its zupt* / nhc* fields are used (ground-vehicle aids)
   /// false: the rawlog's reference (GT) is ignored, as for a rawlog without
