@@ -11,6 +11,8 @@
 #include <Eigen/Dense>
 
 #include "kind.hpp"
+#include "rng.hpp"
+#include "navimpact/stochastic/simulate.hpp"
 #include "navimpact/core/error.hpp"
 
 namespace navimpact::stochastic {
@@ -268,6 +270,36 @@ double profileBlockLogLikelihood(Model& m, const std::vector<double>& y, std::si
     if (best - before < 1e-4) break;  // converged
   }
   return best;
+}
+
+std::vector<double> simulateBlockMeans(const Model& m, std::size_t nb, std::size_t block, std::uint64_t seed) {
+  if (block == 0) throw Error("simulateBlockMeans: block must be >= 1 sample");
+  if (!(m.rate_hz > 0)) throw Error("simulateBlockMeans: the model needs a rate");
+  std::vector<double> y(nb, 0.0);
+  const double bd = static_cast<double>(block);
+  for (std::size_t i = 0; i < m.terms.size(); ++i) {
+    const Process& p = m.terms[i];
+    if (p.kind == ProcessKind::DR) {
+      // Mean of omega k over k = kb .. kb + b - 1.
+      for (std::size_t k = 0; k < nb; ++k) y[k] += p.omega * (static_cast<double>(k) * bd + 0.5 * (bd - 1.0));
+      continue;
+    }
+    const auto a = sampledArma(p, m.rate_hz);
+    if (!a) continue;
+    const TermBlock t = blockForm(*a, block);
+    detail::Rng rng(deriveSeed(seed, i));
+    // (w, v) = (sqrt(R) z1, M / sqrt(R) z1 + sqrt(Q - M^2 / R) z2).
+    const double sr = std::sqrt(std::max(t.R, 0.0));
+    const double cv = sr > 0 ? t.M / sr : 0.0;
+    const double sv = std::sqrt(std::max(t.Q - cv * cv, 0.0));
+    double s = std::sqrt(std::max(t.P0, 0.0)) * rng.normal();
+    for (std::size_t k = 0; k < nb; ++k) {
+      const double z1 = rng.normal(), z2 = rng.normal();
+      y[k] += t.H * s + sr * z1;
+      s = t.F * s + cv * z1 + sv * z2;
+    }
+  }
+  return y;
 }
 
 }  // namespace navimpact::stochastic

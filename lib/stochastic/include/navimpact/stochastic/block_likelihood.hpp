@@ -77,4 +77,17 @@ BlockLikelihood blockLogLikelihood(const Model& m, const std::vector<double>& y,
 double profileBlockLogLikelihood(Model& m, const std::vector<double>& y, std::size_t block,
                                  const Eigen::MatrixXd& X, const std::vector<int>& terms = {});
 
+/**
+ * Exact draw of @p nb block means of @p block samples under @p m: the block
+ * state space of blockLogLikelihood() driven by its own noise (per term and
+ * block the pair (w_k, v_k), jointly normal with variances R, Q and
+ * covariance M; the state from N(0, P0): GM stationary, RW from 0), so the
+ * draws have exactly the distribution the likelihood assumes, at a cost
+ * independent of the block length. A DR term adds its trend (omega per
+ * sample from sample 0, as simulate()); SIN terms are ignored. Term i draws
+ * from its own stream deriveSeed(seed, i).
+ * @throws navimpact::Error for block == 0 or a model without a rate.
+ */
+std::vector<double> simulateBlockMeans(const Model& m, std::size_t nb, std::size_t block, std::uint64_t seed);
+
 }  // namespace navimpact::stochastic
