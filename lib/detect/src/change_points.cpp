@@ -225,7 +225,9 @@ ChangePointResult detectChangePoints(std::vector<double>& x, const HaarWvFunctio
       maxabs = std::max(maxabs, std::abs(byIndex[q].size));
       if (byIndex[q].z / byIndex[q].threshold > byIndex[strongest].z / byIndex[strongest].threshold) strongest = q;
     }
-    if (std::abs(net) < 0.5 * maxabs) {
+    // A cluster at one sample (a change found again in another window and
+    // corrected) has no duration: it is one change of its net size.
+    if (std::abs(net) < 0.5 * maxabs && byIndex[j].index > byIndex[i].index) {
       Transient t;
       t.first = byIndex[i].index;
       t.last = byIndex[j].index;
