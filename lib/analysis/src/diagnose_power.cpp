@@ -239,7 +239,7 @@ Case drawCase(const std::vector<Cause>& causes, const DrawRanges& rg, double snr
         break;
       }
       case Cause::GaussMarkov: {
-        const double T = rng.logU(2.0 / rate, record / 5.0);
+        const double T = rng.logU(std::max(2.0 / rate, rg.min_gm_T_record * record), record / 5.0);
         const double s = std::sqrt(wvScaleFor(stochastic::Process::gm(1.0, T), m, n, target));
         addProc(stochastic::Process::gm(s, T));
         h.truth = {{"sigma", s}, {"T", T}};

@@ -15,6 +15,7 @@
 #include <boost/math/distributions/normal.hpp>
 
 #include "diagnosis_internal.hpp"
+#include "diagnosis_slow.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/golden_section.hpp"
@@ -972,11 +973,13 @@ void cleanTransients(std::vector<double>& x, const std::vector<detect::Transient
   detect::cleanOutliers(x, evs, o);
 }
 
+
 ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   const ImuChannel& chan = sh.data->channels[ci];
   const DiagnoseOptions& opt = *sh.opt;
   const double rate = sh.data->rate_hz;
   const std::size_t n = chan.x.size();
+  const double record = static_cast<double>(n) / rate;
   const double t0 = sh.data->t0_s;
   ChannelDiagnosis cd;
   cd.name = chan.name;
@@ -1462,6 +1465,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     // means (the new terms' variances profiled, a drift's slope by GLS), AIC.
     std::string exact_evidence;
     std::vector<std::pair<double, int>> ranked_exact;  // (exact AIC, extension) when the slow ones were ranked
+    std::vector<std::pair<double, int>> excluded;      // larger sets the nested test kept out
     if (hasSlow(ext[best]) && yb.size() >= 16) {
       const auto key = fastPart(ext[best]);
       std::vector<std::pair<double, int>> ranked;
@@ -1507,8 +1511,10 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
               const double dof_lr = std::max(1.0, (penalty(e.terms, e.terms.size() - e.added) -
                                                    penalty(ext[simple].terms, ext[simple].terms.size() - ext[simple].added)) / 2.0);
               const double lr = 2.0 * (loglik[r.second] - loglik[simple]);
-              if (!(lr > boost::math::quantile(boost::math::complement(boost::math::chi_squared(dof_lr), 0.01))))
+              if (!(lr > boost::math::quantile(boost::math::complement(boost::math::chi_squared(dof_lr), 0.01)))) {
+                excluded.push_back(r);
                 continue;
+              }
             }
             kept.push_back(r);
           }
@@ -1533,7 +1539,63 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
           second = i;
           break;
         }
-    const Extension& win = ext[best];
+    // The slow decision on the exact likelihood of the block means
+    // (diagnosis_slow.hpp): it may replace the WV's slow terms by the slow
+    // explanation the block means prefer, and it judges the runner-up.
+    Extension chosen = ext[best];
+    slow::Choice sc;
+    if (hasSlow(chosen) && yb.size() >= 16) {
+      slow::Problem sp;
+      std::vector<Candidate> fast_terms(chosen.terms.begin(), chosen.terms.end() - chosen.added);
+      for (std::size_t q = chosen.terms.size() - chosen.added; q < chosen.terms.size(); ++q) {
+        const Candidate& c = chosen.terms[q];
+        if (isSlow(c)) {
+          sp.wv_slow.push_back(causeOf(c.kind));
+        } else {
+          fast_terms.push_back(c);
+          sp.fast_causes.push_back(causeName(causeOf(c.kind)));
+        }
+      }
+      sp.base = withoutSin(assemble(m0n, fast_terms));
+      sp.fast_pen = penalty(fast_terms, S.size());
+      sp.wv_start = withoutSin(assemble(m0n, chosen.terms));
+      for (std::size_t q = chosen.terms.size() - chosen.added; q < chosen.terms.size(); ++q)
+        if (isSlow(chosen.terms[q]) && chosen.terms[q].kind != ProcessKind::DR)
+          sp.wv_own.push_back(assembledIndex(m0n, chosen.terms, q));
+      sp.wv_pen = penalty(chosen.terms, chosen.terms.size() - chosen.added);
+      sp.wv_text = newTermsText(chosen);
+      sp.y = &yb;
+      sp.block = blk;
+      sp.rate_hz = rate;
+      sp.record_s = record;
+      sp.seed = stochastic::deriveSeed(opt.seed, 7000000u + 1000u * static_cast<unsigned>(ci) + static_cast<unsigned>(S.size()));
+      sc = slow::decide(sp);
+      if (sc.decided_here && sc.swapped) {
+        Extension e;
+        e.terms = fast_terms;
+        for (const auto& t : sc.terms) {
+          Candidate c;
+          c.kind = t.proc.kind;
+          c.proc = t.proc;
+          c.params = c.kind == ProcessKind::GM ? 2 : 1;
+          if (c.kind == ProcessKind::GM) {
+            c.T_lo = t.lo;
+            c.T_hi = t.hi;
+            c.T_hi_open = c.T_top_only = t.open_top;
+          } else {
+            c.p_lo = t.lo;
+            c.p_hi = t.hi;
+          }
+          e.terms.push_back(c);
+        }
+        e.added = static_cast<int>(e.terms.size() - S.size());
+        e.deviance = wvDeviance(full.nu, wvOf(assemble(m0n, e.terms), tau), full.dof);
+        e.crit = e.deviance + penalty(e.terms);
+        e.valid = true;
+        chosen = e;
+      }
+    }
+    const Extension& win = chosen;
     const Model before = merged(m0n, S);
     const Model after = merged(m0n, win.terms);
     // A finding must change the WV by at least its CI width at some scale.
@@ -1559,7 +1621,8 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
                   (win.needed ? ", below every single term by more than the 1 % chi-square margin"
                               : ", both needed by the exact likelihood (nested likelihood ratio at 1 %)");
     }
-    evidence += exact_evidence;
+    if (sc.decided_here) evidence = (sc.swapped ? "the WV's coarsest scales leave the slow explanations open" : evidence) + sc.evidence;
+    else evidence += exact_evidence;
     // The runner-up naming other causes, on the criterion that chose (the
     // exact likelihood among the slow explanations, else the WV AIC), and a
     // single level shift against a slow explanation (a shift near its
@@ -1568,17 +1631,19 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     // AIC (below 2 both have substantial support; Burnham & Anderson 2002,
     // §2.6).
     std::string ru, ru_detail;
-    double ru_margin = kNaN;
+    double ru_margin = kNaN, ru_p = kNaN;
+    int ru_draws = 0;
+    bool ru_larger = false;  // the runner-up contains the winner (ru_p: its lead under the winner)
     {
       const std::string mine = causesOf(win);
-      if (ranked_exact.size() >= 2 && ranked_exact[0].second == best) {
-        for (const auto& r : ranked_exact)
-          if (causesOf(ext[r.second]) != mine) {
-            ru = causesOf(ext[r.second]);
-            ru_detail = newTermsText(ext[r.second]) + " (exact likelihood of " + std::to_string(yb.size()) + " block means)";
-            ru_margin = r.first - ranked_exact[0].first;
-            break;
-          }
+      if (sc.decided_here) {
+        // The slow decision (diagnosis_slow.hpp): its runner-up and bootstrap.
+        ru = sc.runner_up;
+        ru_detail = sc.runner_up_detail;
+        ru_margin = sc.runner_up.empty() ? kNaN : sc.aic_margin;
+        ru_p = sc.runner_up.empty() ? kNaN : sc.p;
+        ru_draws = sc.draws;
+        ru_larger = sc.larger;
       } else {
         for (int i : order)
           if (i != best && causesOf(ext[i]) != mine) {
@@ -1595,8 +1660,16 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
           if (r.second == best) aic_slow = r.first;
         if (!std::isfinite(aic_slow)) aic_slow = exactAic(win, &l_slow);
         const double aic_shift = bestShiftAic(S, &t_shift, &size_shift);
-        if (std::isfinite(aic_slow) && std::isfinite(aic_shift) &&
-            (!std::isfinite(ru_margin) || aic_shift - aic_slow < ru_margin)) {
+        // The shift is the runner-up when it is closer than the slow one (by
+        // AIC, or, when the slow one was simulated and rejected, whenever it
+        // is within the AIC margin of 2 that decides against a shift).
+        const double shift_margin = aic_shift - aic_slow;
+        const bool slow_open = std::isfinite(ru_p) && (ru_larger ? ru_p <= slow::kLevel : ru_p > slow::kLevel);
+        const bool closer = std::isfinite(ru_p) ? !slow_open && shift_margin < 2.0
+                                                : (!std::isfinite(ru_margin) || shift_margin < ru_margin);
+        if (std::isfinite(aic_slow) && std::isfinite(aic_shift) && closer) {
+          ru_p = kNaN;
+          ru_draws = 0;
           ru = causeName(Cause::LevelShift);
           ru_detail = "a level shift of " + formatNumber(size_shift, 3) + " " + unit + " at t = " + formatNumber(t_shift, 6) +
                       " s (exact likelihood of " + std::to_string(yb.size()) + " block means: AIC " +
@@ -1615,7 +1688,10 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
       nf.runner_up = ru;
       nf.runner_up_detail = ru_detail;
       nf.aic_margin = ru_margin;
-      nf.decided = ru.empty() || !(ru_margin < 2.0);
+      nf.runner_up_p = ru_p;
+      nf.runner_up_draws = ru_draws;
+      nf.decided = ru.empty() || (std::isfinite(ru_p) ? (ru_larger ? ru_p > slow::kLevel : ru_p <= slow::kLevel)
+                                                    : !(ru_margin < 2.0));
       cd.findings.push_back(nf);
       found_at.push_back(cd.findings.size() - 1);
     }
@@ -1642,6 +1718,8 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
     nf.runner_up = f.runner_up;
     nf.runner_up_detail = f.runner_up_detail;
     nf.aic_margin = f.aic_margin;
+    nf.runner_up_p = f.runner_up_p;
+    nf.runner_up_draws = f.runner_up_draws;
     nf.decided = f.decided;
     f = nf;
     added_params += S[i].params;

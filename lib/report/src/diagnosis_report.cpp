@@ -52,6 +52,10 @@ json findingJson(const Finding& f) {
     j["runner_up"] = f.runner_up;
     j["runner_up_detail"] = f.runner_up_detail;
     j["aic_margin"] = num(f.aic_margin);
+    if (f.runner_up_draws > 0) {
+      j["runner_up_p"] = num(f.runner_up_p);
+      j["runner_up_draws"] = f.runner_up_draws;
+    }
   }
   if (!f.harmonics_hz.empty()) j["harmonics_hz"] = f.harmonics_hz;
   if (f.event >= 0) j["event"] = f.event;
@@ -349,7 +353,9 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
       if (!f.evidence.empty()) r << " *Evidence:* " << f.evidence << ".";
       if (!f.decided) {
         r << " *Undecided:* the runner-up, " << f.runner_up_detail << ", ";
-        if (f.aic_margin >= 0)
+        if (f.runner_up_draws > 0)
+          r << "stays plausible at 5 % (parametric bootstrap).";
+        else if (f.aic_margin >= 0)
           r << "is only " << formatNumber(f.aic_margin, 3) << " above it in AIC (decided from a margin of 2).";
         else
           r << "is " << formatNumber(-f.aic_margin, 3) << " below it in AIC"
@@ -406,10 +412,14 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
        "(dof lowered to what "
     << d.options.simulations << " simulations of the model show, seed " << d.options.seed
     << "), Bonferroni over scales; each process family (or a retuned term), and each pair fitted jointly, fitted "
-       "to the excess by the chi-square deviance, chosen by AIC on the whole record (runner-up given as evidence; "
-       "slow explanations ranked again on the exact likelihood of block means, and compared with a single level "
-       "shift there); no term below one CI width, no GM with T beyond a fifth of the record. A finding whose "
-       "runner-up naming another cause is within 2 in AIC is \"undecided between\" the two.\n"
+       "to the excess by the chi-square deviance, chosen by AIC on the whole record (runner-up given as evidence); "
+       "no term below one CI width, no GM with T beyond a fifth of the record. A finding whose runner-up naming "
+       "another cause is within 2 in AIC is \"undecided between\" the two.\n"
+       "- **Slow explanations** (random walk, drift, Gauss-Markov with T near the record; one or two): each fitted "
+       "on the exact likelihood of block means and chosen by AIC, a pair only when a single term, simulated, gives "
+       "its lead in at most 1 % of records; decided only when a parametric bootstrap rejects the runner-up at 5 % "
+       "(the runner-up, simulated, rarely gives the winner such a lead; or, for a larger set containing the winner, "
+       "the winner, simulated, often gives it its lead); also compared with a single level shift.\n"
        "- **Gain:** the first-half extension against the model on the held-out second half; one-sided paired z "
        "test over the scales of the per-scale deviance.\n"
        "- The family-wise level is split WV 40 %, lines 20 %, level shifts 20 %, outliers 20 %, each over the "

@@ -42,6 +42,9 @@ struct DrawRanges {
   double min_duration_s = 0, max_duration_s = 0;
   std::size_t min_samples = 1 << 16, max_samples = 1 << 18;
   double min_wn = 1e-4, max_wn = 1e-1;  ///< white-noise sigma per sample [SI]
+  /// Hidden GM correlation time drawn log-uniform from max(2/rate, this x
+  /// record) to record/5 (0: from 2/rate, the whole documented range).
+  double min_gm_T_record = 0.0;
 };
 
 /// One hidden effect and its truth.

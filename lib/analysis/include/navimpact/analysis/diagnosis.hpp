@@ -110,6 +110,12 @@ struct Finding {
   std::string runner_up;
   std::string runner_up_detail;
   double aic_margin = std::numeric_limits<double>::quiet_NaN();
+  /// Slow explanations (random walk, drift, long Gauss-Markov): how often the
+  /// runner-up, fitted and simulated (parametric bootstrap of the exact block
+  /// likelihood), gives a margin at least the observed one; the finding is
+  /// decided only when this is <= 5 %. NaN when not simulated.
+  double runner_up_p = std::numeric_limits<double>::quiet_NaN();
+  int runner_up_draws = 0;  ///< simulated records behind runner_up_p
   /// false: the evidence between the finding and its runner-up is not
   /// decisive (AIC margin below 2); the report says "undecided between".
   bool decided = true;
