@@ -276,11 +276,15 @@ TEST(Diagnose, FindingsHaveNoVanishingTermsAndNoOverlongGaussMarkov) {
     const double record = c.data.size() / c.data.rate_hz;
     for (const auto& ch : d.channels) {
       for (const auto& p : ch.model_after.terms) {
-        if (p.kind == ns::ProcessKind::GM) EXPECT_LE(p.T, record / 5.0 * 1.0001) << c.text;
+        if (p.kind == ns::ProcessKind::GM) {
+          EXPECT_LE(p.T, record / 5.0 * 1.0001) << c.text;
+        }
       }
       for (const auto& f : ch.findings)
         for (const auto& kv : f.params)
-          if (kv.first != "t_s") EXPECT_NE(kv.second, 0.0) << na::causeName(f.cause) << " " << kv.first << " " << c.text;
+          if (kv.first != "t_s") {
+            EXPECT_NE(kv.second, 0.0) << na::causeName(f.cause) << " " << kv.first << " " << c.text;
+          }
     }
   }
 }
@@ -567,3 +571,4 @@ TEST(Diagnose, SlowCausesAreNeverAConfidentWrongName) {
             << " confident wrong name(s) of " << R << " (root seed " << rootSeed() << ")\n";
   EXPECT_LE(wrong, std::floor(mcBound(0.05, R) * R));
 }
+

@@ -162,6 +162,10 @@ struct Set {
   double pen = 0, aic = kInf;
   Fit fit;
   bool from_wv = false;
+  /// Largest T of its GMs: record/5, or below it for a rival whose GM went
+  /// there (rival_only: the random walk it imitates cannot win as a GM).
+  double T_cap = 0;
+  bool rival_only = false;
   std::string causes, text;
 };
 
@@ -180,6 +184,7 @@ std::string joinCauses(std::vector<std::string> cs) {
 /// the drift's parameters has one), also from the start its record fit came
 /// from; the better.
 double refit(const Set& s, const std::vector<double>& ys, std::size_t blk, double T_lo, double T_hi) {
+  if (s.T_cap > 0) T_hi = s.T_cap;
   Model m = s.fit.model;
   double best = maximise(m, s.own, ys, blk, T_lo, T_hi);
   if (std::find(s.slow.begin(), s.slow.end(), Cause::GaussMarkov) != s.slow.end() && !s.starts.empty()) {
@@ -367,16 +372,33 @@ Choice decide(const Problem& pr) {
   // A GM whose T goes to record/5 is no explanation of its own: the data do
   // not bound its T, and over this record it is the random walk (or drift)
   // it imitates (the rule: no GM with T beyond a fifth of the
-  // record). Such a set neither wins nor competes.
-  sets.erase(std::remove_if(sets.begin(), sets.end(),
-                            [&](const Set& s) {
-                              for (int i : s.slow_idx) {
-                                const Process& p = s.fit.model.terms[static_cast<std::size_t>(i)];
-                                if (p.kind == ProcessKind::GM && p.T >= T_hi * std::exp(-0.05)) return true;
-                              }
-                              return false;
-                            }),
-             sets.end());
+  // record). Such a set cannot win; it competes as the nearest GM that is
+  // not a random walk, refitted with T at most record/5 e^-0.5 (record/8).
+  const double T_cap = T_hi * std::exp(-0.5);
+  auto capT = [&](Model& m, const std::vector<int>& idx) {
+    for (int i : idx) {
+      Process& p = m.terms[static_cast<std::size_t>(i)];
+      if (p.kind != ProcessKind::GM || p.T <= T_cap) continue;
+      const double dt = 1.0 / pr.rate_hz, w0 = -std::expm1(-2.0 * dt / p.T);
+      p.T = T_cap;
+      p.sigma *= std::sqrt(w0 / -std::expm1(-2.0 * dt / p.T));  // the same innovation variance
+    }
+  };
+  for (auto& s : sets) {
+    bool top = false;
+    for (int i : s.slow_idx) {
+      const Process& p = s.fit.model.terms[static_cast<std::size_t>(i)];
+      top = top || (p.kind == ProcessKind::GM && p.T >= T_hi * std::exp(-0.05));
+    }
+    if (!top) continue;
+    s.rival_only = true;
+    s.T_cap = T_cap;
+    Model m = s.fit.model;
+    capT(m, s.own);
+    maximise(m, s.own, y, blk, T_lo, T_cap, -1, &s.fit);
+    s.aic = std::isfinite(s.fit.loglik) ? -2.0 * s.fit.loglik + s.pen : kInf;
+    for (auto& st : s.starts) capT(st.first, st.second);
+  }
   if (sets.empty()) return ch;
   for (auto& s : sets) {
     std::vector<std::string> cs = fast_names;
@@ -400,7 +422,8 @@ Choice decide(const Problem& pr) {
   const std::size_t count = std::max<std::size_t>(1, wv.slow.size());
   int wi = -1;
   for (std::size_t i = 0; i < sets.size(); ++i)
-    if (sets[i].slow.size() == count && (wi < 0 || sets[i].aic < sets[static_cast<std::size_t>(wi)].aic))
+    if (!sets[i].rival_only && sets[i].slow.size() == count &&
+        (wi < 0 || sets[i].aic < sets[static_cast<std::size_t>(wi)].aic))
       wi = static_cast<int>(i);
   if (wi < 0) return ch;
   // The WV's explanation gives way only when the exact likelihood rejects
@@ -409,7 +432,7 @@ Choice decide(const Problem& pr) {
   std::string kept_evidence;
   for (std::size_t i = 0; i < sets.size(); ++i) {
     const Set& v = sets[i];
-    if (!v.from_wv || static_cast<int>(i) == wi) continue;
+    if (!v.from_wv || v.rival_only || static_cast<int>(i) == wi) continue;
     const Set& x = sets[static_cast<std::size_t>(wi)];
     int used = 0;
     const double p = bootstrapP(x, v, v.aic - x.aic, y, blk, T_lo, T_hi, kLevel, stochastic::deriveSeed(pr.seed, 4), &used);
