@@ -572,3 +572,22 @@ TEST(Diagnose, SlowCausesAreNeverAConfidentWrongName) {
   EXPECT_LE(wrong, std::floor(mcBound(0.05, R) * R));
 }
 
+
+
+TEST(Diagnose, ABurstPartlyFlaggedAsSpikesIsOneEvent) {
+  // Regression draw of diagnose-power (root seed 777, outliers run 10, 82.5x
+  // the limit, records of 2^16-10^6 samples): the second difference flags 16
+  // samples of an alternating burst, the transient test the 23 samples that
+  // contain them; that is one event, not two (it was counted 20 for 19).
+  pw::DrawRanges rg;
+  rg.min_samples = 65536;
+  rg.max_samples = 1000000;
+  const std::uint64_t s = ns::deriveSeed(777, 1000000u * (static_cast<std::uint64_t>(na::Cause::Outliers) + 1) + 10);
+  const pw::Case c = pw::drawCase({na::Cause::Outliers}, rg, 82.51079206538158, s);
+  const auto d = diagnoseCase(c, s);
+  const pw::Outcome out = pw::judge(c, d);
+  EXPECT_TRUE(out.right[0]) << out.why;
+  EXPECT_EQ(d.channels[c.channel].outlier_events.size(), static_cast<std::size_t>(c.hidden[0].events)) << pw::describe(d);
+}
+
+

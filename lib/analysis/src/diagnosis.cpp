@@ -1173,10 +1173,29 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
       cpr.transients = kept;
     }
     if (!cpr.transients.empty()) {
-      // Transients: outlier events, interpolated out.
-      for (const auto& tr : cpr.transients)
-        cd.outlier_events.push_back({t0 + static_cast<double>(tr.first) / rate,
-                                     static_cast<double>(tr.last - tr.first) / rate, tr.peak});
+      // Transients: outlier events, interpolated out. One within 10 samples
+      // of a spike event (the part of a burst the second difference did not
+      // flag) is that event, its span extended (its time stays the spike
+      // peak's): one event however many samples it spans.
+      std::vector<double> new_times;
+      const double gap = 10.0 / rate;
+      for (const auto& tr : cpr.transients) {
+        const double a = t0 + static_cast<double>(tr.first) / rate, len = static_cast<double>(tr.last - tr.first) / rate;
+        bool merged_into = false;
+        for (auto& e : cd.outlier_events) {
+          if (a > e.t_s + e.duration_s + gap || a + len < e.t_s - gap) continue;
+          const double end = std::max(e.t_s + e.duration_s, a + len), start = std::min(e.t_s, a);
+          e.t_s = start;
+          e.duration_s = end - start;
+          if (std::abs(tr.peak) > std::abs(e.size)) e.size = tr.peak;
+          merged_into = true;
+          break;
+        }
+        if (!merged_into) {
+          cd.outlier_events.push_back({a, len, tr.peak});
+          new_times.push_back(a);
+        }
+      }
       cleanTransients(x, cpr.transients);
       x_after_pre_changed = true;
       Finding* of = nullptr;
@@ -1196,7 +1215,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
         cd.findings.push_back(f);
         of = &cd.findings.back();
       }
-      for (const auto& tr : cpr.transients) of->times_s.push_back(t0 + static_cast<double>(tr.first) / rate);
+      of->times_s.insert(of->times_s.end(), new_times.begin(), new_times.end());
       std::sort(of->times_s.begin(), of->times_s.end());
       of->params = {{"count", static_cast<double>(of->times_s.size())}};
       of->range_lo = of->times_s.front();
