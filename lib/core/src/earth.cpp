@@ -30,7 +30,7 @@ Radii radiiOf(double s, double c) {
 Radii radii(double lat) { return radiiOf(std::sin(lat), std::cos(lat)); }
 
 LatitudeTerms::LatitudeTerms(double latitude)
-    : lat(latitude), sin_lat(std::sin(latitude)), cos_lat(std::cos(latitude)), tan_lat(std::tan(latitude)),
+    : lat(latitude), sin_lat(std::sin(latitude)), cos_lat(std::cos(latitude)), tan_lat(sin_lat / cos_lat),
       r(radiiOf(sin_lat, cos_lat)) {}
 
 Eigen::Vector3d gravity_N(double lat, double h) {
@@ -98,7 +98,7 @@ Eigen::Vector3d w_IE_N(double lat) { return w_IE_Nof(std::sin(lat), std::cos(lat
 Eigen::Vector3d w_IE_N(const LatitudeTerms& l) { return w_IE_Nof(l.sin_lat, l.cos_lat); }
 
 Eigen::Vector3d w_EN_N(double lat, double h, const Eigen::Vector3d& v_N) {
-  return w_EN_Nof(radii(lat), std::tan(lat), h, v_N);
+  return w_EN_Nof(radii(lat), std::sin(lat) / std::cos(lat), h, v_N);
 }
 Eigen::Vector3d w_EN_N(const LatitudeTerms& l, double h, const Eigen::Vector3d& v_N) {
   return w_EN_Nof(l.r, l.tan_lat, h, v_N);

@@ -50,9 +50,12 @@ void NavState::setRollPitchYaw(double roll, double pitch, double yaw) {
 Eigen::Quaterniond quatFromRotVec(const Eigen::Vector3d& phi) {
   const double a2 = phi.squaredNorm();
   double s, c;  // sin(a/2)/a, cos(a/2)
-  if (a2 < 1e-10) {
-    s = 0.5 - a2 / 48.0;
-    c = 1.0 - a2 / 8.0;
+  if (a2 < 2.5e-3) {
+    // Taylor series in x^2 = a^2/4 to x^8 (the next terms are below 1e-18
+    // relative for |a| < 0.05 rad): sin(x)/x and cos(x).
+    const double x2 = 0.25 * a2;
+    s = 0.5 * (1.0 - x2 * (1.0 / 6.0 - x2 * (1.0 / 120.0 - x2 * (1.0 / 5040.0 - x2 / 362880.0))));
+    c = 1.0 - x2 * (0.5 - x2 * (1.0 / 24.0 - x2 * (1.0 / 720.0 - x2 / 40320.0)));
   } else {
     const double a = std::sqrt(a2);
     s = std::sin(0.5 * a) / a;
