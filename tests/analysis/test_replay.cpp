@@ -46,12 +46,7 @@ std::pair<std::string, std::string> writeWithAndWithoutGt(const std::filesystem:
 }
 
 std::string errorOf(const an::ReplayConfig& c) {
-  try {
-    an::runReplay(c);
-  } catch (const navimpact::Error& e) {
-    return e.what();
-  }
-  return "";
+  return navimpact::test::errorOf([&] { an::runReplay(c); });
 }
 
 }  // namespace

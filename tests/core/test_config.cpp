@@ -17,15 +17,7 @@ namespace limits = navimpact::limits;
 
 namespace {
 
-template <class F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using navimpact::test::errorOf;
 
 ConfigNode doc(const std::string& text) { return ConfigNode::parse(text, "cfg.yaml"); }
 

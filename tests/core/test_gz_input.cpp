@@ -19,19 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string gz(const std::string& text, int level = 6) {
-  std::string out(compressBound(static_cast<uLong>(text.size())) + 64, '\0');
-  z_stream s{};
-  deflateInit2(&s, level, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
-  s.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(text.data()));
-  s.avail_in = static_cast<uInt>(text.size());
-  s.next_out = reinterpret_cast<Bytef*>(out.data());
-  s.avail_out = static_cast<uInt>(out.size());
-  deflate(&s, Z_FINISH);
-  out.resize(s.total_out);
-  deflateEnd(&s);
-  return out;
-}
+std::string gz(const std::string& text, int level = 6) { return test::gzipBytes(text, level); }
 
 std::string write(const std::string& name, const std::string& bytes) {
   const auto p = (test::tempDir() / name).string();
@@ -47,14 +35,7 @@ std::string readAll(const std::string& path) {
   return out;
 }
 
-std::string message(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::errorOf;
 
 std::string randomText(std::size_t n, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
@@ -81,10 +62,10 @@ TEST(GzInput, PlainGzipAndMultiMemberGiveTheSameBytes) {
 TEST(GzInput, TrailingGarbageIsAnError) {
   const std::string text = randomText(5000, 2);
   const auto p = write("tail.gz", gz(text) + "garbage!");
-  const std::string m = message([&] { readAll(p); });
+  const std::string m = errorOf([&] { readAll(p); });
   EXPECT_NE(m.find(p), std::string::npos) << m;
   EXPECT_NE(m.find("8 bytes of trailing garbage after the gzip data"), std::string::npos) << m;
-  EXPECT_NE(message([&] { readAll(write("tail1.gz", gz(text) + "x")); }).find("trailing garbage"), std::string::npos);
+  EXPECT_NE(errorOf([&] { readAll(write("tail1.gz", gz(text) + "x")); }).find("trailing garbage"), std::string::npos);
 }
 
 TEST(GzInput, TruncatedAndCorruptGzipAreErrors) {
@@ -95,14 +76,14 @@ TEST(GzInput, TruncatedAndCorruptGzipAreErrors) {
   for (int k = 0; k < 20; ++k) {
     const std::size_t cut = 2 + rng() % (z.size() - 2);
     const auto p = write("cut" + std::to_string(k) + ".gz", z.substr(0, cut));
-    const std::string m = message([&] { readAll(p); });
+    const std::string m = errorOf([&] { readAll(p); });
     EXPECT_TRUE(m.find("truncated gzip data") != std::string::npos || m.find("corrupt gzip data") != std::string::npos)
         << "cut at " << cut << ": " << m;
   }
   // A flipped byte in the deflate data or the CRC: corrupt.
   std::string bad = z;
   bad[bad.size() - 6] ^= 0x55;  // inside the CRC-32 of the trailer
-  EXPECT_NE(message([&] { readAll(write("crc.gz", bad)); }).find("corrupt gzip data"), std::string::npos);
+  EXPECT_NE(errorOf([&] { readAll(write("crc.gz", bad)); }).find("corrupt gzip data"), std::string::npos);
 }
 
 TEST(LineReader, CapsTheLineLengthAndNamesTheLine) {
@@ -114,7 +95,7 @@ TEST(LineReader, CapsTheLineLengthAndNamesTheLine) {
   EXPECT_EQ(l, "a,b");
   ASSERT_TRUE(r.next(l));
   EXPECT_EQ(l, "1,2");
-  const std::string m = message([&] { r.next(l); });
+  const std::string m = errorOf([&] { r.next(l); });
   EXPECT_NE(m.find(p + ":3: line longer than 4096 bytes"), std::string::npos) << m;
 }
 
@@ -134,7 +115,7 @@ TEST(CsvReader, OneLineFileOfManyMegabytesIsRefusedWithinTheLineCap) {
   o.rate_hz = 100.0;
   o.gyro_unit = "rad/s";
   o.acc_unit = "m/s2";
-  const std::string m = message([&] { readImuCsv(p, o); });
+  const std::string m = errorOf([&] { readImuCsv(p, o); });
   EXPECT_NE(m.find(":2: line longer than 1048576 bytes"), std::string::npos) << m;
   EXPECT_LT(m.size(), 300u);
 }

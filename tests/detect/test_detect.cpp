@@ -20,6 +20,7 @@
 #include "navimpact/detect/null_model.hpp"
 #include "navimpact/detect/outliers.hpp"
 #include "navimpact/stochastic/simulate.hpp"
+#include "test_support.hpp"
 
 namespace nd = navimpact::detect;
 namespace ns = navimpact::stochastic;
@@ -29,15 +30,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 int runs(int dflt) {
-  if (const char* e = std::getenv("NAVIMPACT_DETECT_RUNS")) return std::max(10, std::atoi(e));
-  return dflt;
+  return std::max(10, static_cast<int>(navimpact::test::envOr("NAVIMPACT_DETECT_RUNS", static_cast<std::uint64_t>(dflt))));
 }
 
-std::uint64_t rootSeed() {
-  std::uint64_t s = 20261124;
-  if (const char* e = std::getenv("NAVIMPACT_DETECT_SEED")) s = std::strtoull(e, nullptr, 10);
-  return s;
-}
+std::uint64_t rootSeed() { return navimpact::test::envOr("NAVIMPACT_DETECT_SEED", 20261124); }
 
 /// A random null model: white noise plus, with equal odds, nothing, a GM
 /// (T from 2 samples to n/5) or a random walk, with random strengths.

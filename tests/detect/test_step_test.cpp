@@ -25,17 +25,14 @@
 #include "navimpact/stochastic/block_likelihood.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
+#include "test_support.hpp"
 
 namespace nd = navimpact::detect;
 namespace ns = navimpact::stochastic;
 
 namespace {
 
-std::uint64_t rootSeed() {
-  std::uint64_t s = 20261125;
-  if (const char* e = std::getenv("NAVIMPACT_DETECT_SEED")) s = std::strtoull(e, nullptr, 10);
-  return s;
-}
+std::uint64_t rootSeed() { return navimpact::test::envOr("NAVIMPACT_DETECT_SEED", 20261125); }
 
 struct Drawn {
   ns::Model model;

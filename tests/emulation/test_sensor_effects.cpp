@@ -73,14 +73,7 @@ std::array<std::vector<double>, 6> randomErrors(std::size_t n, std::uint64_t see
   return e;
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const navimpact::Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using navimpact::test::errorOf;
 
 }  // namespace
 

@@ -39,14 +39,7 @@ emu::StaticRecordingSpec adis() {
   return s;
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const navimpact::Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using navimpact::test::errorOf;
 
 // A trajectory at rest (level, heading east) for GNSS/baro checks.
 emu::SmoothTrajectory rest(double dur) {

@@ -17,12 +17,7 @@ std::string writeCsv(const std::string& name, const std::string& body) {
   return p.string();
 }
 std::string errorOf(const emu::TrajectorySpec& s) {
-  try {
-    emu::readTrajectoryCsv(s);
-  } catch (const navimpact::Error& e) {
-    return e.what();
-  }
-  return "";
+  return navimpact::test::errorOf([&] { emu::readTrajectoryCsv(s); });
 }
 emu::TrajectorySpec nedSpec(const std::string& file) {
   emu::TrajectorySpec s;

@@ -43,19 +43,7 @@ void spit(const std::string& path, const std::string& bytes) { std::ofstream(pat
 
 std::string gunzip(const std::string& path) { return readFileMaybeGz(path); }
 
-std::string gzip(const std::string& text) {
-  std::string out(compressBound(static_cast<uLong>(text.size())) + 64, '\0');
-  z_stream s{};
-  deflateInit2(&s, 1, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
-  s.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(text.data()));
-  s.avail_in = static_cast<uInt>(text.size());
-  s.next_out = reinterpret_cast<Bytef*>(out.data());
-  s.avail_out = static_cast<uInt>(out.size());
-  deflate(&s, Z_FINISH);
-  out.resize(s.total_out);
-  deflateEnd(&s);
-  return out;
-}
+std::string gzip(const std::string& text) { return test::gzipBytes(text, 1); }
 
 std::string headLines(const std::string& text, int n) {
   std::size_t p = 0;
@@ -63,10 +51,7 @@ std::string headLines(const std::string& text, int n) {
   return p == std::string::npos ? text : text.substr(0, p + 1);
 }
 
-std::uint64_t envOr(const char* name, std::uint64_t def) {
-  const char* v = std::getenv(name);
-  return v && *v ? std::strtoull(v, nullptr, 10) : def;
-}
+using test::envOr;
 
 /// Seeds per target (decompressed bytes for rawlogs: the harness compresses).
 std::map<std::string, std::vector<std::string>> seeds(const fs::path& dir) {

@@ -18,20 +18,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string message(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::errorOf;
 
 std::string bad(const std::string& name) { return test::sourcePath("tests/data/bad/" + name); }
 
 void expectBoth(const std::string& path, const std::string& label, const std::vector<std::string>& parts) {
   for (int reader = 0; reader < 2; ++reader) {
-    const std::string m = message([&] {
+    const std::string m = errorOf([&] {
       if (reader == 0) rawlog::readImuRawlog(path, label);
       else rawlog::readRawlog(path);
     });

@@ -22,16 +22,7 @@ std::string write(const std::string& name, const std::string& text) {
   return p.string();
 }
 
-template <class F>
-std::string errorOf(F f) {
-  try {
-    f();
-  } catch (const navimpact::Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no navimpact::Error thrown";
-  return "";
-}
+using navimpact::test::errorOf;
 }  // namespace
 
 TEST(ModelFile, Table1HasTheEightModelsAndRef) {

@@ -5,21 +5,12 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/stochastic/model_text.hpp"
+#include "test_support.hpp"
 
 using namespace navimpact::stochastic;
 
 namespace {
-/// Message of the Error thrown by f (fails the test if none is thrown).
-template <class F>
-std::string errorOf(F f) {
-  try {
-    f();
-  } catch (const navimpact::Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no navimpact::Error thrown";
-  return "";
-}
+using navimpact::test::errorOf;
 std::string parseError(const std::string& text) {
   return errorOf([&] { parseTerms(text, 200.0); });
 }

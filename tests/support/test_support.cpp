@@ -1,6 +1,9 @@
 #include "test_support.hpp"
 
+#include <zlib.h>
+
 #include <atomic>
+#include <cstdlib>
 
 namespace fs = std::filesystem;
 
@@ -29,6 +32,25 @@ fs::path tempDir() {
   fs::remove_all(p);
   fs::create_directories(p);
   return p;
+}
+
+std::string gzipBytes(const std::string& text, int level) {
+  std::string out(compressBound(static_cast<uLong>(text.size())) + 64, '\0');
+  z_stream s{};
+  deflateInit2(&s, level, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
+  s.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(text.data()));
+  s.avail_in = static_cast<uInt>(text.size());
+  s.next_out = reinterpret_cast<Bytef*>(out.data());
+  s.avail_out = static_cast<uInt>(out.size());
+  deflate(&s, Z_FINISH);
+  out.resize(s.total_out);
+  deflateEnd(&s);
+  return out;
+}
+
+std::uint64_t envOr(const char* name, std::uint64_t dflt) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::strtoull(v, nullptr, 10) : dflt;
 }
 
 }  // namespace navimpact::test

@@ -3,8 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
+
+#include "navimpact/core/error.hpp"
 
 namespace navimpact::test {
 
@@ -18,6 +21,25 @@ std::string sourcePath(const std::string& rel);
 std::string dataPath(const std::string& rel);
 /// Fresh, empty temporary directory unique to the calling test.
 std::filesystem::path tempDir();
+
+/// The message of the navimpact::Error that @p f throws, or "(no error)" when
+/// it returns (any other exception passes through and fails the test).
+template <class F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const navimpact::Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+/// @p text as one gzip member at zlib @p level (0 = stored .. 9).
+std::string gzipBytes(const std::string& text, int level = 6);
+
+/// The unsigned integer in the environment variable @p name, or @p dflt when
+/// it is unset or empty (seeds and run counts a user may override).
+std::uint64_t envOr(const char* name, std::uint64_t dflt);
 
 }  // namespace navimpact::test
 
