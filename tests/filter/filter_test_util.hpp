@@ -4,13 +4,15 @@
 #include <random>
 #include <vector>
 
+#include "../ins/ins_test_util.hpp"
 #include "navimpact/filter/ekf.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 
 namespace ftest {
 
 using namespace navimpact;
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using instest::kDeg;
+using instest::navState;
 
 /// Same model on the three axes of each sensor ("" = perfect sensor).
 inline stochastic::ImuModel model(const std::vector<stochastic::Process>& gyro,
@@ -24,14 +26,7 @@ inline stochastic::ImuModel model(const std::vector<stochastic::Process>& gyro,
   return m;
 }
 
-inline ins::NavState staticState() {
-  ins::NavState x;
-  x.lat = 46.57 * kDeg;
-  x.lon = 7.65 * kDeg;
-  x.h = 550.0;
-  x.setRollPitchYaw(2.0 * kDeg, -1.5 * kDeg, 60.0 * kDeg);
-  return x;
-}
+inline ins::NavState staticState() { return navState(46.57, 7.65, 550.0, Eigen::Vector3d::Zero(), 2.0, -1.5, 60.0); }
 
 /// Perfect rates of a vehicle at rest (f_B = -C_NtoB g_N, w_IB_B = C_NtoB w_IE_N).
 inline void staticRates(const ins::NavState& x, Eigen::Vector3d& w_B, Eigen::Vector3d& f_B) {

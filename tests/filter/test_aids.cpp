@@ -21,15 +21,7 @@ using Eigen::VectorXd;
 
 namespace {
 
-ins::NavState movingState() {
-  ins::NavState x;
-  x.lat = -33.9 * kDeg;
-  x.lon = 151.2 * kDeg;
-  x.h = 80.0;
-  x.v_N = Vector3d(12.0, -7.0, 0.4);
-  x.setRollPitchYaw(4.0 * kDeg, -3.0 * kDeg, -150.0 * kDeg);
-  return x;
-}
+ins::NavState movingState() { return navState(-33.9, 151.2, 80.0, Vector3d(12.0, -7.0, 0.4), 4.0, -3.0, -150.0); }
 const Vector3d kW(0.02, -0.04, 0.25);  // body rate [rad/s]
 const Vector3d kF(0.9, 1.3, -9.6);     // specific force [m/s^2]
 

@@ -12,6 +12,7 @@
 
 #include "filter_test_util.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/emulation/perfect_imu.hpp"
 #include "navimpact/emulation/trajectory.hpp"
 #include "navimpact/filter/alignment.hpp"
 
@@ -191,18 +192,6 @@ emulation::SmoothTrajectory makeTrajectory(const Scenario& sc) {
   return emulation::SmoothTrajectory(s, so);
 }
 
-ins::NavState truthAt(const emulation::SmoothTrajectory& tr, double t) {
-  const emulation::TruthState ts = tr.at(t);
-  ins::NavState x;
-  x.t = t;
-  x.lat = ts.pos.lat;
-  x.lon = ts.pos.lon;
-  x.h = ts.pos.h;
-  x.v_N = ts.v_N;
-  x.q_BtoN = Eigen::Quaterniond(ts.C_BtoN);
-  return x;
-}
-
 struct AlignOutcome {
   bool done = false;
   filter::Vector9d err, sigma;
@@ -251,7 +240,7 @@ AlignOutcome runAligner(const Scenario& sc, filter::AlignmentOptions opt, double
   out.done = al.done();
   if (!out.done) return out;
   out.rep = al.report();
-  out.err = filter::navError(al.state(), truthAt(tr, al.state().t));
+  out.err = filter::navError(al.state(), emulation::truthNavState(tr, al.state().t));
   out.sigma = al.P0().diagonal().cwiseSqrt();
   return out;
 }

@@ -19,15 +19,7 @@ using Eigen::Vector3d;
 using P = stochastic::Process;
 
 namespace {
-ins::NavState movingState() {
-  ins::NavState x;
-  x.lat = -33.9 * kDeg;
-  x.lon = 151.2 * kDeg;
-  x.h = 300.0;
-  x.v_N = Vector3d(-40.0, 25.0, -2.0);
-  x.setRollPitchYaw(-8.0 * kDeg, 5.0 * kDeg, -100.0 * kDeg);
-  return x;
-}
+ins::NavState movingState() { return navState(-33.9, 151.2, 300.0, Vector3d(-40.0, 25.0, -2.0), -8.0, 5.0, -100.0); }
 }  // namespace
 
 // Series Phi is second order (error O(dt^3)), series Qd third order (error

@@ -17,15 +17,7 @@ using Eigen::VectorXd;
 namespace {
 
 // A moving, turning, accelerating vehicle: every F term is exercised.
-ins::NavState movingState() {
-  ins::NavState x;
-  x.lat = 46.57 * kDeg;
-  x.lon = 7.65 * kDeg;
-  x.h = 1200.0;
-  x.v_N = Vector3d(35.0, -22.0, 3.0);
-  x.setRollPitchYaw(12.0 * kDeg, -7.0 * kDeg, 130.0 * kDeg);
-  return x;
-}
+ins::NavState movingState() { return navState(46.57, 7.65, 1200.0, Vector3d(35.0, -22.0, 3.0), 12.0, -7.0, 130.0); }
 const Vector3d kW(0.05, -0.03, 0.12);   // body rate [rad/s]
 const Vector3d kF(1.5, -0.8, -9.2);     // specific force [m/s^2]
 

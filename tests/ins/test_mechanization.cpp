@@ -7,22 +7,16 @@
 #include <iostream>
 #include <random>
 
+#include "ins_test_util.hpp"
 #include "navimpact/ins/mechanization.hpp"
 #include "navimpact/core/error.hpp"
 
 using namespace navimpact;
 using Eigen::Vector3d;
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using instest::kDeg;
 
 namespace {
-ins::NavState restState() {
-  ins::NavState x;
-  x.lat = 46.57 * kDeg;
-  x.lon = 7.65 * kDeg;
-  x.h = 550.0;
-  x.setRollPitchYaw(3.0 * kDeg, -2.0 * kDeg, 130.0 * kDeg);
-  return x;
-}
+ins::NavState restState() { return instest::navState(46.57, 7.65, 550.0, Vector3d::Zero(), 3.0, -2.0, 130.0); }
 }  // namespace
 
 // Required by issue 3: one hour at 200 Hz of perfect static IMU data.
