@@ -100,6 +100,15 @@ Eigen::VectorXd wvOf(const Layout& L, const Eigen::VectorXd& th, const Eigen::Ve
   return nu;
 }
 
+Eigen::MatrixXd pinvSym(const Eigen::MatrixXd& M) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (M + M.transpose()));
+  const Eigen::VectorXd ev = es.eigenvalues();
+  const double tol = 1e-12 * std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
+  Eigen::VectorXd inv(ev.size());
+  for (Eigen::Index i = 0; i < ev.size(); ++i) inv[i] = std::fabs(ev[i]) > tol ? 1.0 / ev[i] : 0.0;
+  return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+}
+
 }  // namespace detail
 
 namespace {
@@ -107,6 +116,7 @@ namespace {
 using detail::Jet;
 using detail::kMaxParams;
 using detail::Layout;
+using detail::pinvSym;
 
 /**
  * Weights of the objective: residuals r = diag(d) (nu_hat - nu) or, when the
@@ -905,15 +915,6 @@ int reweight(const Layout& L, Eigen::VectorXd& th, Data& d, const FitOptions& op
     if (change < 1e-3) break;
   }
   return done;
-}
-
-Eigen::MatrixXd pinvSym(const Eigen::MatrixXd& M) {
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (M + M.transpose()));
-  const Eigen::VectorXd ev = es.eigenvalues();
-  const double tol = 1e-12 * std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
-  Eigen::VectorXd inv(ev.size());
-  for (Eigen::Index i = 0; i < ev.size(); ++i) inv[i] = std::fabs(ev[i]) > tol ? 1.0 / ev[i] : 0.0;
-  return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
 }
 
 /// Names and back-transformed values of the parameters of term i.

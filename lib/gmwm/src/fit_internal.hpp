@@ -139,5 +139,7 @@ Eigen::VectorXd fromModel(const Layout& L, const Model& m);
 Eigen::MatrixXd jacobian(const Layout& L, const Eigen::VectorXd& th, const Eigen::VectorXd& tau);
 /// Model WV nu(theta).
 Eigen::VectorXd wvOf(const Layout& L, const Eigen::VectorXd& th, const Eigen::VectorXd& tau);
+/// Pseudo-inverse of the symmetric part of @p M (eigenvalues below 1e-12 of the largest dropped).
+Eigen::MatrixXd pinvSym(const Eigen::MatrixXd& M);
 
 }  // namespace navimpact::gmwm::detail

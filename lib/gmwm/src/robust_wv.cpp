@@ -202,16 +202,7 @@ WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rat
     throw Error("robust wavelet variance: efficiency must be in (0, 1), got " + std::to_string(eff));
   detail::checkSeries(x, n);
   const int J = detail::maxLevel(n);
-  WaveletVariance r;
-  r.tau.resize(J);
-  r.wv.resize(J);
-  r.ci_low.resize(J);
-  r.ci_high.resize(J);
-  r.n_coef.resize(J);
-  r.eta.resize(J);
-  r.rate_hz = rate_hz;
-  r.n = n;
-  r.robust = true;
+  WaveletVariance r = detail::sizedWv(J, rate_hz, n, true);
   r.eff = eff;
   const double c = biweightConstant(eff);
   const double a = consistencyA(c);

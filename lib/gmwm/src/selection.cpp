@@ -22,15 +22,6 @@ using stochastic::ProcessKind;
 
 namespace {
 
-Eigen::MatrixXd pinvSym(const Eigen::MatrixXd& M) {
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (M + M.transpose()));
-  const Eigen::VectorXd ev = es.eigenvalues();
-  const double tol = 1e-12 * std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
-  Eigen::VectorXd inv(ev.size());
-  for (Eigen::Index i = 0; i < ev.size(); ++i) inv[i] = std::fabs(ev[i]) > tol ? 1.0 / ev[i] : 0.0;
-  return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
-}
-
 std::vector<ProcessKind> kindsOf(const Model& m) {
   std::vector<ProcessKind> k;
   for (const auto& t : m.terms) k.push_back(t.kind);
@@ -93,7 +84,7 @@ double optimism(const FitResult& f, const WaveletVariance& wv) {
   }
   D = 0.5 * (D + D.transpose());
   // Hessian of the objective / 2 = B + D; d theta_hat / d nu_hat = (B + D)^+ A' Omega.
-  const Eigen::MatrixXd dTheta = pinvSym(B + D) * A.transpose() * om.asDiagonal();
+  const Eigen::MatrixXd dTheta = detail::pinvSym(B + D) * A.transpose() * om.asDiagonal();
   const Eigen::MatrixXd S = A * dTheta;  // d nu(theta_hat) / d nu_hat
   double tr = 0;
   for (int j = 0; j < J; ++j) tr += S(j, j) * V[j] * om[j];

@@ -263,6 +263,20 @@ std::vector<long double> haarModwtSumSquares(const double* x, std::size_t n, int
   return ss;
 }
 
+WaveletVariance sizedWv(int J, double rate_hz, std::size_t n, bool robust) {
+  WaveletVariance r;
+  r.tau.resize(J);
+  r.wv.resize(J);
+  r.ci_low.resize(J);
+  r.ci_high.resize(J);
+  r.n_coef.resize(J);
+  r.eta.resize(J);
+  r.rate_hz = rate_hz;
+  r.n = n;
+  r.robust = robust;
+  return r;
+}
+
 }  // namespace detail
 
 Eigen::VectorXd WaveletVariance::weights() const {
@@ -290,16 +304,7 @@ WaveletVariance waveletVariance(const double* x, std::size_t n, double rate_hz, 
                 std::to_string(Jmax) + " for " + std::to_string(n) + " samples");
   const int J = max_j == 0 ? Jmax : max_j;
 
-  WaveletVariance r;
-  r.tau.resize(J);
-  r.wv.resize(J);
-  r.ci_low.resize(J);
-  r.ci_high.resize(J);
-  r.n_coef.resize(J);
-  r.eta.resize(J);
-  r.rate_hz = rate_hz;
-  r.n = n;
-  r.robust = false;
+  WaveletVariance r = detail::sizedWv(J, rate_hz, n, false);
   const std::vector<long double> ss = detail::haarModwtSumSquares(x, n, J);
   for (int i = 0; i < J; ++i) {
     const double tau = std::ldexp(1.0, i + 1);

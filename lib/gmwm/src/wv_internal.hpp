@@ -5,7 +5,13 @@
 #include <functional>
 #include <vector>
 
+#include "navimpact/gmwm/wavelet_variance.hpp"
+
 namespace navimpact::gmwm::detail {
+
+/// A WV of @p J scales with every per-scale vector sized (values to fill),
+/// the rate, the samples used and whether it is the robust estimator.
+WaveletVariance sizedWv(int J, double rate_hz, std::size_t n, bool robust);
 
 /// Largest J with 2^J <= n (floor(log2 n)).
 int maxLevel(std::size_t n);
