@@ -102,4 +102,7 @@ void checkTau(double tau);
 /// The definition of a kind.
 const KindDef& kindDef(ProcessKind k);
 
+/// @p a equals @p b ignoring ASCII case (process names and keys).
+bool iequals(const std::string& a, const char* b);
+
 }  // namespace navimpact::stochastic::detail

@@ -44,15 +44,6 @@ const std::vector<TermSpec>& specs() {
   return all;
 }
 
-bool iequals(const std::string& a, const char* b) {
-  std::size_t i = 0;
-  for (; i < a.size() && b[i]; ++i)
-    if (std::toupper(static_cast<unsigned char>(a[i])) !=
-        std::toupper(static_cast<unsigned char>(b[i])))
-      return false;
-  return i == a.size() && b[i] == '\0';
-}
-
 std::string namesList() {
   std::string s;
   for (const auto& sp : specs()) {
@@ -164,7 +155,7 @@ Process parseTerm(Parser& P, double rate_hz) {
   if (name.empty()) P.failHere("a process name (" + namesList() + ")");
   const TermSpec* spec = nullptr;
   for (const auto& sp : specs())
-    if (iequals(name, sp.name)) spec = &sp;
+    if (detail::iequals(name, sp.name)) spec = &sp;
   if (!spec) P.fail(name_pos, "a process name (" + namesList() + ")", "'" + printable(name, 40) + "'");
   const int nkeys = static_cast<int>(spec->keys.size());
 
@@ -186,7 +177,7 @@ Process parseTerm(Parser& P, double rate_hz) {
     if (key.empty()) P.failHere("a key (" + keylist + ") of " + spec->name);
     int idx = -1;
     for (int k = 0; k < nkeys; ++k)
-      if (iequals(key, spec->keys[k])) idx = k;
+      if (detail::iequals(key, spec->keys[k])) idx = k;
     if (idx < 0)
       P.fail(key_pos, "a key of " + std::string(spec->name) + " (" + keylist + ")",
              "unknown key '" + printable(key, 40) + "'");
@@ -241,7 +232,7 @@ std::vector<Process> parseTerms(const std::string& text, double rate_hz) {
     // "none" (alone) = no error.
     Parser Q(text, "model");
     const std::string id = Q.identifier();
-    if (iequals(id, "none")) {
+    if (detail::iequals(id, "none")) {
       if (!Q.atEnd()) Q.failHere("end of text after 'none'");
       return terms;
     }

@@ -23,6 +23,8 @@ const std::vector<const KindDef*>& defs() {
   return d;
 }
 
+}  // namespace
+
 bool iequals(const std::string& a, const char* b) {
   std::size_t i = 0;
   for (; i < a.size() && b[i]; ++i)
@@ -31,8 +33,6 @@ bool iequals(const std::string& a, const char* b) {
       return false;
   return i == a.size() && b[i] == '\0';
 }
-
-}  // namespace
 
 const KindDef& kindDef(ProcessKind k) {
   const auto i = static_cast<std::size_t>(k);
