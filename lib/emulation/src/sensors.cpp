@@ -200,22 +200,27 @@ void BaroSimulator::next(double t_until, std::vector<BaroSample>& out) {
   }
 }
 
+namespace {
+
+/// Every record of a block simulator in one block.
+template <class Record, class Simulator>
+std::vector<Record> allRecords(Simulator&& s) {
+  std::vector<Record> out;
+  out.reserve(s.size());
+  s.next(std::numeric_limits<double>::infinity(), out);
+  return out;
+}
+
+}  // namespace
+
 std::vector<GnssFix> simulateGnss(const SmoothTrajectory& tr, const GnssOptions& opt, double t_start,
                                   double t_end) {
-  GnssSimulator g(tr, opt, t_start, t_end);
-  std::vector<GnssFix> out;
-  out.reserve(g.size());
-  g.next(std::numeric_limits<double>::infinity(), out);
-  return out;
+  return allRecords<GnssFix>(GnssSimulator(tr, opt, t_start, t_end));
 }
 
 std::vector<BaroSample> simulateBaro(const SmoothTrajectory& tr, const BaroOptions& opt, double t_start,
                                      double t_end) {
-  BaroSimulator b(tr, opt, t_start, t_end);
-  std::vector<BaroSample> out;
-  out.reserve(b.size());
-  b.next(std::numeric_limits<double>::infinity(), out);
-  return out;
+  return allRecords<BaroSample>(BaroSimulator(tr, opt, t_start, t_end));
 }
 
 }  // namespace navimpact::emulation
