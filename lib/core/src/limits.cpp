@@ -1,18 +1,14 @@
 #include "navimpact/core/limits.hpp"
 
 #include <cmath>
-#include <cstdio>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::limits {
 
 namespace {
-std::string g(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
+std::string g(double v) { return formatNumber(v, 6); }  // %g
 }  // namespace
 
 std::string describe(const Range& r) {

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "navimpact/core/format.hpp"
+
 namespace navimpact::plot::detail {
 
 double niceStep(double raw) {
@@ -72,11 +74,7 @@ std::vector<Tick> linearTicks(double lo, double hi, int maxTicks) {
 }
 
 namespace {
-std::string plainDecimal(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
+std::string plainDecimal(double v) { return formatNumber(v, 10); }
 }  // namespace
 
 std::vector<Tick> logTicks(double lo, double hi, int labelStride, bool withMinor,
