@@ -52,14 +52,8 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
   if (!(spec.max_gap_s > 0.0)) throw keyError(path, "trajectory.max_gap_s", "must be > 0");
 
   LineReader reader(path);  // streamed, lines of at most 1 MiB
-  std::size_t lineNo = 0;
-  auto nextLine = [&](std::string_view& line) {
-    if (!reader.next(line)) return false;
-    lineNo = reader.lineNo();
-    return true;
-  };
   std::string_view headerView;
-  if (!nextLine(headerView) || trim(headerView).empty()) throw fileError(path, 1, "empty file, expected a header line");
+  if (!reader.next(headerView) || trim(headerView).empty()) throw fileError(path, 1, "empty file, expected a header line");
   const std::string headerText(headerView);
   const std::string_view header(headerText);
   const auto names = splitView(header, ',');
@@ -84,32 +78,32 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
   rows.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(reader.input().statedSize() / 60, 1u << 24)));
   std::vector<std::size_t> lines;
   std::string_view line;
-  while (nextLine(line)) {
+  while (reader.next(line)) {
     if (trim(line).empty()) continue;
     const auto f = splitView(line, ',');
     if (f.size() != names.size())
-      throw fileError(path, lineNo, "expected " + std::to_string(names.size()) + " fields, found " +
+      throw fileError(path, reader.lineNo(), "expected " + std::to_string(names.size()) + " fields, found " +
                                         std::to_string(f.size()));
     std::array<double, 7> r{};
     for (int k = 0; k < 7; ++k) {
       if (!parseDouble(trim(f[idx[k]]), r[k]))
-        throw fileError(path, lineNo, "column '" + want[k] + "': '" + printable(f[idx[k]]) + "' is not a number");
+        throw fileError(path, reader.lineNo(), "column '" + want[k] + "': '" + printable(f[idx[k]]) + "' is not a number");
       if (!std::isfinite(r[k]))
-        throw fileError(path, lineNo, "column '" + want[k] + "': value is NaN or infinite");
+        throw fileError(path, reader.lineNo(), "column '" + want[k] + "': value is NaN or infinite");
     }
     r[0] *= kT;
     if (!rows.empty()) {
       const double dt = r[0] - rows.back()[0];
-      if (dt == 0.0) throw fileError(path, lineNo, "time " + std::to_string(r[0]) + " s repeats the previous line");
-      if (dt < 0.0) throw fileError(path, lineNo, "time goes backwards (" + std::to_string(rows.back()[0]) +
+      if (dt == 0.0) throw fileError(path, reader.lineNo(), "time " + std::to_string(r[0]) + " s repeats the previous line");
+      if (dt < 0.0) throw fileError(path, reader.lineNo(), "time goes backwards (" + std::to_string(rows.back()[0]) +
                                                       " s then " + std::to_string(r[0]) + " s)");
       if (dt > spec.max_gap_s)
-        throw fileError(path, lineNo, "gap of " + std::to_string(dt) + " s before this line exceeds max_gap_s = " +
+        throw fileError(path, reader.lineNo(), "gap of " + std::to_string(dt) + " s before this line exceeds max_gap_s = " +
                                           std::to_string(spec.max_gap_s) + " s that the smoothing spline may bridge");
     }
     if (spec.start_s && r[0] < *spec.start_s) { rows.push_back(r); lines.push_back(0); continue; }
     rows.push_back(r);
-    lines.push_back(lineNo);
+    lines.push_back(reader.lineNo());
   }
   // window
   std::size_t first = 0, last = rows.size();

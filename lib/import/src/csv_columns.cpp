@@ -26,24 +26,18 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
   // Streamed (lines of at most 1 MiB, plain or gzip): memory is the columns
   // kept, not the file's text (a 10^6-row IMU file is ~70 MB of text).
   LineReader reader(path);
-  std::size_t lineNo = 0;
-  auto nextLine = [&](std::string_view& line) {
-    if (!reader.next(line)) return false;
-    lineNo = reader.lineNo();
-    return true;
-  };
 
   // --- header ---------------------------------------------------------------
   std::string_view header;
   bool found = false;
-  while (nextLine(header)) {
+  while (reader.next(header)) {
     const auto t = trim(header);
     if (t.empty() || t.front() == '#') continue;
     found = true;
     break;
   }
   if (!found) throw fileError(path, 0, "file is empty (expected a header line naming the columns)");
-  const std::size_t headerLine = lineNo;
+  const std::size_t headerLine = reader.lineNo();
   const std::string headerText(header);  // the reader's buffer moves on
   header = headerText;
   const auto names = splitView(header, delimiter);
@@ -90,7 +84,7 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
     t.line.reserve(approx);
   }
   std::string_view line;
-  while (nextLine(line)) {
+  while (reader.next(line)) {
     if (trim(line).empty()) continue;
     std::size_t c = 0, start = 0;
     for (;; ++c) {
@@ -98,7 +92,7 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
       const bool last = cut == std::string_view::npos;
       if (last) cut = line.size();
       if (c >= ncol)
-        throw fileError(path, lineNo, "more fields than the " + std::to_string(ncol) + " header columns");
+        throw fileError(path, reader.lineNo(), "more fields than the " + std::to_string(ncol) + " header columns");
       if (slot[c] >= 0) {
         const ColumnRequest& rq = req[slot[c]];
         const std::string_view field = line.substr(start, cut - start);
@@ -107,11 +101,11 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
           if (rq.allow_empty && trim(field).empty()) {
             v = NAN;
           } else {
-            throw fileError(path, lineNo, "column '" + printable(rq.name) + "' (key " + rq.key + "): '" +
+            throw fileError(path, reader.lineNo(), "column '" + printable(rq.name) + "' (key " + rq.key + "): '" +
                                               printable(field) + "' is not a number");
           }
         } else if (!std::isfinite(v)) {
-          throw fileError(path, lineNo, "column '" + printable(rq.name) + "' (key " + rq.key + "): value is " +
+          throw fileError(path, reader.lineNo(), "column '" + printable(rq.name) + "' (key " + rq.key + "): value is " +
                                             printable(trim(field)) + " (finite numbers only)");
         }
         byCol[c].push_back(v);
@@ -120,9 +114,9 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
       start = cut + 1;
     }
     if (c + 1 != ncol)
-      throw fileError(path, lineNo, "missing fields: " + std::to_string(c + 1) + " of the " + std::to_string(ncol) +
+      throw fileError(path, reader.lineNo(), "missing fields: " + std::to_string(c + 1) + " of the " + std::to_string(ncol) +
                                         " header columns");
-    t.line.push_back(static_cast<std::uint32_t>(lineNo));
+    t.line.push_back(static_cast<std::uint32_t>(reader.lineNo()));
   }
   if (t.line.empty()) throw fileError(path, headerLine, "no data rows after the header");
   t.columns.resize(req.size());
