@@ -11,6 +11,12 @@
 #                          [JSON path=regex ...] [FILES f ...])
 #        runs the check `name` below with the variables given (NI is always
 #        set; ARGS becomes one '|'-separated string, JSON and FILES lists);
+#      navimpact_cli_case("a|b|c" va vb vc)
+#        the '|'-separated fields of one case of a table of cases into va, vb, ...;
+#      navimpact_cli_uav_scenario(FILE END_S SEED [EXTRA])
+#        writes an emulation configuration of the committed UAV flight's first
+#        END_S seconds (reference model; IMU, GNSS, baro seeds SEED, SEED+1,
+#        SEED+2) with the YAML text EXTRA after it;
 #  - run as a script, `cmake -DCHECK=name -DVAR=value ... -P cli_helpers.cmake`,
 #    it runs the check function check_<name>() defined below.
 # Command arguments travel as one '|'-separated string (';' would be split by
@@ -54,6 +60,27 @@ if(NOT CMAKE_SCRIPT_MODE_FILE)
     add_test(NAME ${name}
              COMMAND ${CMAKE_COMMAND} -DCHECK=${C_CHECK} -DNI=${NI} ${_defs} -P ${NAVIMPACT_CLI_HELPERS})
   endfunction()
+
+  function(navimpact_cli_case case)
+    string(REPLACE "|" ";" _fields "${case}")
+    set(_i 0)
+    foreach(_var ${ARGN})
+      list(GET _fields ${_i} _v)
+      set(${_var} "${_v}" PARENT_SCOPE)
+      math(EXPR _i "${_i} + 1")
+    endforeach()
+  endfunction()
+
+  function(navimpact_cli_uav_scenario file end_s seed)
+    math(EXPR _gnss "${seed} + 1")
+    math(EXPR _baro "${seed} + 2")
+    file(WRITE ${file} "
+trajectory: {file: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz, system: geodetic, end_s: ${end_s}}
+imu: {rate_hz: 200, errors: model, model: ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref, seed: ${seed}}
+gnss: {seed: ${_gnss}}
+baro: {seed: ${_baro}}
+${ARGN}")
+  endfunction()
   return()
 endif()
 
@@ -82,6 +109,17 @@ function(require_files dir)
     endif()
   endforeach()
 endfunction()
+
+# Read the JSON file PATH into `j`; its `channels` array must hold N entries
+# (WHAT names the file in the message); `last` is N - 1.
+macro(read_json_channels path n what)
+  file(READ ${path} j)
+  string(JSON _nch LENGTH "${j}" channels)
+  if(NOT _nch EQUAL ${n})
+    fail("${what}: ${_nch} channels, expected ${n}")
+  endif()
+  math(EXPR last "${_nch} - 1")
+endmacro()
 
 function(require_lines file n what)
   file(STRINGS ${file} rows)
@@ -139,12 +177,7 @@ endfunction()
 # fit --structure WN+GM: fit.json has the six channels, each with terms,
 # intervals and the WV; both figures and model.yaml exist. DIR.
 function(check_fit_json)
-  file(READ ${DIR}/fit.json j)
-  string(JSON n LENGTH "${j}" channels)
-  if(NOT n EQUAL 6)
-    fail("fit.json has ${n} channels, expected 6")
-  endif()
-  math(EXPR last "${n} - 1")
+  read_json_channels(${DIR}/fit.json 6 "fit.json")
   foreach(i RANGE ${last})
     string(JSON name GET "${j}" channels ${i} name)
     string(JSON s GET "${j}" channels ${i} structure)
@@ -442,12 +475,7 @@ endfunction()
 # wv --allan on the excerpt into DIR: 6 channels x 18 scales, Allan
 # deviations, SI units, the rate, wv.csv in long format, both figures.
 function(check_wv_json)
-  file(READ ${DIR}/wv.json j)
-  string(JSON nch LENGTH "${j}" channels)
-  if(NOT nch EQUAL 6)
-    fail("wv.json: ${nch} channels, expected 6")
-  endif()
-  math(EXPR last "${nch} - 1")
+  read_json_channels(${DIR}/wv.json 6 "wv.json")
   foreach(c RANGE ${last})
     string(JSON name GET "${j}" channels ${c} name)
     foreach(key tau_s wv ci_low ci_high)
@@ -546,16 +574,11 @@ function(check_diagnose_excerpt)
   run_ni(diagnose --input ${DATA} --rate 100 --gyro-unit deg/s --acc-unit g
          --model fit:WN --simulations 4 --out ${OUT})
   require_files(${OUT} diagnosis.json report.md model_extended.yaml wv_envelope.png)
-  file(READ ${OUT}/diagnosis.json j)
+  read_json_channels(${OUT}/diagnosis.json 6 "diagnosis.json")
   string(JSON verdict GET "${j}" verdict)
   if(NOT verdict STREQUAL "inadequate")
     fail("a white-noise-only model of the ADIS16405 should be inadequate, got ${verdict}")
   endif()
-  string(JSON nch LENGTH "${j}" channels)
-  if(NOT nch EQUAL 6)
-    fail("expected 6 channels, got ${nch}")
-  endif()
-  math(EXPR last "${nch} - 1")
   foreach(c RANGE ${last})
     string(JSON nf LENGTH "${j}" channels ${c} findings)
     if(nf GREATER 0)

@@ -2,13 +2,7 @@
 # --info on its output (when MRPT's apps are installed), and bad input.
 set(_edir ${CMAKE_CURRENT_BINARY_DIR}/emulate_cli)
 file(MAKE_DIRECTORY ${_edir})
-file(WRITE ${_edir}/uav30.yaml "
-trajectory: {file: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz, system: geodetic, end_s: 30}
-imu: {rate_hz: 200, errors: model, model: ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref, seed: 5}
-gnss: {seed: 6}
-baro: {seed: 7}
-ground_truth: {rate_hz: 10}
-")
+navimpact_cli_uav_scenario(${_edir}/uav30.yaml 30 5 "ground_truth: {rate_hz: 10}\n")
 file(WRITE ${_edir}/bad_key.yaml "
 trajectory: {file: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz}
 imu: {rate_hz: 200, errors: none, sede: 5}
@@ -68,10 +62,7 @@ foreach(_case "baro_sigma|imu: {errors: none}\nbaro: {sigma_m: 1e308}|key 'baro.
               "knot_step_tiny|imu: {errors: none}\nsmoothing: {knot_step_s: 1e-308}|key 'smoothing.knot_step_s': cutoff 1 Hz times knot step 1e-308 s is 1e-308, below 0.0002"
               "cutoff_tiny|imu: {errors: none}\nsmoothing: {position_cutoff_hz: 1e-308}|key 'smoothing.position_cutoff_hz': cutoff 1e-308 Hz"
               "knots_finer_than_samples|imu: {errors: none}\nsmoothing: {knot_step_s: 0.0001, position_cutoff_hz: 2, attitude_cutoff_hz: 2}|uav_flight_260s.csv.gz: smoothing spline: knot step 0.0001 s gives 300000 knot intervals for 3001 samples .at most 64 per sample")
-  string(REPLACE "|" ";" _p "${_case}")
-  list(GET _p 0 _n)
-  list(GET _p 1 _body)
-  list(GET _p 2 _re)
+  navimpact_cli_case("${_case}" _n _body _re)
   file(WRITE ${_edir}/range_${_n}.yaml
        "trajectory: {file: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz, end_s: 30}\n${_body}\n")
   navimpact_cli_fail(cli_emulate_range_${_n}
@@ -95,13 +86,7 @@ navimpact_cli_fail(cli_emulate_budget
 # 1 % too much (a scale factor 5x the detection limit of README "Run diagnosis"),
 # then diagnose --run with the model the sensor was emulated with names
 # scale_factor with a significant held-out gain and writes the extension.
-file(WRITE ${_edir}/gyro_scale.yaml "
-trajectory: {file: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz, system: geodetic, end_s: 240}
-imu: {rate_hz: 200, errors: model, model: ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref, seed: 41601}
-gnss: {seed: 41602}
-baro: {seed: 41603}
-effects: {gyro_scale: [0.01, -0.01, 0.01], seed: 41604}
-")
+navimpact_cli_uav_scenario(${_edir}/gyro_scale.yaml 240 41601 "effects: {gyro_scale: [0.01, -0.01, 0.01], seed: 41604}\n")
 add_test(NAME cli_emulate_effects
   COMMAND ${NI} emulate --config ${_edir}/gyro_scale.yaml --out ${_edir}/gyro_scale.rawlog --overwrite)
 set_tests_properties(cli_emulate_effects PROPERTIES FIXTURES_SETUP emu_effects

@@ -31,37 +31,29 @@ file(READ ${_kat}/manifest.yaml _m)
 string(REPLACE "file: imu.csv.gz" "file: ${_kat}/imu.csv.gz" _m "${_m}")
 string(REPLACE "file: gnss.csv" "file: ${_kat}/gnss.csv" _m "${_m}")
 string(REPLACE "file: reference.csv" "file: ${_kat}/reference.csv" _m "${_m}")
-string(REPLACE "unit: rad/s" "unit: rpm" _bad_unit "${_m}")
-file(WRITE ${_idir}/bad_unit.yaml "${_bad_unit}")
-navimpact_cli_fail(cli_import_bad_unit
-  ARGS import --manifest ${_idir}/bad_unit.yaml --out ${_idir}/bad.rawlog
-  REGEX "bad_unit.yaml: key 'imu.gyro.unit'.*rpm" NOOUT ${_idir}/bad.rawlog)
-string(REPLACE "max_gap_s: 3.5" "max_gapp_s: 3.5" _bad_key "${_m}")
-file(WRITE ${_idir}/bad_key.yaml "${_bad_key}")
-navimpact_cli_fail(cli_import_unknown_key
-  ARGS import --manifest ${_idir}/bad_key.yaml --out ${_idir}/bad.rawlog
-  REGEX "bad_key.yaml: key 'gnss.max_gapp_s': unknown key" NOOUT ${_idir}/bad.rawlog)
-string(REPLACE "axes: [-x, y, -z]" "axes: [-x, y, z]" _bad_axes "${_m}")
-file(WRITE ${_idir}/bad_axes.yaml "${_bad_axes}")
-navimpact_cli_fail(cli_import_mirror_axes
-  ARGS import --manifest ${_idir}/bad_axes.yaml --out ${_idir}/bad.rawlog
-  REGEX "key 'imu.axes': is a mirror" NOOUT ${_idir}/bad.rawlog)
-# a stream with a NaN and a repeated time (the GNSS file copied with defects)
+# TEST|FROM|TO|REGEX: the manifest (in TEST.yaml) with FROM replaced by TO
+foreach(_case "bad_unit|unit: rad/s|unit: rpm|bad_unit.yaml: key 'imu.gyro.unit'.*rpm"
+              "unknown_key|max_gap_s: 3.5|max_gapp_s: 3.5|unknown_key.yaml: key 'gnss.max_gapp_s': unknown key"
+              "mirror_axes|axes: [-x, y, -z]|axes: [-x, y, z]|key 'imu.axes': is a mirror")
+  navimpact_cli_case("${_case}" _n _from _to _re)
+  string(REPLACE "${_from}" "${_to}" _bad "${_m}")
+  file(WRITE ${_idir}/${_n}.yaml "${_bad}")
+  navimpact_cli_fail(cli_import_${_n}
+    ARGS import --manifest ${_idir}/${_n}.yaml --out ${_idir}/bad.rawlog REGEX "${_re}" NOOUT ${_idir}/bad.rawlog)
+endforeach()
+# TEST|FROM|TO|REGEX: a stream with a defect (the GNSS file copied to gnss_TEST.csv
+# with FROM replaced by TO, named by the manifest TEST.yaml): a NaN, a repeated time
 file(READ ${_kat}/gnss.csv _g)
-string(REPLACE "0.700,3.000,1448546405.617,52.2141820426667" "0.700,3.000,1448546405.617,nan" _g_nan "${_g}")
-file(WRITE ${_idir}/gnss_nan.csv "${_g_nan}")
-string(REPLACE "${_kat}/gnss.csv" "${_idir}/gnss_nan.csv" _m_nan "${_m}")
-file(WRITE ${_idir}/nan.yaml "${_m_nan}")
-navimpact_cli_fail(cli_import_nan
-  ARGS import --manifest ${_idir}/nan.yaml --out ${_idir}/bad.rawlog
-  REGEX "gnss_nan.csv:3: column 'lat_deg' \\(key gnss.position.lat\\): value is nan" NOOUT ${_idir}/bad.rawlog)
-string(REPLACE "0.700,3.000" "-2.300,3.000" _g_rep "${_g}")
-file(WRITE ${_idir}/gnss_rep.csv "${_g_rep}")
-string(REPLACE "${_kat}/gnss.csv" "${_idir}/gnss_rep.csv" _m_rep "${_m}")
-file(WRITE ${_idir}/rep.yaml "${_m_rep}")
-navimpact_cli_fail(cli_import_repeated_time
-  ARGS import --manifest ${_idir}/rep.yaml --out ${_idir}/bad.rawlog
-  REGEX "gnss_rep.csv:3: column 't_s' \\(key gnss.time.column\\): time repeats" NOOUT ${_idir}/bad.rawlog)
+foreach(_case "nan|0.700,3.000,1448546405.617,52.2141820426667|0.700,3.000,1448546405.617,nan|gnss_nan.csv:3: column 'lat_deg' \\(key gnss.position.lat\\): value is nan"
+              "repeated_time|0.700,3.000|-2.300,3.000|gnss_repeated_time.csv:3: column 't_s' \\(key gnss.time.column\\): time repeats")
+  navimpact_cli_case("${_case}" _n _from _to _re)
+  string(REPLACE "${_from}" "${_to}" _bad "${_g}")
+  file(WRITE ${_idir}/gnss_${_n}.csv "${_bad}")
+  string(REPLACE "${_kat}/gnss.csv" "${_idir}/gnss_${_n}.csv" _bad "${_m}")
+  file(WRITE ${_idir}/${_n}.yaml "${_bad}")
+  navimpact_cli_fail(cli_import_${_n}
+    ARGS import --manifest ${_idir}/${_n}.yaml --out ${_idir}/bad.rawlog REGEX "${_re}" NOOUT ${_idir}/bad.rawlog)
+endforeach()
 navimpact_cli_fail(cli_import_missing_manifest
   ARGS import --manifest ${_idir}/none.yaml --out ${_idir}/bad.rawlog
   REGEX "none.yaml: cannot open the manifest" NOOUT ${_idir}/bad.rawlog)

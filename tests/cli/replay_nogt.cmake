@@ -8,13 +8,7 @@
 # is no ground truth and has no RMS.
 set(_ngdir ${CMAKE_CURRENT_BINARY_DIR}/replay_nogt_cli)
 file(MAKE_DIRECTORY ${_ngdir})
-file(WRITE ${_ngdir}/uav60.yaml "
-trajectory: {file: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz, system: geodetic, end_s: 60}
-imu: {rate_hz: 200, errors: model, model: ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref, seed: 11}
-gnss: {seed: 12}
-baro: {seed: 13}
-ground_truth: {rate_hz: 10}
-")
+navimpact_cli_uav_scenario(${_ngdir}/uav60.yaml 60 11 "ground_truth: {rate_hz: 10}\n")
 add_test(NAME cli_emulate_nogt
   COMMAND ${NI} emulate --config ${_ngdir}/uav60.yaml --no-gt --out ${_ngdir}/uav60_nogt.rawlog --overwrite)
 set_tests_properties(cli_emulate_nogt PROPERTIES FIXTURES_SETUP nogt_rawlog
