@@ -57,29 +57,24 @@ cv::Mat renderAndRead(const np::Figure& f, const std::string& name = "fig.png") 
   return img;
 }
 
-/// Mean row of red pixels in column @p x (NaN if none).
-double redRowMean(const cv::Mat& img, int x, int y0, int y1) {
+/// Mean position of the red pixels at positions lo..hi-1 of a column
+/// (@p alongColumn, at x = @p at) or a row (at y = @p at); NaN if none.
+double redMean(const cv::Mat& img, bool alongColumn, int at, int lo, int hi) {
   double sum = 0;
   int n = 0;
-  for (int y = y0; y < y1; ++y)
-    if (isRed(img.at<cv::Vec3b>(y, x))) {
-      sum += y;
+  for (int p = lo; p < hi; ++p)
+    if (isRed(alongColumn ? img.at<cv::Vec3b>(p, at) : img.at<cv::Vec3b>(at, p))) {
+      sum += p;
       ++n;
     }
   return n ? sum / n : std::numeric_limits<double>::quiet_NaN();
 }
 
+/// Mean row of red pixels in column @p x (NaN if none).
+double redRowMean(const cv::Mat& img, int x, int y0, int y1) { return redMean(img, true, x, y0, y1); }
+
 /// Mean column of red pixels in row @p y (NaN if none).
-double redColMean(const cv::Mat& img, int y, int x0, int x1) {
-  double sum = 0;
-  int n = 0;
-  for (int x = x0; x < x1; ++x)
-    if (isRed(img.at<cv::Vec3b>(y, x))) {
-      sum += x;
-      ++n;
-    }
-  return n ? sum / n : std::numeric_limits<double>::quiet_NaN();
-}
+double redColMean(const cv::Mat& img, int y, int x0, int x1) { return redMean(img, false, y, x0, x1); }
 
 }  // namespace
 

@@ -133,6 +133,25 @@ std::pair<double, double> padRange(Range r, bool log, double frac) {
   return {a - d, b + d};
 }
 
+/// The values one axis' limits come from: a finite value is remembered (a
+/// log axis with finite values but no positive one is an error), a valid one
+/// (finite, positive on a log axis) widens the range.
+struct AxisValues {
+  bool log = false;
+  Range r;
+  bool anyFinite = false;
+  void add(double v) {
+    if (std::isfinite(v)) anyFinite = true;
+    if (validOn(v, log)) r.add(v);
+  }
+  /// The padded range; @throws Error on a log axis with finite values but none positive.
+  std::pair<double, double> limits(const std::string& where, const char* axis, double pad) const {
+    if (r.empty() && anyFinite && log)
+      throw Error(where + ": log " + axis + " axis but no positive finite " + axis + " value to plot");
+    return padRange(r, log, pad);
+  }
+};
+
 std::pair<double, double> checkedLim(const std::pair<double, double>& lim, bool log,
                                      const std::string& where, const char* axis) {
   if (!std::isfinite(lim.first) || !std::isfinite(lim.second) || !(lim.second > lim.first))
@@ -149,7 +168,6 @@ void computeLimits(const Axes& ax, std::size_t index, Scale& xs, Scale& ys) {
   const std::string where = axesName(ax, index);
   xs.log = ax.logx;
   ys.log = ax.logy;
-  bool anyFiniteX = false, anyFiniteY = false;
   for (const auto& s : ax.series)
     if (s.x.size() != s.y.size())
       throw Error(where + ": series '" + s.label + "' has " + std::to_string(s.x.size()) +
@@ -163,29 +181,20 @@ void computeLimits(const Axes& ax, std::size_t index, Scale& xs, Scale& ys) {
     xs.lo = l.first;
     xs.hi = l.second;
   } else {
-    Range r;
+    AxisValues x{ax.logx};
     for (const auto& s : ax.series)
-      for (std::size_t i = 0; i < s.x.size(); ++i) {
-        if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) anyFiniteX = true;
-        if (validOn(s.x[i], ax.logx) && validOn(s.y[i], ax.logy)) r.add(s.x[i]);
+      for (std::size_t i = 0; i < s.x.size(); ++i) {  // a point counts where both coordinates do
+        if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) x.anyFinite = true;
+        if (validOn(s.x[i], ax.logx) && validOn(s.y[i], ax.logy)) x.r.add(s.x[i]);
       }
     for (const auto& b : ax.bands)
-      for (std::size_t i = 0; i < b.x.size(); ++i) {
-        if (std::isfinite(b.x[i])) anyFiniteX = true;
-        if (validOn(b.x[i], ax.logx)) r.add(b.x[i]);
-      }
-    for (const auto& sp : ax.spans) {
-      if (validOn(sp.x0, ax.logx)) r.add(sp.x0);
-      if (validOn(sp.x1, ax.logx)) r.add(sp.x1);
-    }
+      for (double v : b.x) x.add(v);
+    for (const auto& sp : ax.spans)  // spans widen the range but do not make a log axis an error
+      for (double v : {sp.x0, sp.x1})
+        if (validOn(v, ax.logx)) x.r.add(v);
     for (const auto& c : ax.cells)
-      for (double v : {c.x0, c.x1}) {
-        if (std::isfinite(v)) anyFiniteX = true;
-        if (validOn(v, ax.logx)) r.add(v);
-      }
-    if (r.empty() && anyFiniteX && ax.logx)
-      throw Error(where + ": log x axis but no positive finite x value to plot");
-    auto l = padRange(r, ax.logx, ax.logx ? 0.03 : 0.0);
+      for (double v : {c.x0, c.x1}) x.add(v);
+    auto l = x.limits(where, "x", ax.logx ? 0.03 : 0.0);
     xs.lo = l.first;
     xs.hi = l.second;
   }
@@ -195,33 +204,23 @@ void computeLimits(const Axes& ax, std::size_t index, Scale& xs, Scale& ys) {
     ys.lo = l.first;
     ys.hi = l.second;
   } else {
-    Range r;
+    AxisValues y{ax.logy};
     auto inX = [&](double x) { return validOn(x, ax.logx) && x >= xs.lo && x <= xs.hi; };
     for (const auto& s : ax.series)
-      for (std::size_t i = 0; i < s.x.size(); ++i) {
-        if (std::isfinite(s.y[i])) anyFiniteY = true;
-        if (inX(s.x[i]) && validOn(s.y[i], ax.logy)) r.add(s.y[i]);
+      for (std::size_t i = 0; i < s.x.size(); ++i) {  // every finite y counts, the range only within the x limits
+        if (std::isfinite(s.y[i])) y.anyFinite = true;
+        if (inX(s.x[i]) && validOn(s.y[i], ax.logy)) y.r.add(s.y[i]);
       }
     for (const auto& b : ax.bands)
-      for (std::size_t i = 0; i < b.x.size(); ++i) {
-        if (!inX(b.x[i])) continue;
-        for (double v : {b.lo[i], b.hi[i]}) {
-          if (std::isfinite(v)) anyFiniteY = true;
-          if (validOn(v, ax.logy)) r.add(v);
+      for (std::size_t i = 0; i < b.x.size(); ++i)
+        if (inX(b.x[i])) {
+          y.add(b.lo[i]);
+          y.add(b.hi[i]);
         }
-      }
-    for (const auto& h : ax.hlines) {
-      if (std::isfinite(h.y)) anyFiniteY = true;
-      if (validOn(h.y, ax.logy)) r.add(h.y);
-    }
+    for (const auto& h : ax.hlines) y.add(h.y);
     for (const auto& c : ax.cells)
-      for (double v : {c.y0, c.y1}) {
-        if (std::isfinite(v)) anyFiniteY = true;
-        if (validOn(v, ax.logy)) r.add(v);
-      }
-    if (r.empty() && anyFiniteY && ax.logy)
-      throw Error(where + ": log y axis but no positive finite y value to plot");
-    auto l = padRange(r, ax.logy, 0.05);
+      for (double v : {c.y0, c.y1}) y.add(v);
+    auto l = y.limits(where, "y", 0.05);
     ys.lo = l.first;
     ys.hi = l.second;
   }
