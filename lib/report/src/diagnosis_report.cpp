@@ -25,6 +25,21 @@ using nlohmann::json;
 
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+/// Add (x, y) to a series of a log axis when y > 0 (a non-positive value has no place on it).
+void addPositive(plot::Series& s, double x, double y) {
+  if (!(y > 0)) return;
+  s.x.push_back(x);
+  s.y.push_back(y);
+}
+
+/// Add (x, lo..hi) to a band of a log axis when lo > 0.
+void addPositive(plot::Band& b, double x, double lo, double hi) {
+  if (!(lo > 0)) return;
+  b.x.push_back(x);
+  b.lo.push_back(lo);
+  b.hi.push_back(hi);
+}
+
 json findingJson(const Finding& f) {
   json j;
   j["channel"] = f.channel;
@@ -455,28 +470,11 @@ std::vector<std::string> diagnosisFigures(
       plot::Series bad{"significant", {}, {}, {213, 94, 0}, plot::LineStyle::None,
                        plot::Marker::FilledCircle};
       for (const auto& s : c.scales) {
-        if (std::isfinite(s.env_low) && s.env_low > 0) {
-          env.x.push_back(s.tau_s);
-          env.lo.push_back(s.env_low);
-          env.hi.push_back(s.env_high);
-        }
-        if (s.ci_low > 0) {
-          ci.x.push_back(s.tau_s);
-          ci.lo.push_back(s.ci_low);
-          ci.hi.push_back(s.ci_high);
-        }
-        if (s.measured > 0) {
-          meas.x.push_back(s.tau_s);
-          meas.y.push_back(s.measured);
-        }
-        if (s.model > 0) {
-          model.x.push_back(s.tau_s);
-          model.y.push_back(s.model);
-        }
-        if (s.significant && s.measured > 0) {
-          bad.x.push_back(s.tau_s);
-          bad.y.push_back(s.measured);
-        }
+        if (std::isfinite(s.env_low)) addPositive(env, s.tau_s, s.env_low, s.env_high);
+        addPositive(ci, s.tau_s, s.ci_low, s.ci_high);
+        addPositive(meas, s.tau_s, s.measured);
+        addPositive(model, s.tau_s, s.model);
+        if (s.significant) addPositive(bad, s.tau_s, s.measured);
       }
       if (!env.x.empty()) ax.bands.push_back(env);
       if (!ci.x.empty()) ax.bands.push_back(ci);
@@ -543,23 +541,10 @@ std::vector<std::string> diagnosisFigures(
       for (std::size_t j = 0; j < c.scales_after.size(); ++j) {
         const auto& s = c.scales_after[j];
         tau(static_cast<Eigen::Index>(j)) = std::round(s.tau_s * d.rate_hz);  // 2^j samples
-        if (s.ci_low > 0) {
-          ci.x.push_back(s.tau_s);
-          ci.lo.push_back(s.ci_low);
-          ci.hi.push_back(s.ci_high);
-        }
-        if (s.measured > 0) {
-          meas.x.push_back(s.tau_s);
-          meas.y.push_back(s.measured);
-        }
-        if (s.model > 0) {
-          after.x.push_back(s.tau_s);
-          after.y.push_back(s.model);
-        }
-        if (c.scales[j].model > 0) {
-          before.x.push_back(s.tau_s);
-          before.y.push_back(c.scales[j].model);
-        }
+        addPositive(ci, s.tau_s, s.ci_low, s.ci_high);
+        addPositive(meas, s.tau_s, s.measured);
+        addPositive(after, s.tau_s, s.model);
+        addPositive(before, s.tau_s, c.scales[j].model);
       }
       if (!ci.x.empty()) ax.bands.push_back(ci);
       ax.series.push_back(meas);
@@ -572,11 +557,7 @@ std::vector<std::string> diagnosisFigures(
           plot::Series s{stochastic::formatTerms({c.model_after.terms[t]}, 3), {}, {},
                          plot::palette(static_cast<int>(t) + 3), plot::LineStyle::Dotted};
           s.width = 1.5;
-          for (Eigen::Index j = 0; j < comp.rows(); ++j)
-            if (comp(j, t) > 0) {
-              s.x.push_back(tau(j) / d.rate_hz);
-              s.y.push_back(comp(j, t));
-            }
+          for (Eigen::Index j = 0; j < comp.rows(); ++j) addPositive(s, tau(j) / d.rate_hz, comp(j, t));
           if (!s.x.empty()) ax.series.push_back(s);
         }
       }

@@ -310,27 +310,42 @@ plot::Color colorOf(std::size_t i) { return plot::palette(static_cast<int>(i)); 
 
 double scaleOf(int c) { return c >= 6 ? 1.0 / units::kDeg : 1.0; }
 
-void errorsFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std::string& path) {
-  const auto& w = v.r.meta.outages[o];
-  const double x0 = w.start_s - v.r.meta.t0 - v.r.meta.plot_before_s,
-               x1 = w.end_s - v.r.meta.t0 + v.r.meta.plot_after_s;
+/// A figure of @p rows x @p cols panels, @p width x @p height pixels.
+plot::Figure panelGrid(int width, int height, int rows, int cols, std::string title) {
   plot::Figure fig;
-  fig.width = 1800;
-  fig.height = 1300;
-  fig.rows = 3;
-  fig.cols = 3;
-  fig.title = s.title + ": actual error (RMS over " + std::to_string(v.r.acc.runs) +
-              " runs, solid) and predicted sigma (dashed); GNSS outage shaded";
+  fig.width = width;
+  fig.height = height;
+  fig.rows = rows;
+  fig.cols = cols;
+  fig.title = std::move(title);
+  return fig;
+}
+
+/// A panel over the window plotted around outage @p o (from plot_before_s
+/// before its start to plot_after_s after its end; time from t0), the outage shaded.
+plot::Axes outagePanel(const View& v, std::size_t o) {
+  const auto& w = v.r.meta.outages[o];
+  const double start = w.start_s - v.r.meta.t0, end = w.end_s - v.r.meta.t0;
+  plot::Axes ax;
+  ax.xlabel = "time [s]";
+  ax.spans.push_back({"GNSS outage", start, end, {128, 128, 128}, 0.15});
+  ax.xlim = std::make_pair(start - v.r.meta.plot_before_s, end + v.r.meta.plot_after_s);
+  return ax;
+}
+
+void errorsFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std::string& path) {
+  const plot::Axes panel = outagePanel(v, o);
+  const double x0 = panel.xlim->first, x1 = panel.xlim->second;
+  plot::Figure fig = panelGrid(1800, 1300, 3, 3,
+                                s.title + ": actual error (RMS over " + std::to_string(v.r.acc.runs) +
+                                    " runs, solid) and predicted sigma (dashed); GNSS outage shaded");
   const char* rowName[3] = {"position", "velocity", "attitude"};
   const char* unit[3] = {"m", "m/s", "deg"};
   const char* axisName[3] = {"north", "east", "down"};
   for (int c = 0; c < 9; ++c) {
-    plot::Axes ax;
+    plot::Axes ax = panel;
     ax.title = std::string(rowName[c / 3]) + " " + axisName[c % 3];
-    ax.xlabel = "time [s]";
     ax.ylabel = std::string(rowName[c / 3]) + " error [" + unit[c / 3] + "]";
-    ax.spans.push_back({"GNSS outage", w.start_s - v.r.meta.t0, w.end_s - v.r.meta.t0, {128, 128, 128}, 0.15});
-    ax.xlim = std::make_pair(x0, x1);
     ax.legend = c == 0 ? plot::LegendPos::TopLeft : plot::LegendPos::None;
     for (std::size_t i = 0; i < s.models.size(); ++i) {
       const std::size_t m = v.index(s.models[i]);
@@ -355,25 +370,17 @@ void errorsFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std
 }
 
 void neesFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std::string& path) {
-  const auto& w = v.r.meta.outages[o];
-  const double x0 = w.start_s - v.r.meta.t0 - v.r.meta.plot_before_s,
-               x1 = w.end_s - v.r.meta.t0 + v.r.meta.plot_after_s;
-  plot::Figure fig;
-  fig.width = 1600;
-  fig.height = 1100;
-  fig.rows = 2;
-  fig.cols = 2;
-  fig.title = s.title + ": average NEES over " + std::to_string(v.r.acc.runs) +
-              " runs with its two-sided 95 % chi-square band";
+  const plot::Axes panel = outagePanel(v, o);
+  const double x0 = panel.xlim->first, x1 = panel.xlim->second;
+  plot::Figure fig = panelGrid(1600, 1100, 2, 2,
+                                s.title + ": average NEES over " + std::to_string(v.r.acc.runs) +
+                                    " runs with its two-sided 95 % chi-square band");
   const char* names[4] = {"position (3 dof)", "velocity (3 dof)", "attitude (3 dof)", "all nine (9 dof)"};
   for (int b = 0; b < 4; ++b) {
-    plot::Axes ax;
+    plot::Axes ax = panel;
     ax.title = names[b];
-    ax.xlabel = "time [s]";
     ax.ylabel = "ANEES";
     ax.logy = true;
-    ax.spans.push_back({"GNSS outage", w.start_s - v.r.meta.t0, w.end_s - v.r.meta.t0, {128, 128, 128}, 0.15});
-    ax.xlim = std::make_pair(x0, x1);
     const auto band = aneesBand(v.r.acc.runs, kDof[b]);
     ax.hlines.push_back({"95 % band", band.first, {0, 0, 0}, plot::LineStyle::Dashed});
     ax.hlines.push_back({"", band.second, {0, 0, 0}, plot::LineStyle::Dashed});
