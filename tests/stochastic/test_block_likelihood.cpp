@@ -15,6 +15,7 @@
 #include "navimpact/stochastic/block_likelihood.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
+#include "stochastic_test_util.hpp"
 
 using namespace navimpact::stochastic;
 
@@ -27,18 +28,7 @@ Eigen::MatrixXd sampleCovariance(const Model& m, int n) {
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
   for (const auto& p : m.terms) {
     const auto a = sampledArma(p, m.rate_hz);
-    if (!a) continue;
-    Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(n + 1, n + 1);
-    Z(0, 0) = 1.0;
-    for (int t = 0; t < n; ++t) {
-      Z.row(t + 1) = a->phi * Z.row(t);
-      Z(t + 1, t + 1) += 1.0;
-    }
-    Eigen::MatrixXd C(n, n + 1);
-    for (int t = 0; t < n; ++t) C.row(t) = Z.row(t + 1) - a->mu * Z.row(t);
-    Eigen::VectorXd D = Eigen::VectorXd::Constant(n + 1, a->q);
-    D(0) = a->p0;
-    cov += C * D.asDiagonal() * C.transpose();
+    if (a) cov += navimpact::test::sampledFormCovariance(*a, n);
   }
   return cov;
 }

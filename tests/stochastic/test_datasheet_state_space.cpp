@@ -7,18 +7,11 @@
 #include "navimpact/stochastic/datasheet.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 #include "navimpact/stochastic/state_space.hpp"
+#include "stochastic_test_util.hpp"
 
 using namespace navimpact::stochastic;
 using navimpact::units::Quantity;
-
-namespace {
-Model model(double rate, std::vector<Process> terms) {
-  Model m;
-  m.rate_hz = rate;
-  m.terms = std::move(terms);
-  return m;
-}
-}  // namespace
+using navimpact::test::model;
 
 TEST(Datasheet, ArwOfWhiteNoiseByHand) {
   // Table 1 gyro WN 9.788e-4 rad/s per sample at 200 Hz:

@@ -33,7 +33,7 @@
 #include "navimpact/stochastic/spectrum.hpp"
 #include "navimpact/stochastic/state_space.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
-#include "wv_helper.hpp"
+#include "stochastic_test_util.hpp"
 
 using namespace navimpact::stochastic;
 namespace test = navimpact::test;
@@ -607,19 +607,8 @@ TEST_P(Kinds, SampledFormAgainstWv) {
       continue;
     }
     ASSERT_TRUE(a.has_value()) << describe(m);
-    // x = C [z_{-1}, e_0 .. e_{n-1}]', Cov x = C diag(p0, q, ..., q) C'.
     const int n = 200;
-    Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(n + 1, n + 1);  // row t+1: z_t; row 0: z_{-1}
-    Z(0, 0) = 1.0;
-    for (int t = 0; t < n; ++t) {
-      Z.row(t + 1) = a->phi * Z.row(t);
-      Z(t + 1, t + 1) += 1.0;
-    }
-    Eigen::MatrixXd C(n, n + 1);
-    for (int t = 0; t < n; ++t) C.row(t) = Z.row(t + 1) - a->mu * Z.row(t);
-    Eigen::VectorXd D = Eigen::VectorXd::Constant(n + 1, a->q);
-    D(0) = a->p0;
-    const Eigen::MatrixXd cov = C * D.asDiagonal() * C.transpose();
+    const Eigen::MatrixXd cov = navimpact::test::sampledFormCovariance(*a, n);
     for (int half = 1; half <= 32; half *= 2) {
       // W_t = (mean x[t, t+m) - mean x[t-m, t)) / 2 at t = 100.
       Eigen::VectorXd w = Eigen::VectorXd::Zero(n);

@@ -13,18 +13,13 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
-#include "wv_helper.hpp"
+#include "stochastic_test_util.hpp"
 
 using namespace navimpact::stochastic;
 namespace test = navimpact::test;
 
 namespace {
-Model model(double rate, std::vector<Process> terms) {
-  Model m;
-  m.rate_hz = rate;
-  m.terms = std::move(terms);
-  return m;
-}
+using navimpact::test::model;
 double mean(const std::vector<double>& x) {
   double s = 0;
   for (double v : x) s += v;

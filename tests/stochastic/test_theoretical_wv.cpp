@@ -13,7 +13,7 @@
 #include "navimpact/stochastic/process.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 #include "test_support.hpp"
-#include "wv_helper.hpp"
+#include "stochastic_test_util.hpp"
 
 using namespace navimpact::stochastic;
 namespace test = navimpact::test;
