@@ -12,6 +12,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <tuple>
 
 #include "navimpact/core/error.hpp"
 #include "text.hpp"
@@ -137,7 +138,8 @@ std::pair<double, double> padRange(Range r, bool log, double frac) {
 /// log axis with finite values but no positive one is an error), a valid one
 /// (finite, positive on a log axis) widens the range.
 struct AxisValues {
-  bool log = false;
+  explicit AxisValues(bool log_axis) : log(log_axis) {}
+  bool log;
   Range r;
   bool anyFinite = false;
   void add(double v) {
@@ -177,9 +179,7 @@ void computeLimits(const Axes& ax, std::size_t index, Scale& xs, Scale& ys) {
       throw Error(where + ": band '" + b.label + "' has x, lo, hi of different lengths");
 
   if (ax.xlim) {
-    auto l = checkedLim(*ax.xlim, ax.logx, where, "x");
-    xs.lo = l.first;
-    xs.hi = l.second;
+    std::tie(xs.lo, xs.hi) = checkedLim(*ax.xlim, ax.logx, where, "x");
   } else {
     AxisValues x{ax.logx};
     for (const auto& s : ax.series)
@@ -194,15 +194,11 @@ void computeLimits(const Axes& ax, std::size_t index, Scale& xs, Scale& ys) {
         if (validOn(v, ax.logx)) x.r.add(v);
     for (const auto& c : ax.cells)
       for (double v : {c.x0, c.x1}) x.add(v);
-    auto l = x.limits(where, "x", ax.logx ? 0.03 : 0.0);
-    xs.lo = l.first;
-    xs.hi = l.second;
+    std::tie(xs.lo, xs.hi) = x.limits(where, "x", ax.logx ? 0.03 : 0.0);
   }
 
   if (ax.ylim) {
-    auto l = checkedLim(*ax.ylim, ax.logy, where, "y");
-    ys.lo = l.first;
-    ys.hi = l.second;
+    std::tie(ys.lo, ys.hi) = checkedLim(*ax.ylim, ax.logy, where, "y");
   } else {
     AxisValues y{ax.logy};
     auto inX = [&](double x) { return validOn(x, ax.logx) && x >= xs.lo && x <= xs.hi; };
@@ -220,9 +216,7 @@ void computeLimits(const Axes& ax, std::size_t index, Scale& xs, Scale& ys) {
     for (const auto& h : ax.hlines) y.add(h.y);
     for (const auto& c : ax.cells)
       for (double v : {c.y0, c.y1}) y.add(v);
-    auto l = y.limits(where, "y", 0.05);
-    ys.lo = l.first;
-    ys.hi = l.second;
+    std::tie(ys.lo, ys.hi) = y.limits(where, "y", 0.05);
   }
 }
 
