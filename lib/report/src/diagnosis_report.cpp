@@ -14,6 +14,7 @@
 #include "navimpact/stochastic/model_file.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
+#include "figures.hpp"
 
 namespace navimpact::report {
 
@@ -451,18 +452,11 @@ std::vector<std::string> diagnosisFigures(
   std::vector<std::string> names;
   // Overview: measured WV vs simulated envelope per channel.
   {
-    plot::Figure fig;
-    fig.title = "Measured WV vs simulations of the model (red: family-wise significant misfit)";
-    fig.rows = 2;
-    fig.cols = 3;
-    fig.width = 1800;
-    fig.height = 1000;
+    plot::Figure fig = detail::figureOf(
+        1800, 1000, "Measured WV vs simulations of the model (red: family-wise significant misfit)", 2, 3);
     for (const auto& c : d.channels) {
-      plot::Axes ax;
+      plot::Axes ax = detail::logLogAxes("tau [s]", "WV [(" + channelUnit(c.name) + ")^2]");
       ax.title = c.name + (c.adequate ? " — adequate" : " — inadequate");
-      ax.xlabel = "tau [s]";
-      ax.ylabel = "WV [(" + channelUnit(c.name) + ")^2]";
-      ax.logx = ax.logy = true;
       plot::Band env{"simulated envelope", {}, {}, {}, plot::palette(0), 0.25};
       plot::Band ci{"model 95 % CI", {}, {}, {}, plot::palette(1), 0.15};
       plot::Series meas{"measured", {}, {}, {0, 0, 0}};
@@ -525,14 +519,8 @@ std::vector<std::string> diagnosisFigures(
     if (c.adequate) continue;
     // Extended model's fit on the cleaned record, with components.
     {
-      plot::Figure fig;
-      fig.width = 1200;
-      fig.height = 800;
-      fig.title = c.name + ": extended model vs cleaned record";
-      plot::Axes ax;
-      ax.xlabel = "tau [s]";
-      ax.ylabel = "WV [(" + channelUnit(c.name) + ")^2]";
-      ax.logx = ax.logy = true;
+      plot::Figure fig = detail::figureOf(1200, 800, c.name + ": extended model vs cleaned record");
+      plot::Axes ax = detail::logLogAxes("tau [s]", "WV [(" + channelUnit(c.name) + ")^2]");
       plot::Band ci{"extended model 95 % CI", {}, {}, {}, plot::palette(2), 0.2};
       plot::Series meas{"measured (cleaned)", {}, {}, {0, 0, 0}};
       plot::Series before{"model before", {}, {}, plot::palette(1), plot::LineStyle::Dashed};
@@ -567,14 +555,8 @@ std::vector<std::string> diagnosisFigures(
       names.push_back(name);
     }
     if (!c.line_freqs_hz.empty() && !c.spectrum.psd.empty()) {
-      plot::Figure fig;
-      fig.width = 1200;
-      fig.height = 700;
-      fig.title = c.name + ": periodogram, lines beyond the family-wise threshold";
-      plot::Axes ax;
-      ax.xlabel = "frequency [Hz]";
-      ax.ylabel = "PSD [(" + channelUnit(c.name) + ")^2/Hz]";
-      ax.logx = ax.logy = true;
+      plot::Figure fig = detail::figureOf(1200, 700, c.name + ": periodogram, lines beyond the family-wise threshold");
+      plot::Axes ax = detail::logLogAxes("frequency [Hz]", "PSD [(" + channelUnit(c.name) + ")^2/Hz]");
       plot::Series psd{"measured PSD", {}, {}, {0, 0, 0}};
       psd.width = 1.0;
       plot::Series bg{"background max(model, local level)", {}, {}, plot::palette(1)};

@@ -14,6 +14,7 @@
 #include "navimpact/plot/figure.hpp"
 #include "navimpact/report/study_report.hpp"
 #include "navimpact/report/timing.hpp"
+#include "figures.hpp"
 
 namespace navimpact::report {
 
@@ -310,17 +311,6 @@ plot::Color colorOf(std::size_t i) { return plot::palette(static_cast<int>(i)); 
 
 double scaleOf(int c) { return c >= 6 ? 1.0 / units::kDeg : 1.0; }
 
-/// A figure of @p rows x @p cols panels, @p width x @p height pixels.
-plot::Figure panelGrid(int width, int height, int rows, int cols, std::string title) {
-  plot::Figure fig;
-  fig.width = width;
-  fig.height = height;
-  fig.rows = rows;
-  fig.cols = cols;
-  fig.title = std::move(title);
-  return fig;
-}
-
 /// A panel over the window plotted around outage @p o (from plot_before_s
 /// before its start to plot_after_s after its end; time from t0), the outage shaded.
 plot::Axes outagePanel(const View& v, std::size_t o) {
@@ -336,9 +326,10 @@ plot::Axes outagePanel(const View& v, std::size_t o) {
 void errorsFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std::string& path) {
   const plot::Axes panel = outagePanel(v, o);
   const double x0 = panel.xlim->first, x1 = panel.xlim->second;
-  plot::Figure fig = panelGrid(1800, 1300, 3, 3,
-                                s.title + ": actual error (RMS over " + std::to_string(v.r.acc.runs) +
-                                    " runs, solid) and predicted sigma (dashed); GNSS outage shaded");
+  plot::Figure fig = detail::figureOf(1800, 1300,
+                                      s.title + ": actual error (RMS over " + std::to_string(v.r.acc.runs) +
+                                          " runs, solid) and predicted sigma (dashed); GNSS outage shaded",
+                                      3, 3);
   const char* rowName[3] = {"position", "velocity", "attitude"};
   const char* unit[3] = {"m", "m/s", "deg"};
   const char* axisName[3] = {"north", "east", "down"};
@@ -372,9 +363,10 @@ void errorsFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std
 void neesFigure(const View& v, const ModelSetSpec& s, std::size_t o, const std::string& path) {
   const plot::Axes panel = outagePanel(v, o);
   const double x0 = panel.xlim->first, x1 = panel.xlim->second;
-  plot::Figure fig = panelGrid(1600, 1100, 2, 2,
-                                s.title + ": average NEES over " + std::to_string(v.r.acc.runs) +
-                                    " runs with its two-sided 95 % chi-square band");
+  plot::Figure fig = detail::figureOf(1600, 1100,
+                                      s.title + ": average NEES over " + std::to_string(v.r.acc.runs) +
+                                          " runs with its two-sided 95 % chi-square band",
+                                      2, 2);
   const char* names[4] = {"position (3 dof)", "velocity (3 dof)", "attitude (3 dof)", "all nine (9 dof)"};
   for (int b = 0; b < 4; ++b) {
     plot::Axes ax = panel;
