@@ -267,13 +267,19 @@ function(check_covariance_outputs)
   endif()
 endfunction()
 
-# rawlog-edit (package mrpt-apps) sees the labels of RAWLOG at their rates.
-function(check_rawlog_edit_info)
+# RAWLOG_EDIT: rawlog-edit (package mrpt-apps); where it is not installed the
+# calling check says so and returns (skipped).
+macro(require_rawlog_edit)
   find_program(RAWLOG_EDIT rawlog-edit)
   if(NOT RAWLOG_EDIT)
     message("rawlog-edit not installed (apt-get install mrpt-apps): check skipped")
     return()
   endif()
+endmacro()
+
+# rawlog-edit (package mrpt-apps) sees the labels of RAWLOG at their rates.
+function(check_rawlog_edit_info)
+  require_rawlog_edit()
   execute_process(COMMAND ${RAWLOG_EDIT} --info -i ${RAWLOG} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
     fail("rawlog-edit --info failed (${rc}): ${out}${err}")
@@ -297,11 +303,7 @@ endfunction()
 # length (sum of |dE| + |dN|, in 1e-5 m from the 5-decimal text) must lie
 # between MIN_M and MAX_M metres, and there must be ROWS rows.
 function(check_rawlog_edit_gt_distance)
-  find_program(RAWLOG_EDIT rawlog-edit)
-  if(NOT RAWLOG_EDIT)
-    message("rawlog-edit not installed (apt-get install mrpt-apps): check skipped")
-    return()
-  endif()
+  require_rawlog_edit()
   get_filename_component(dir ${RAWLOG} DIRECTORY)
   get_filename_component(stem ${RAWLOG} NAME_WE)
   get_filename_component(name ${RAWLOG} NAME)
