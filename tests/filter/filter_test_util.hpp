@@ -11,6 +11,10 @@
 namespace ftest {
 
 using namespace navimpact;
+using Eigen::Matrix3d;
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
 using instest::kDeg;
 using instest::navState;
 

@@ -15,9 +15,6 @@
 
 using namespace navimpact;
 using namespace ftest;
-using Eigen::MatrixXd;
-using Eigen::Vector3d;
-using Eigen::VectorXd;
 
 namespace {
 

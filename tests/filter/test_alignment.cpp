@@ -18,7 +18,6 @@
 
 using namespace navimpact;
 using namespace ftest;
-using Eigen::Vector3d;
 
 namespace {
 double logUniform(std::mt19937_64& rng, double lo, double hi) {

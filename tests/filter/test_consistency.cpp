@@ -14,8 +14,6 @@
 
 using namespace navimpact;
 using namespace ftest;
-using Eigen::MatrixXd;
-using Eigen::Vector3d;
 using P = stochastic::Process;
 
 namespace {

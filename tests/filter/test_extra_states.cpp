@@ -23,10 +23,6 @@
 
 using namespace navimpact;
 using namespace ftest;
-using Eigen::Matrix3d;
-using Eigen::MatrixXd;
-using Eigen::Vector3d;
-using Eigen::VectorXd;
 using filter::Extra;
 
 namespace {

@@ -11,7 +11,6 @@
 
 using namespace navimpact;
 using namespace ftest;
-using Eigen::Vector3d;
 
 namespace {
 filter::Matrix9d diagP(double p, double v, double a) {
