@@ -45,6 +45,26 @@ std::pair<std::string, std::string> writeWithAndWithoutGt(const std::filesystem:
   return {withGt, noGt};
 }
 
+// GNSS outages every PERIOD:DURATION drawn at random: a period in [4, max_period] s,
+// a duration that leaves at least 0.5 s of GNSS on either side.
+navimpact::OutagePattern drawPattern(std::mt19937_64& rng, double max_period) {
+  const double period = std::uniform_real_distribution<double>(4.0, max_period)(rng);
+  const double duration = std::uniform_real_distribution<double>(0.5, period - 0.5)(rng);
+  return {period, duration};
+}
+
+// The replay of @p path with the reference model, the outage @p outage and
+// outages laid every @p pattern.
+an::ReplayConfig patternReplay(const std::string& path, const navimpact::Outage& outage,
+                               const navimpact::OutagePattern& pattern) {
+  an::ReplayConfig c;
+  c.rawlog = path;
+  c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
+  c.outages.push_back(outage);
+  c.outages_every = pattern;
+  return c;
+}
+
 std::string errorOf(const an::ReplayConfig& c) {
   return navimpact::test::errorOf([&] { an::runReplay(c); });
 }
@@ -426,18 +446,13 @@ TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) 
   const std::uint64_t seed = std::random_device{}();
   std::mt19937_64 rng(seed);
   for (int draw = 0; draw < 3; ++draw) {
-    const double period = std::uniform_real_distribution<double>(4.0, 30.0)(rng);
-    const double duration = std::uniform_real_distribution<double>(0.5, period - 0.5)(rng);
+    const navimpact::OutagePattern pattern = drawPattern(rng, 30.0);
     const double explicitStart = std::uniform_real_distribution<double>(0.0, 40.0)(rng);
     std::printf("seed %llu draw %d: outages every %.4f:%.4f s, explicit outage %.4f:5 s\n",
-                static_cast<unsigned long long>(seed), draw, period, duration, explicitStart);
+                static_cast<unsigned long long>(seed), draw, pattern.period_s, pattern.duration_s, explicitStart);
     for (const auto& path : {withGt, noGt}) {
       SCOPED_TRACE(path + " seed " + std::to_string(seed) + " draw " + std::to_string(draw));
-      an::ReplayConfig c;
-      c.rawlog = path;
-      c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
-      c.outages.push_back(navimpact::Outage::fromStartDuration(explicitStart, 5.0));
-      c.outages_every = navimpact::OutagePattern{period, duration};
+      const an::ReplayConfig c = patternReplay(path, navimpact::Outage::fromStartDuration(explicitStart, 5.0), pattern);
       const an::ReplayResult whole = an::runReplay(c);
       std::ostringstream csv;
       navimpact::report::ReplayWriter writer(csv);
@@ -469,18 +484,13 @@ TEST(Replay, ReplayFromRecordsInMemoryIsTheReplayAndStopsWhereAsked) {
   const std::uint64_t seed = std::random_device{}();
   std::mt19937_64 rng(seed);
   for (int draw = 0; draw < 2; ++draw) {
-    const double period = std::uniform_real_distribution<double>(4.0, 20.0)(rng);
-    const double duration = std::uniform_real_distribution<double>(0.5, period - 0.5)(rng);
+    const navimpact::OutagePattern pattern = drawPattern(rng, 20.0);
     const double u = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
     std::printf("seed %llu draw %d: outages every %.4f:%.4f s, stop at %.4f of the filter's time\n",
-                static_cast<unsigned long long>(seed), draw, period, duration, u);
+                static_cast<unsigned long long>(seed), draw, pattern.period_s, pattern.duration_s, u);
     for (const auto& path : {withGt, noGt}) {
       SCOPED_TRACE(path + " seed " + std::to_string(seed) + " draw " + std::to_string(draw));
-      an::ReplayConfig c;
-      c.rawlog = path;
-      c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
-      c.outages.push_back(navimpact::Outage::fromStartDuration(2.0, 3.0));
-      c.outages_every = navimpact::OutagePattern{period, duration};
+      const an::ReplayConfig c = patternReplay(path, navimpact::Outage::fromStartDuration(2.0, 3.0), pattern);
       const an::ReplayResult whole = an::runReplay(c);
       const double stop = whole.aided_from_s + 1.0 + u * (55.0 - whole.aided_from_s);
       const navimpact::rawlog::RawlogRecords data = navimpact::rawlog::readRawlogRecords(path);
