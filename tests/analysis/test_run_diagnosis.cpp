@@ -356,6 +356,36 @@ void checkHidden(const an::RunDiagnosis& d, const Hidden& h) {
   EXPECT_LE(misses, 1);
 }
 
+/// The triad of one sensor that an effect acts on: the gyro's or the accelerometer's vector.
+struct TriadEffect {
+  const char* cause;  ///< the cause the diagnosis must name
+  const char* param;  ///< its parameter per channel
+  const char* what;   ///< in the log line
+  const char* unit;   ///< suffix of the magnitude in the log line
+  double range_hi;    ///< documented range [-hi, hi]
+  double limit_gyro, limit_acc;  ///< detection limits
+  Eigen::Vector3d emu::SensorEffects::*gyro;
+  Eigen::Vector3d emu::SensorEffects::*acc;
+};
+
+/// The effect on one triad (drawn: gyro or accelerometer), one magnitude
+/// log-uniform over three decades below its range's end with a random sign
+/// per axis, emulated, diagnosed and checked.
+void checkHiddenTriad(const TriadEffect& e, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const bool gyro = (rng() & 1u) != 0;
+  const double m = std::abs(drawSigned(rng, e.range_hi, 3.0));
+  emu::SensorEffects fx;
+  Hidden h{e.cause, m, gyro ? e.limit_gyro : e.limit_acc, {}};
+  for (int i = 0; i < 3; ++i) {
+    const double v = (rng() & 1u) ? m : -m;
+    (fx.*(gyro ? e.gyro : e.acc))(i) = v;
+    h.truth.push_back({navimpact::kChannelNames[(gyro ? 0 : 3) + i], e.param, v});
+  }
+  std::cout << "hidden " << e.what << ": seed " << seed << ", " << (gyro ? "gyro" : "acc") << " " << m << e.unit << "\n";
+  checkHidden(an::diagnoseRun(hiddenOptions(emulateWithEffects(e.cause, seed, fx), seed + 1)), h);
+}
+
 }  // namespace
 
 // White noise k times the model's while moving (k log-uniform over the
@@ -385,38 +415,17 @@ TEST(RunDiagnosisHidden, InMotionNoise) {
 // Scale factors of one triad (drawn: gyro or accelerometer), one magnitude
 // log-uniform over [5e-5, 0.05] with a random sign per axis.
 TEST(RunDiagnosisHidden, ScaleFactor) {
-  for (std::uint64_t seed : {41101u, 41102u}) {
-    std::mt19937_64 rng(seed);
-    const bool gyro = (rng() & 1u) != 0;
-    const double m = std::abs(drawSigned(rng, limits::kScaleFactor.hi, 3.0));
-    emu::SensorEffects fx;
-    Hidden h{"scale_factor", m, gyro ? kLimitGyroScale : kLimitAccScale, {}};
-    for (int i = 0; i < 3; ++i) {
-      const double v = (rng() & 1u) ? m : -m;
-      (gyro ? fx.gyro_scale : fx.acc_scale)(i) = v;
-      h.truth.push_back({navimpact::kChannelNames[(gyro ? 0 : 3) + i], "scale", v});
-    }
-    std::cout << "hidden scale factor: seed " << seed << ", " << (gyro ? "gyro" : "acc") << " " << m << "\n";
-    checkHidden(an::diagnoseRun(hiddenOptions(emulateWithEffects("scale", seed, fx), seed + 1)), h);
-  }
+  const TriadEffect e{"scale_factor", "scale", "scale factor", "", limits::kScaleFactor.hi,
+                      kLimitGyroScale, kLimitAccScale, &emu::SensorEffects::gyro_scale, &emu::SensorEffects::acc_scale};
+  for (std::uint64_t seed : {41101u, 41102u}) checkHiddenTriad(e, seed);
 }
 
 // Misalignment of one triad (drawn), one magnitude log-uniform over [5e-5, 0.05] rad.
 TEST(RunDiagnosisHidden, Misalignment) {
-  for (std::uint64_t seed : {41201u, 41202u}) {
-    std::mt19937_64 rng(seed);
-    const bool gyro = (rng() & 1u) != 0;
-    const double m = std::abs(drawSigned(rng, limits::kMisalignmentRad.hi, 3.0));
-    emu::SensorEffects fx;
-    Hidden h{"misalignment", m, gyro ? kLimitGyroMisalignment : kLimitAccMisalignment, {}};
-    for (int i = 0; i < 3; ++i) {
-      const double v = (rng() & 1u) ? m : -m;
-      (gyro ? fx.gyro_misalignment_rad : fx.acc_misalignment_rad)(i) = v;
-      h.truth.push_back({navimpact::kChannelNames[(gyro ? 0 : 3) + i], "angle", v});
-    }
-    std::cout << "hidden misalignment: seed " << seed << ", " << (gyro ? "gyro" : "acc") << " " << m << " rad\n";
-    checkHidden(an::diagnoseRun(hiddenOptions(emulateWithEffects("misalignment", seed, fx), seed + 1)), h);
-  }
+  const TriadEffect e{"misalignment", "angle", "misalignment", " rad", limits::kMisalignmentRad.hi,
+                      kLimitGyroMisalignment, kLimitAccMisalignment, &emu::SensorEffects::gyro_misalignment_rad,
+                      &emu::SensorEffects::acc_misalignment_rad};
+  for (std::uint64_t seed : {41201u, 41202u}) checkHiddenTriad(e, seed);
 }
 
 // IMU-GNSS time offset, magnitude log-uniform over [1e-4, 0.1] s, random sign.
