@@ -70,6 +70,12 @@ na::DiagnoseOptions diagOptions() {
   return d;
 }
 
+/// The navigation gain of @p d on @p data, planned along the test's flight.
+void addGain(na::Diagnosis& d, const ImuSeries& data) {
+  const auto plan = na::prepareNavGain(navOptions(), kRate, kN);
+  na::addNavigationGain(d, data, *plan);
+}
+
 }  // namespace
 
 TEST(DiagnoseNav, BadInputFailsInPreparation) {
@@ -97,8 +103,7 @@ TEST(DiagnoseNav, IdenticalModelsGiveIdenticalPairedRuns) {
   const ImuSeries data = record(false, 3);
   na::Diagnosis d = na::diagnose(data, wnModel(), diagOptions());
   ASSERT_TRUE(d.adequate);
-  const auto plan = na::prepareNavGain(navOptions(), kRate, kN);
-  na::addNavigationGain(d, data, *plan);
+  addGain(d, data);
   ASSERT_TRUE(d.navigation.has_value());
   ASSERT_EQ(d.navigation->outages.size(), 1u);
   const auto& o = d.navigation->outages[0];
@@ -122,8 +127,7 @@ TEST(DiagnoseNav, HiddenGyroRandomWalkImprovesConsistency) {
   const ImuSeries data = record(true, 4);
   na::Diagnosis d = na::diagnose(data, wnModel(), diagOptions());
   ASSERT_FALSE(d.adequate);
-  const auto plan = na::prepareNavGain(navOptions(), kRate, kN);
-  na::addNavigationGain(d, data, *plan);
+  addGain(d, data);
   const auto& o = d.navigation->outages.at(0);
   std::cout << "NEES before " << o.anees_before << " after " << o.anees_after << " band "
             << o.nees_band.first << ".." << o.nees_band.second << "; h " << o.mean_h_before
