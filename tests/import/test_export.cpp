@@ -8,6 +8,7 @@
 #include "navimpact/core/earth.hpp"
 #include "navimpact/import/export_run.hpp"
 #include "navimpact/import/manifest.hpp"
+#include "recording_checks.hpp"
 #include "test_support.hpp"
 
 namespace navimpact {
@@ -48,12 +49,7 @@ TEST(ExportRun, ImportOfTheExportIsTheRecording) {
     const auto notes = import::exportRun(d, dir);
     const Recording b = import::importManifest((dir / "manifest.yaml").string());
     EXPECT_EQ(b.start_unix_s, d.start_unix_s);
-    ASSERT_EQ(b.imu.size(), d.imu.size());
-    for (std::size_t k = 0; k < d.imu.size(); ++k) {
-      EXPECT_EQ(b.imu[k].t, d.imu[k].t);
-      EXPECT_EQ(b.imu[k].w_IB_B, d.imu[k].w_IB_B);
-      EXPECT_EQ(b.imu[k].f_B, d.imu[k].f_B);
-    }
+    ASSERT_NO_FATAL_FAILURE(test::expectSameImu(b.imu, d.imu));
     ASSERT_EQ(b.gnss.size(), d.gnss.size());
     for (std::size_t k = 0; k < d.gnss.size(); ++k) {
       EXPECT_EQ(b.gnss[k].t, d.gnss[k].t);

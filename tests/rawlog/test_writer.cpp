@@ -18,6 +18,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/rawlog/reader.hpp"
 #include "navimpact/rawlog/writer.hpp"
+#include "recording_checks.hpp"
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -58,6 +59,16 @@ Recording sample() {
                            Eigen::Vector3d(15, -22.5, -5 + k), q, {}, {}, {}});
   }
   return d;
+}
+
+/// The rawlogs the record readers are checked on: the sample written into the
+/// test's folder (pose-observation reference), the bundled legacy one and a
+/// foreign one (an Xsens driver's labels).
+std::vector<std::string> readerRawlogs() {
+  const std::string p = (navimpact::test::tempDir() / "sample.rawlog").string();
+  navimpact::rawlog::writeRawlog(p, sample());
+  return {p, navimpact::test::sourcePath("datasets/uav_flight_260s_ref.rawlog"),
+          navimpact::test::dataPath("imu_label_xsens.rawlog")};
 }
 
 void expectRoundTrip(const Recording& a, const Recording& b) {
@@ -304,11 +315,7 @@ TEST(RawlogWriter, LegacyGroundTruthAsImuObservationReads) {
 // record, in time order (a GT with its velocity entry as one record), for the
 // pose-observation reference, the legacy one and a foreign rawlog.
 TEST(RawlogReader, ReturnsTheRecordsOfReadRawlogInTimeOrder) {
-  const auto dir = navimpact::test::tempDir();
-  const std::string p = (dir / "sample.rawlog").string();
-  navimpact::rawlog::writeRawlog(p, sample());
-  for (const std::string& path : {p, navimpact::test::sourcePath("datasets/uav_flight_260s_ref.rawlog"),
-                                  navimpact::test::dataPath("imu_label_xsens.rawlog")}) {
+  for (const std::string& path : readerRawlogs()) {
     SCOPED_TRACE(path);
     const Recording whole = navimpact::rawlog::readRawlog(path);
     navimpact::rawlog::RawlogReader reader(path);
@@ -332,12 +339,7 @@ TEST(RawlogReader, ReturnsTheRecordsOfReadRawlogInTimeOrder) {
     EXPECT_EQ(reader.header().origin.lat, whole.origin.lat);
     EXPECT_EQ(reader.header().start_unix_s, whole.start_unix_s);
     EXPECT_EQ(reader.header().t_start_s, whole.t_start_s);
-    ASSERT_EQ(d.imu.size(), whole.imu.size());
-    for (std::size_t i = 0; i < d.imu.size(); ++i) {
-      EXPECT_EQ(d.imu[i].t, whole.imu[i].t);
-      EXPECT_EQ(d.imu[i].w_IB_B, whole.imu[i].w_IB_B);
-      EXPECT_EQ(d.imu[i].f_B, whole.imu[i].f_B);
-    }
+    ASSERT_NO_FATAL_FAILURE(navimpact::test::expectSameImu(d.imu, whole.imu));
     ASSERT_EQ(d.gnss.size(), whole.gnss.size());
     for (std::size_t i = 0; i < d.gnss.size(); ++i) {
       EXPECT_EQ(d.gnss[i].t, whole.gnss[i].t);
@@ -359,11 +361,7 @@ TEST(RawlogReader, ReturnsTheRecordsOfReadRawlogInTimeOrder) {
 // The records read into memory once come back in the reader's order, field
 // for field, with its final header (a run replayed many times is decoded once).
 TEST(RawlogReader, RecordsInMemoryComeBackInTheReadersOrder) {
-  const auto dir = navimpact::test::tempDir();
-  const std::string p = (dir / "sample_mem.rawlog").string();
-  navimpact::rawlog::writeRawlog(p, sample());
-  for (const std::string& path : {p, navimpact::test::sourcePath("datasets/uav_flight_260s_ref.rawlog"),
-                                  navimpact::test::dataPath("imu_label_xsens.rawlog")}) {
+  for (const std::string& path : readerRawlogs()) {
     SCOPED_TRACE(path);
     const navimpact::rawlog::RawlogRecords mem = navimpact::rawlog::readRawlogRecords(path);
     navimpact::rawlog::RawlogReader reader(path);
