@@ -39,6 +39,19 @@ bool sameBits(const MatrixXd& a, const MatrixXd& b) {
          std::memcmp(a.data(), b.data(), sizeof(double) * std::size_t(a.size())) == 0;
 }
 
+/// nineRowProduct(out, l, r, assign) on a copy of @p start gives the bits of
+/// Eigen's out = l r (@p assign) or out += l r on another copy.
+template <class Out, class L, class R>
+void expectSameBits(const Out& start, const L& l, const R& r, bool assign, const char* what) {
+  Out e = start, o = start;
+  if (assign)
+    e.noalias() = l * r;
+  else
+    e.noalias() += l * r;
+  nineRowProduct(o, l, r, assign);
+  EXPECT_TRUE(sameBits(e, o)) << what;
+}
+
 }  // namespace
 
 TEST(NineRowProduct, SameBitsAsEigenForEveryFilterShape) {
@@ -55,49 +68,18 @@ TEST(NineRowProduct, SameBitsAsEigenForEveryFilterShape) {
       const Matrix9d D9 = sparseRandom(9, 9, rng);
       const MatrixXd Dni = sparseRandom(9, m, rng);
 
-      // Matrix9d * (9 x m), assigned (F_nn F_ni, A P_ni)
-      {
-        MatrixXd e(9, m), o = sparseRandom(9, m, rng);
-        e.noalias() = A * P.topRightCorner(9, m);
-        nineRowProduct(o, A, P.topRightCorner(9, m), true);
-        EXPECT_TRUE(sameBits(e, o)) << "A * Pni";
-        e.noalias() = A * Lni;
-        nineRowProduct(o, A, Lni, true);
-        EXPECT_TRUE(sameBits(e, o)) << "Fnn * Fni";
-      }
+      // Matrix9d * (9 x m), assigned over random contents (F_nn F_ni, A P_ni)
+      const MatrixXd R = sparseRandom(9, m, rng);
+      expectSameBits(R, A, P.topRightCorner(9, m), true, "A * Pni");
+      expectSameBits(R, A, Lni, true, "Fnn * Fni");
       // (9 x m) * (m x m) block, accumulated (B P_ii)
-      {
-        MatrixXd e = Dni, o = Dni;
-        e.noalias() += Lni * P.bottomRightCorner(m, m);
-        nineRowProduct(o, Lni, P.bottomRightCorner(m, m), false);
-        EXPECT_TRUE(sameBits(e, o)) << "B * Pii";
-      }
-      // (9 x m) * (9 x m)' into 9 x 9, accumulated and assigned (B P_ni', M B', F_ni Q_ii F_ni')
-      {
-        Matrix9d e = D9, o = D9;
-        e.noalias() += Lni * P.topRightCorner(9, m).transpose();
-        nineRowProduct(o, Lni, P.topRightCorner(9, m).transpose(), false);
-        EXPECT_TRUE(sameBits(e, o)) << "B * Pni'";
-        e = D9;
-        o = D9;
-        e.noalias() += Lni * Lni2.transpose();
-        nineRowProduct(o, Lni, Lni2.transpose(), false);
-        EXPECT_TRUE(sameBits(e, o)) << "M * B'";
-      }
+      expectSameBits(Dni, Lni, P.bottomRightCorner(m, m), false, "B * Pii");
+      // (9 x m) * (9 x m)' into 9 x 9, accumulated (B P_ni', M B', F_ni Q_ii F_ni')
+      expectSameBits(D9, Lni, P.topRightCorner(9, m).transpose(), false, "B * Pni'");
+      expectSameBits(D9, Lni, Lni2.transpose(), false, "M * B'");
       // Matrix9d * Matrix9d (and transposed), assigned and accumulated
-      {
-        Matrix9d e, o = D9;
-        e.noalias() = A * A2;
-        nineRowProduct(o, A, A2, true);
-        EXPECT_TRUE(sameBits(e, o)) << "A * Pnn";
-        e.noalias() = A * A2.transpose();
-        nineRowProduct(o, A, A2.transpose(), true);
-        EXPECT_TRUE(sameBits(e, o)) << "M * A'";
-        e = D9;
-        o = D9;
-        e.noalias() += A * A2.transpose();
-        nineRowProduct(o, A, A2.transpose(), false);
-        EXPECT_TRUE(sameBits(e, o)) << "+= M * A'";
-      }
+      expectSameBits(D9, A, A2, true, "A * Pnn");
+      expectSameBits(D9, A, A2.transpose(), true, "M * A'");
+      expectSameBits(D9, A, A2.transpose(), false, "+= M * A'");
     }
 }
