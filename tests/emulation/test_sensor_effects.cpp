@@ -75,6 +75,23 @@ std::array<std::vector<double>, 6> randomErrors(std::size_t n, std::uint64_t see
 
 using navimpact::test::errorOf;
 
+/// Random sinusoids (@p n samples from @p g) before and after an effect on
+/// both triads, each axis uniform over @p range (the effect printed with @p seed).
+struct TriadApplied {
+  std::vector<ins::ImuSample> perfect, out;
+  emu::SensorEffects fx;
+};
+TriadApplied applyTriadEffect(std::mt19937_64& g, std::uint64_t seed, std::size_t n, Vector3d emu::SensorEffects::*gyro,
+                              Vector3d emu::SensorEffects::*acc, const lim::Range& range) {
+  TriadApplied r;
+  r.perfect = randomSinusoids(g).imu(0.0, n);
+  r.fx.*gyro = uniform3(g, range);
+  r.fx.*acc = uniform3(g, range);
+  std::printf("seed %llu: %s\n", (unsigned long long)seed, emu::describeEffects(r.fx).c_str());
+  r.out = emu::applySensorEffects(r.perfect, {}, r.fx, {}, 1).imu;
+  return r;
+}
+
 }  // namespace
 
 TEST(SensorEffects, NoEffectGivesExactlyPerfectPlusErrors) {
@@ -103,12 +120,8 @@ TEST(SensorEffects, NoEffectGivesExactlyPerfectPlusErrors) {
 TEST(SensorEffects, ScaleFactorAddsScaleTimesTrue) {
   const std::uint64_t seed = 21;
   std::mt19937_64 g(seed);
-  const auto perfect = randomSinusoids(g).imu(0.0, 2000);
-  emu::SensorEffects fx;
-  fx.gyro_scale = uniform3(g, lim::kScaleFactor);
-  fx.acc_scale = uniform3(g, lim::kScaleFactor);
-  std::printf("seed %llu: %s\n", (unsigned long long)seed, emu::describeEffects(fx).c_str());
-  const auto out = emu::applySensorEffects(perfect, {}, fx, {}, 1).imu;
+  const auto [perfect, out, fx] =
+      applyTriadEffect(g, seed, 2000, &emu::SensorEffects::gyro_scale, &emu::SensorEffects::acc_scale, lim::kScaleFactor);
   for (std::size_t k = 0; k < perfect.size(); ++k) {
     const Vector3d dg = out[k].dtheta_B - perfect[k].dtheta_B, da = out[k].dv_B - perfect[k].dv_B;
     const Vector3d eg = fx.gyro_scale.cwiseProduct(perfect[k].dtheta_B), ea = fx.acc_scale.cwiseProduct(perfect[k].dv_B);
@@ -122,12 +135,8 @@ TEST(SensorEffects, ScaleFactorAddsScaleTimesTrue) {
 TEST(SensorEffects, MisalignmentAndNonOrthogonalityAreTheDocumentedMatrix) {
   const std::uint64_t seed = 22;
   std::mt19937_64 g(seed);
-  const auto perfect = randomSinusoids(g).imu(0.0, 1000);
-  emu::SensorEffects fx;
-  fx.gyro_misalignment_rad = uniform3(g, lim::kMisalignmentRad);
-  fx.acc_misalignment_rad = uniform3(g, lim::kMisalignmentRad);
-  std::printf("seed %llu: %s\n", (unsigned long long)seed, emu::describeEffects(fx).c_str());
-  auto out = emu::applySensorEffects(perfect, {}, fx, {}, 1).imu;
+  const auto [perfect, out, fx] = applyTriadEffect(g, seed, 1000, &emu::SensorEffects::gyro_misalignment_rad,
+                                                   &emu::SensorEffects::acc_misalignment_rad, lim::kMisalignmentRad);
   for (std::size_t k = 0; k < perfect.size(); ++k) {
     // measured - true = m x true (a rotation of the triad by -m, to first order)
     const Vector3d eg = fx.gyro_misalignment_rad.cross(perfect[k].dtheta_B);
