@@ -22,13 +22,11 @@ namespace st = navimpact::stochastic;
 /// reference model converted to 100 Hz (19 scales), computed once.
 const gm::WaveletVariance& simulatedWv() {
   static const gm::WaveletVariance wv = [] {
-    st::Model m;
-    m.rate_hz = 200;
-    m.terms = st::parseTerms(
-        "WN(sigma=5.521e-3) + GM(sigma=4.811e-4, T=3.22) + GM(sigma=6.666e-4, T=47.40) + "
-        "GM(sigma=4.003e-4, T=556) + DR(omega=9.302e-10)",
-        200);
-    m = st::convertRate(m, 100);
+    const st::Model m = st::convertRate(st::parseModel("WN(sigma=5.521e-3) + GM(sigma=4.811e-4, T=3.22) + "
+                                                       "GM(sigma=6.666e-4, T=47.40) + GM(sigma=4.003e-4, T=556) + "
+                                                       "DR(omega=9.302e-10)",
+                                                       200),
+                                        100);
     const std::size_t n = 1000000;
     const auto x = st::simulate(m, n, 20190101);
     return gm::waveletVariance(x.data(), n, 100);
@@ -50,6 +48,13 @@ const gm::WaveletVariance* adisWv() {
     return std::make_unique<gm::WaveletVariance>(gm::waveletVariance(c.x.data(), c.x.size(), 100));
   }();
   return wv.get();
+}
+
+/// adisWv(), or nullptr with @p state skipped when the shared data is absent.
+const gm::WaveletVariance* adisWvOrSkip(benchmark::State& state) {
+  const gm::WaveletVariance* wv = adisWv();
+  if (!wv) state.SkipWithError("shared data not found");
+  return wv;
 }
 
 void runFit(benchmark::State& state, const gm::WaveletVariance& wv, const char* structure,
@@ -81,9 +86,8 @@ BENCHMARK(BM_FitSimulatedEfficient_WN_3GM_DR)->Unit(benchmark::kMillisecond);
 
 // Asymptotic WV covariance (19 x 19, quadrature per pair of scales).
 static void BM_WvCovariance(benchmark::State& state) {
-  st::Model m;
-  m.rate_hz = 100;
-  m.terms = st::parseTerms("WN(sigma=5.5e-3) + GM(sigma=4.8e-4, T=3.2) + GM(sigma=6.7e-4, T=47) + GM(sigma=4e-4, T=556)", 100);
+  const st::Model m =
+      st::parseModel("WN(sigma=5.5e-3) + GM(sigma=4.8e-4, T=3.2) + GM(sigma=6.7e-4, T=47) + GM(sigma=4e-4, T=556)", 100);
   for (auto _ : state) benchmark::DoNotOptimize(gm::wvCovariance(m, simulatedWv()).sum());
 }
 BENCHMARK(BM_WvCovariance)->Unit(benchmark::kMillisecond);
@@ -92,22 +96,16 @@ static void BM_FitSimulated_WN_GM(benchmark::State& state) { runFit(state, simul
 BENCHMARK(BM_FitSimulated_WN_GM)->Unit(benchmark::kMillisecond);
 
 static void BM_FitAdisAccX_WN_3GM_DR(benchmark::State& state) {
-  const auto* wv = adisWv();
-  if (!wv) {
-    state.SkipWithError("shared data not found");
-    return;
-  }
+  const auto* wv = adisWvOrSkip(state);
+  if (!wv) return;
   runFit(state, *wv, "WN+GM+GM+GM+DR");
 }
 BENCHMARK(BM_FitAdisAccX_WN_3GM_DR)->Unit(benchmark::kMillisecond);
 
 // Automatic selection over the 32 default candidates (WN + QN?/RW?/DR? + 0..3 GM).
 static void BM_SelectAdisAccX(benchmark::State& state) {
-  const auto* wv = adisWv();
-  if (!wv) {
-    state.SkipWithError("shared data not found");
-    return;
-  }
+  const auto* wv = adisWvOrSkip(state);
+  if (!wv) return;
   const auto cands = gm::defaultCandidates(3);
   for (auto _ : state) {
     const auto r = gm::selectModel(cands, *wv, gm::FitOptions{});

@@ -15,13 +15,10 @@ namespace st = navimpact::stochastic;
 
 /// Table 1 gyroscope reference model with QN and RW added, at 100 Hz.
 st::Model model() {
-  st::Model m;
-  m.rate_hz = 100;
-  m.terms = st::parseTerms(
+  return st::parseModel(
       "WN(sigma=9.788e-4) + QN(Q=1e-5) + RW(gamma=1e-7) + GM(sigma=4.805e-5, T=59.22) + "
       "GM(sigma=7.555e-5, T=2008) + DR(omega=1e-10) + SIN(amp=1e-4, freq=0.56)",
       100);
-  return m;
 }
 
 }  // namespace

@@ -87,9 +87,7 @@ TEST(GmwmFit, RecoversExactWvOfEveryKind) {
       {"WN(sigma=0.01) + SIN(amp=0.02, freq=0.7)", 100},
   };
   for (const auto& c : cases) {
-    Model truth;
-    truth.rate_hz = c.rate;
-    truth.terms = stochastic::parseTerms(c.model, c.rate);
+    const Model truth = stochastic::parseModel(c.model, c.rate);
     const auto wv = exactWv(truth, 1u << 20);
     const auto f = gmwm::fit(kinds(truth), wv);
     EXPECT_LT(f.objective, 1e-10) << c.model << " -> " << stochastic::formatTerms(f.model.terms);
@@ -104,9 +102,7 @@ TEST(GmwmFit, RecoversExactWvOfEveryKind) {
 // <= 1 each (eta3 is conservative), so on simulated data it is O(J), while a
 // weight with a wrong scale (no eta, nu_hat instead of nu^2) is off by orders.
 TEST(GmwmFit, ModelBasedWeights) {
-  Model truth;
-  truth.rate_hz = 100;
-  truth.terms = stochastic::parseTerms("WN(sigma=0.01) + GM(sigma=0.002, T=0.5) + GM(sigma=0.004, T=40)", 100);
+  const Model truth = stochastic::parseModel("WN(sigma=0.01) + GM(sigma=0.002, T=0.5) + GM(sigma=0.004, T=40)", 100);
   gmwm::FitOptions o;
   o.weighting = gmwm::Weighting::ModelBased;
   const auto ex = exactWv(truth, 1u << 20);
@@ -141,9 +137,7 @@ TEST(GmwmFit, ModelBasedWeights) {
 // 2 nu^2 / eta_j that the diagonal weights assume is off by more than 25 % at
 // the first scale (it ignores the filter's autocorrelation: 3/8 vs 1/2).
 TEST(GmwmFit, WvCovarianceMatchesMonteCarlo) {
-  Model m;
-  m.rate_hz = 100;
-  m.terms = stochastic::parseTerms("WN(sigma=0.01) + GM(sigma=0.004, T=0.2) + RW(gamma=2e-5)", 100);
+  Model m = stochastic::parseModel("WN(sigma=0.01) + GM(sigma=0.004, T=0.2) + RW(gamma=2e-5)", 100);
   const std::size_t n = 1u << 14;
   const int R = 400;
   std::vector<Eigen::VectorXd> reps;
@@ -178,9 +172,7 @@ TEST(GmwmFit, WvCovarianceMatchesMonteCarlo) {
 // reported objective is the quadratic form under the full Omega (O(J) on
 // simulated data: a chi-square-like sum), and the intervals come from (A' V^-1 A)^-1.
 TEST(GmwmFit, EfficientWeights) {
-  Model truth;
-  truth.rate_hz = 100;
-  truth.terms = stochastic::parseTerms("WN(sigma=0.01) + GM(sigma=0.002, T=0.5) + GM(sigma=0.004, T=40)", 100);
+  const Model truth = stochastic::parseModel("WN(sigma=0.01) + GM(sigma=0.002, T=0.5) + GM(sigma=0.004, T=40)", 100);
   gmwm::FitOptions o;
   o.weighting = gmwm::Weighting::Efficient;
   const auto fe = gmwm::fit(kinds(truth), exactWv(truth, 1u << 20), o);
@@ -275,9 +267,7 @@ Model withLogParams(Model m, const Eigen::VectorXd& p) {
 TEST(GmwmFit, EfficientAsymptoticSeAtTable1) {
   const std::size_t n = 4320000;
   for (const auto& [name, text] : kTable1Refs) {
-    Model m;
-    m.rate_hz = 200;
-    m.terms = stochastic::parseTerms(text, m.rate_hz);
+    Model m = stochastic::parseModel(text, 200);
     gmwm::WaveletVariance wv = exactWv(m, n);
     const int J = wv.scales();
     Eigen::MatrixXd V = gmwm::wvCovariance(m, wv);
@@ -352,9 +342,7 @@ TEST(GmwmFit, RecoversTable1ReferenceModels) {
   const std::uint64_t seeds[10] = {101, 202, 303, 404, 505, 606, 707, 808, 909, 1010};
   const std::size_t n = 4320000;  // 6 h at 200 Hz
   for (const auto& [name, text] : kTable1Refs) {
-    Model truth;
-    truth.rate_hz = 200.0;
-    truth.terms = stochastic::parseTerms(text, truth.rate_hz);
+    const Model truth = stochastic::parseModel(text, 200.0);
     const auto tg = gms(truth);
     const double record_s = n / truth.rate_hz;
     struct Count {
@@ -457,9 +445,7 @@ bool negligible(const Process& p, double rate, const gmwm::WaveletVariance& wv) 
 // terms are not; a term just above 0.1 x the CI width at one scale is not
 // flagged, just below it at every scale is.
 TEST(GmwmFit, NegligibleTermsAreFlagged) {
-  Model m;
-  m.rate_hz = 100;
-  m.terms = stochastic::parseTerms("WN(sigma=0.01) + GM(sigma=0.003, T=2) + DR(omega=1e-40) + RW(gamma=1e-30)", 100);
+  Model m = stochastic::parseModel("WN(sigma=0.01) + GM(sigma=0.003, T=2) + DR(omega=1e-40) + RW(gamma=1e-30)", 100);
   const auto wv = simulatedWv(m, 1u << 16, 5);
   const std::vector<bool> neg = gmwm::negligibleTerms(m, wv);
   ASSERT_EQ(neg.size(), 4u);
@@ -630,9 +616,7 @@ TEST(GmwmFit, GlobalOptimumWithoutDuplicateTermsOnRandomModels) {
 // beyond the record next to a RW, two WNs; and a measurably correlated
 // sub-sample GM (lag-1 correlation 0.16, as on the ADIS16405) is not a pair.
 TEST(GmwmFit, RedundantTermsRules) {
-  Model m;
-  m.rate_hz = 100;
-  m.terms = stochastic::parseTerms("WN(sigma=0.01) + GM(sigma=0.003, T=2)", 100);
+  Model m = stochastic::parseModel("WN(sigma=0.01) + GM(sigma=0.003, T=2)", 100);
   const auto wv = simulatedWv(m, 1u << 16, 7);
   auto pairs = [&](const char* text) { Model x = m; x.terms = stochastic::parseTerms(text, 100); return gmwm::redundantTerms(x, wv); };
   EXPECT_TRUE(pairs("WN(sigma=0.01) + GM(sigma=0.003, T=2)").empty());

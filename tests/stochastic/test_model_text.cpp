@@ -37,6 +37,14 @@ TEST(ModelText, AllKindsKeyOrderAndWhitespace) {
   EXPECT_EQ(t[4], Process::wn(1.0));
 }
 
+TEST(ModelText, ParseModelGivesTheTermsAtTheRate) {
+  const Model m = parseModel("WN(sigma=1e-3) + AR1(phi=0.5, sigma2=1)", 50.0);
+  EXPECT_EQ(m.rate_hz, 50.0);
+  ASSERT_EQ(m.terms.size(), 2u);
+  EXPECT_EQ(formatTerms(m.terms, 17), formatTerms(parseTerms("WN(sigma=1e-3) + AR1(phi=0.5, sigma2=1)", 50.0), 17));
+  EXPECT_NE(errorOf([] { parseModel("WN(sigma=)", 50.0); }).find("expected a number"), std::string::npos);
+}
+
 TEST(ModelText, NoneIsEmpty) {
   EXPECT_TRUE(parseTerms("none", 200.0).empty());
   EXPECT_TRUE(parseTerms("  none ", 200.0).empty());

@@ -246,6 +246,13 @@ std::vector<Process> parseTerms(const std::string& text, double rate_hz) {
   return terms;
 }
 
+Model parseModel(const std::string& text, double rate_hz) {
+  Model m;
+  m.rate_hz = rate_hz;
+  m.terms = parseTerms(text, rate_hz);
+  return m;
+}
+
 std::string formatTerms(const std::vector<Process>& terms, int digits) {
   if (terms.empty()) return "none";
   std::string s;

@@ -25,6 +25,9 @@ namespace navimpact::stochastic {
  */
 std::vector<Process> parseTerms(const std::string& text, double rate_hz);
 
+/// The model at @p rate_hz whose terms are @p text (parseTerms). @throws navimpact::Error as parseTerms.
+Model parseModel(const std::string& text, double rate_hz);
+
 /// Text form with 4 significant digits by default; round-trips exactly with
 /// digits=17 (then each number is printed with the shortest of 15/16/17 digits
 /// that reads back as the same double, e.g. 4.811e-4 rather than 0.00048109999999999998).
