@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "gmwm_test_util.hpp"
 #include "navimpact/core/csv_reader.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
@@ -137,14 +138,8 @@ TEST_P(WvReference, MatchesRPackageOnFullRecording) {
 INSTANTIATE_TEST_SUITE_P(Acquisitions, WvReference, ::testing::Values(1, 2, 3));
 
 TEST(Wv, MatchesNaiveDefinitionWithLargeMean) {
-  std::mt19937_64 rng(11);
-  std::normal_distribution<double> nd(0.0, 1.0);
-  std::vector<double> x(1000);
-  double rw = 0;
-  for (auto& v : x) {
-    rw += 0.05 * nd(rng);
-    v = 1e3 + nd(rng) + rw;  // large mean, white noise and a random walk
-  }
+  // large mean, white noise and a random walk
+  const std::vector<double> x = gmwmtest::levelNoiseAndAr1(1000, 11, 1e3, 1.0, 1.0, 0.05);
   const auto w = gmwm::waveletVariance(x.data(), x.size(), 10.0);
   ASSERT_EQ(w.scales(), 9);  // floor(log2 1000)
   for (int j = 1; j <= 9; ++j) {
@@ -159,14 +154,7 @@ TEST(Wv, MatchesNaiveDefinitionWithLargeMean) {
 
 TEST(Wv, BlockedPyramidMatchesWholeArrayPyramid) {
   // 200003 samples: several cache blocks in every stage of the blocked code.
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> nd(0.0, 1.0);
-  std::vector<double> x(200003);
-  double ar = 0;
-  for (auto& v : x) {
-    ar = 0.999 * ar + 0.1 * nd(rng);
-    v = -9.8 + 0.01 * nd(rng) + ar;
-  }
+  const std::vector<double> x = gmwmtest::levelNoiseAndAr1(200003, 5, -9.8, 0.01, 0.999, 0.1);
   const auto w = gmwm::waveletVariance(x.data(), x.size(), 100.0);
   const auto ref = simplePyramidWv(x, 17);
   ASSERT_EQ(w.scales(), 17);

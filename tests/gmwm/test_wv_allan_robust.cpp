@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "gmwm_test_util.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 
@@ -27,14 +28,7 @@ std::vector<double> whiteNoise(std::size_t n, double sigma, unsigned seed) {
 TEST(Allan, EqualsTwiceHaarWvAtDoubleCluster) {
   // Haar: W_{j,t} = (theta_{t+1} - 2 theta_{t+1-m} + theta_{t+1-2m}) / (2m), m = 2^{j-1},
   // so AVAR(m) = 2 nu^2(2m) term by term with the same n - 2m + 1 terms (gmwm_formulas.md §1).
-  std::mt19937_64 rng(7);
-  std::normal_distribution<double> nd(0.0, 1.0);
-  std::vector<double> x(50000);
-  double rw = 0;
-  for (auto& v : x) {
-    rw += 0.01 * nd(rng);
-    v = 9.81 + 0.05 * nd(rng) + rw;
-  }
+  const std::vector<double> x = gmwmtest::levelNoiseAndAr1(50000, 7, 9.81, 0.05, 1.0, 0.01);
   const auto wv = gmwm::waveletVariance(x.data(), x.size(), 100.0);
   Eigen::VectorXd m(wv.scales());
   for (int i = 0; i < wv.scales(); ++i) m[i] = wv.tau[i] / 2.0;
