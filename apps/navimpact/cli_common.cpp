@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <vector>
 
 namespace navimpact::cli {
@@ -18,6 +19,16 @@ std::vector<Command>& registry() {
 void addOverwriteFlag(CLI::App& app, bool& flag) {
   app.add_flag("--overwrite", flag,
                "replace an existing, non-empty output whole (default: refuse it before any work)");
+}
+
+Command mergeCommand(std::string name, std::string help, std::function<int(const MergeOpts&)> run) {
+  return {std::move(name), std::move(help), [run = std::move(run)](CLI::App& app) {
+            auto o = std::make_shared<MergeOpts>();
+            app.add_option("dirs", o->dirs, "shard folders")->required();
+            app.add_option("--out", o->out, "output folder")->required();
+            addOverwriteFlag(app, o->overwrite);
+            return std::function<int()>([o, run]() -> int { return run(*o); });
+          }};
 }
 
 std::string executablePath() {

@@ -25,6 +25,17 @@ struct Registrar {
   explicit Registrar(Command c) { registry().push_back(std::move(c)); }
 };
 
+/// Options of a command that merges the shard folders of a run into one
+/// output (study-merge, sweep-merge).
+struct MergeOpts {
+  std::vector<std::string> dirs;
+  std::string out;
+  bool overwrite = false;
+};
+
+/// The merge command @p name: the shard folders, --out and --overwrite, then @p run.
+Command mergeCommand(std::string name, std::string help, std::function<int(const MergeOpts&)> run);
+
 /// Declare --overwrite on a command that writes an output folder or file:
 /// without it a non-empty output is refused before any work; with it the
 /// output is replaced whole when the job succeeds.

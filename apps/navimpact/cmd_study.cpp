@@ -23,12 +23,6 @@ struct StudyOpts {
   bool overwrite = false;
 };
 
-struct MergeOpts {
-  std::vector<std::string> dirs;
-  std::string out;
-  bool overwrite = false;
-};
-
 void printSummary(const an::StudyResults& r, const std::string& dir) {
   std::cout << "study: " << r.acc.runs << " runs x " << r.meta.labels.size() << " models on "
             << r.meta.trajectory << "\n";
@@ -67,7 +61,7 @@ int runStudyCmd(const StudyOpts& o) {
   return 0;
 }
 
-int runMergeCmd(const MergeOpts& o) {
+int runMergeCmd(const navimpact::cli::MergeOpts& o) {
   navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
   const an::StudyResults res = an::mergeShards(o.dirs);
   navimpact::report::writeStudyOutputs(res, out);
@@ -94,13 +88,7 @@ navimpact::cli::Registrar regStudy({"study",
                                       return [o]() -> int { return runStudyCmd(*o); };
                                     }});
 
-navimpact::cli::Registrar regMerge({"study-merge", "Merge study shards (navimpact study --shard K/N) into one study",
-                                    [](CLI::App& app) {
-                                      auto o = std::make_shared<MergeOpts>();
-                                      app.add_option("dirs", o->dirs, "shard folders")->required();
-                                      app.add_option("--out", o->out, "output folder")->required();
-                                      navimpact::cli::addOverwriteFlag(app, o->overwrite);
-                                      return [o]() -> int { return runMergeCmd(*o); };
-                                    }});
+navimpact::cli::Registrar regMerge(navimpact::cli::mergeCommand(
+    "study-merge", "Merge study shards (navimpact study --shard K/N) into one study", runMergeCmd));
 
 }  // namespace

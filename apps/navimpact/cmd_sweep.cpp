@@ -42,12 +42,6 @@ struct SweepOpts {
   bool overwrite = false;
 };
 
-struct MergeOpts {
-  std::vector<std::string> dirs;
-  std::string out;
-  bool overwrite = false;
-};
-
 void printSummary(const an::SweepResults& r, const std::string& dir) {
   std::cout << "sweep: " << r.meta.columns.size() << " column(s) x " << r.meta.durations_s.size()
             << " outage durations x " << r.meta.labels.size() << " models, " << r.runs << " runs per cell\n";
@@ -240,7 +234,7 @@ int emitSlurm(const SweepOpts& o, const an::SweepConfig& cfg, const an::SweepMet
   return 0;
 }
 
-int runMergeCmd(const MergeOpts& o) {
+int runMergeCmd(const navimpact::cli::MergeOpts& o) {
   const auto t0 = std::chrono::steady_clock::now();
   navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
   const an::SweepRuns runs = an::mergeSweepShards(o.dirs, navimpact::cli::buildId());
@@ -287,14 +281,7 @@ navimpact::cli::Registrar regSweep(
        return [o]() -> int { return runSweepCmd(*o); };
      }});
 
-navimpact::cli::Registrar regMerge({"sweep-merge",
-                                    "Merge sweep shards (navimpact sweep --shard K/N) into the map of the whole sweep",
-                                    [](CLI::App& app) {
-                                      auto o = std::make_shared<MergeOpts>();
-                                      app.add_option("dirs", o->dirs, "shard folders")->required();
-                                      app.add_option("--out", o->out, "output folder")->required();
-                                      navimpact::cli::addOverwriteFlag(app, o->overwrite);
-                                      return [o]() -> int { return runMergeCmd(*o); };
-                                    }});
+navimpact::cli::Registrar regMerge(navimpact::cli::mergeCommand(
+    "sweep-merge", "Merge sweep shards (navimpact sweep --shard K/N) into the map of the whole sweep", runMergeCmd));
 
 }  // namespace
