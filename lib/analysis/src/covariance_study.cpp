@@ -45,11 +45,7 @@ std::string modelText(const stochastic::ImuModel& m) {
 }  // namespace
 
 CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
-  InputScope scope(path);
-  CovarianceStudyConfig c;
-  c.source = path;
-  c.loadFrom(ConfigNode::load(path));
-  return c;
+  return loadConfigFile(path, &CovarianceStudyConfig::source);
 }
 
 void CovarianceStudyConfig::loadFrom(const ConfigNode& root) {

@@ -65,11 +65,7 @@ Eigen::Vector3d sigma3(const ConfigNode& n, const std::string& k, const limits::
 }  // namespace
 
 ReplayConfig loadReplayConfig(const std::string& path) {
-  InputScope scope(path);
-  ReplayConfig c;
-  c.config_file = path;
-  c.loadFrom(ConfigNode::load(path));
-  return c;
+  return loadConfigFile(path, &ReplayConfig::config_file);
 }
 
 void ReplayConfig::loadFrom(const ConfigNode& root) {

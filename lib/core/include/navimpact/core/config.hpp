@@ -157,4 +157,16 @@ class ConfigNode {
   std::string path_;
 };
 
+/// The configuration file @p path read by @p Config::loadFrom(ConfigNode),
+/// with the path kept in its member @p file; an exception other than
+/// navimpact::Error leaving the read names the file (InputScope).
+template <class Config>
+Config loadConfigFile(const std::string& path, std::string Config::*file) {
+  InputScope scope(path);
+  Config c;
+  c.*file = path;
+  c.loadFrom(ConfigNode::load(path));
+  return c;
+}
+
 }  // namespace navimpact
