@@ -92,6 +92,16 @@ const ErrorStateEkf::Cache::Blocks& ErrorStateEkf::Cache::blocksFor(
 }
 
 namespace {
+/// @throws Error "WHAT must be > 0 at t = T s" unless every sigma is finite and > 0.
+template <class Derived>
+void requirePositiveSigma(const Eigen::MatrixBase<Derived>& sigma, const char* what, double t) {
+  if (!(sigma.array() > 0.0).all() || !sigma.allFinite())
+    throw Error(std::string(what) + " must be > 0 at t = " + formatNumber(t, 9) + " s");
+}
+void requirePositiveSigma(double sigma, const char* what, double t) {
+  requirePositiveSigma(Eigen::Matrix<double, 1, 1>(sigma), what, t);
+}
+
 bool sameState(const ins::NavState& a, const ins::NavState& b) {
   return a.lat == b.lat && a.lon == b.lon && a.h == b.h && a.v_N == b.v_N &&
          a.q_BtoN.coeffs() == b.q_BtoN.coeffs();
@@ -939,12 +949,10 @@ VectorXd ErrorStateEkf::residualGnssPosition(const earth::Geodetic& z, const Vec
 
 UpdateResult ErrorStateEkf::updateGnssPosition(const earth::Geodetic& z, const Vector3d& sigma,
                                                const Vector3d& lever_B, double dt_meas) {
-  if (!(sigma.array() > 0.0).all() || !sigma.allFinite())
-    throw Error("GNSS position sigma must be > 0 at t = " + formatNumber(state().t, 9) + " s");
+  requirePositiveSigma(sigma, "GNSS position sigma", state().t);
   flushPropagation();
-  const VectorXd dz = residualGnssPosition(z, lever_B, dt_meas);
-  const MatrixXd R = sigma.cwiseAbs2().asDiagonal();
-  return update(dz, H_gnssPosition(lever_B, dt_meas), R);
+  return update(residualGnssPosition(z, lever_B, dt_meas), H_gnssPosition(lever_B, dt_meas),
+                MatrixXd(sigma.cwiseAbs2().asDiagonal()));
 }
 
 VectorXd ErrorStateEkf::residualGnssVelocity(const Vector3d& z_N, const Vector3d& lever_B,
@@ -958,17 +966,14 @@ VectorXd ErrorStateEkf::residualGnssVelocity(const Vector3d& z_N, const Vector3d
 
 UpdateResult ErrorStateEkf::updateGnssVelocity(const Vector3d& z_N, const Vector3d& sigma,
                                                const Vector3d& lever_B, double dt_meas) {
-  if (!(sigma.array() > 0.0).all() || !sigma.allFinite())
-    throw Error("GNSS velocity sigma must be > 0 at t = " + formatNumber(state().t, 9) + " s");
+  requirePositiveSigma(sigma, "GNSS velocity sigma", state().t);
   flushPropagation();
-  const VectorXd dz = residualGnssVelocity(z_N, lever_B, dt_meas);
-  const MatrixXd R = sigma.cwiseAbs2().asDiagonal();
-  return update(dz, H_gnssVelocity(lever_B, dt_meas), R);
+  return update(residualGnssVelocity(z_N, lever_B, dt_meas), H_gnssVelocity(lever_B, dt_meas),
+                MatrixXd(sigma.cwiseAbs2().asDiagonal()));
 }
 
 UpdateResult ErrorStateEkf::updateZeroVelocity(double sigma) {
-  if (!(sigma > 0.0) || !std::isfinite(sigma))
-    throw Error("zero-velocity update sigma must be > 0 at t = " + formatNumber(state().t, 9) + " s");
+  requirePositiveSigma(sigma, "zero-velocity update sigma", state().t);
   flushPropagation();
   const VectorXd dz = state().v_N;
   return update(dz, H_zeroVelocity(), MatrixXd::Identity(3, 3) * (sigma * sigma));
@@ -983,9 +988,7 @@ Eigen::Vector2d ErrorStateEkf::residualNonHolonomic(const Vector3d& point_B) con
 
 UpdateResult ErrorStateEkf::updateNonHolonomic(double sigma_lat, double sigma_vert,
                                                const Vector3d& point_B) {
-  if (!(sigma_lat > 0.0) || !std::isfinite(sigma_lat) || !(sigma_vert > 0.0) ||
-      !std::isfinite(sigma_vert))
-    throw Error("non-holonomic constraint sigmas must be > 0 at t = " + formatNumber(state().t, 9) + " s");
+  requirePositiveSigma(Eigen::Vector2d(sigma_lat, sigma_vert), "non-holonomic constraint sigmas", state().t);
   flushPropagation();
   const VectorXd dz = residualNonHolonomic(point_B);
   MatrixXd R = MatrixXd::Zero(2, 2);
@@ -995,8 +998,7 @@ UpdateResult ErrorStateEkf::updateNonHolonomic(double sigma_lat, double sigma_ve
 }
 
 UpdateResult ErrorStateEkf::updateBaro(double h_meas, double sigma) {
-  if (!(sigma > 0.0) || !std::isfinite(sigma))
-    throw Error("barometer sigma must be > 0 at t = " + formatNumber(state().t, 9) + " s");
+  requirePositiveSigma(sigma, "barometer sigma", state().t);
   VectorXd dz(1);
   dz(0) = state().h - h_meas;
   return update(dz, H_baro(), MatrixXd::Constant(1, 1, sigma * sigma));
