@@ -42,24 +42,29 @@ stochastic::Model whiteShortGms(const stochastic::Model& in, double t_max, const
   return out;
 }
 
+/// The section of an effect on both triads (scale_factor, misalignment): the
+/// prior sigma and initial value of the gyro's and the accelerometer's,
+/// keys gyro_sigma, acc_sigma, gyro, acc with the unit @p suffix ("" or "_rad").
+void readTriadSection(const ConfigNode& s, const std::string& suffix, double& gyro_sigma, double& acc_sigma,
+                      Eigen::Vector3d& gyro0, Eigen::Vector3d& acc0, const limits::Range& sigma_range,
+                      const limits::Range& range) {
+  s.allowKeys(std::vector<std::string>{"gyro_sigma" + suffix, "acc_sigma" + suffix, "gyro" + suffix, "acc" + suffix});
+  s.read("gyro_sigma" + suffix, gyro_sigma, sigma_range);
+  s.read("acc_sigma" + suffix, acc_sigma, sigma_range);
+  s.read("gyro" + suffix, gyro0, range);
+  s.read("acc" + suffix, acc0, range);
+}
+
 }  // namespace
 
 void ExtraStates::loadFrom(const ConfigNode& n) {
   n.allowKeys({"scale_factor", "misalignment", "lever_arm", "time_offset"});
-  if (const auto s = n.optMap("scale_factor")) {
-    s->allowKeys({"gyro_sigma", "acc_sigma", "gyro", "acc"});
-    s->read("gyro_sigma", gyro_scale_sigma, limits::kScaleFactorSigma);
-    s->read("acc_sigma", acc_scale_sigma, limits::kScaleFactorSigma);
-    s->read("gyro", gyro_scale0, limits::kScaleFactor);
-    s->read("acc", acc_scale0, limits::kScaleFactor);
-  }
-  if (const auto m = n.optMap("misalignment")) {
-    m->allowKeys({"gyro_sigma_rad", "acc_sigma_rad", "gyro_rad", "acc_rad"});
-    m->read("gyro_sigma_rad", gyro_misalignment_sigma_rad, limits::kMisalignmentSigmaRad);
-    m->read("acc_sigma_rad", acc_misalignment_sigma_rad, limits::kMisalignmentSigmaRad);
-    m->read("gyro_rad", gyro_misalignment0_rad, limits::kMisalignmentRad);
-    m->read("acc_rad", acc_misalignment0_rad, limits::kMisalignmentRad);
-  }
+  if (const auto s = n.optMap("scale_factor"))
+    readTriadSection(*s, "", gyro_scale_sigma, acc_scale_sigma, gyro_scale0, acc_scale0, limits::kScaleFactorSigma,
+                     limits::kScaleFactor);
+  if (const auto m = n.optMap("misalignment"))
+    readTriadSection(*m, "_rad", gyro_misalignment_sigma_rad, acc_misalignment_sigma_rad, gyro_misalignment0_rad,
+                     acc_misalignment0_rad, limits::kMisalignmentSigmaRad, limits::kMisalignmentRad);
   if (const auto l = n.optMap("lever_arm")) {
     l->allowKeys({"sigma_m", "error_m"});
     l->read("sigma_m", lever_arm_sigma_m, limits::kLeverArmErrorSigmaM);
