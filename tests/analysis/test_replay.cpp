@@ -45,12 +45,30 @@ std::pair<std::string, std::string> writeWithAndWithoutGt(const std::filesystem:
   return {withGt, noGt};
 }
 
-// GNSS outages every PERIOD:DURATION drawn at random: a period in [4, max_period] s,
-// a duration that leaves at least 0.5 s of GNSS on either side.
-navimpact::OutagePattern drawPattern(std::mt19937_64& rng, double max_period) {
-  const double period = std::uniform_real_distribution<double>(4.0, max_period)(rng);
-  const double duration = std::uniform_real_distribution<double>(0.5, period - 0.5)(rng);
-  return {period, duration};
+// @p draws random draws of GNSS outages every PERIOD:DURATION (a period in
+// [4, max_period] s, a duration leaving at least 0.5 s of GNSS on either side),
+// each with one more value uniform in [lo, hi] (@p what names it), from a
+// random seed; each draw is printed, its trace names the seed and the draw.
+struct PatternDraw {
+  navimpact::OutagePattern pattern;
+  double value = 0.0;
+  std::string trace;
+};
+std::vector<PatternDraw> drawPatterns(int draws, double max_period, double lo, double hi, const char* what) {
+  const std::uint64_t seed = std::random_device{}();
+  std::mt19937_64 rng(seed);
+  std::vector<PatternDraw> out;
+  for (int draw = 0; draw < draws; ++draw) {
+    PatternDraw d;
+    d.pattern.period_s = std::uniform_real_distribution<double>(4.0, max_period)(rng);
+    d.pattern.duration_s = std::uniform_real_distribution<double>(0.5, d.pattern.period_s - 0.5)(rng);
+    d.value = std::uniform_real_distribution<double>(lo, hi)(rng);
+    d.trace = "seed " + std::to_string(seed) + " draw " + std::to_string(draw);
+    std::printf("%s: outages every %.4f:%.4f s, %s %.4f\n", d.trace.c_str(), d.pattern.period_s, d.pattern.duration_s,
+                what, d.value);
+    out.push_back(d);
+  }
+  return out;
 }
 
 // The replay of @p path with the reference model, the outage @p outage and
@@ -441,18 +459,11 @@ TEST(Replay, ExtraStatesFromTheConfigurationAreEstimated) {
 // start to the last IMU sample). Pattern drawn at random (seed printed), with
 // and without a reference (aligning phase), with an explicit outage besides.
 TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) {
-  const auto dir = navimpact::test::tempDir();
-  const auto [withGt, noGt] = writeWithAndWithoutGt(dir, "");
-  const std::uint64_t seed = std::random_device{}();
-  std::mt19937_64 rng(seed);
-  for (int draw = 0; draw < 3; ++draw) {
-    const navimpact::OutagePattern pattern = drawPattern(rng, 30.0);
-    const double explicitStart = std::uniform_real_distribution<double>(0.0, 40.0)(rng);
-    std::printf("seed %llu draw %d: outages every %.4f:%.4f s, explicit outage %.4f:5 s\n",
-                static_cast<unsigned long long>(seed), draw, pattern.period_s, pattern.duration_s, explicitStart);
+  const auto [withGt, noGt] = writeWithAndWithoutGt(navimpact::test::tempDir(), "");
+  for (const PatternDraw& d : drawPatterns(3, 30.0, 0.0, 40.0, "explicit 5 s outage from [s]")) {
     for (const auto& path : {withGt, noGt}) {
-      SCOPED_TRACE(path + " seed " + std::to_string(seed) + " draw " + std::to_string(draw));
-      const an::ReplayConfig c = patternReplay(path, navimpact::Outage::fromStartDuration(explicitStart, 5.0), pattern);
+      SCOPED_TRACE(path + " " + d.trace);
+      const an::ReplayConfig c = patternReplay(path, navimpact::Outage::fromStartDuration(d.value, 5.0), d.pattern);
       const an::ReplayResult whole = an::runReplay(c);
       std::ostringstream csv;
       navimpact::report::ReplayWriter writer(csv);
@@ -479,18 +490,12 @@ TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) 
 // reference's content and sigma still come from the whole data). Outage
 // patterns and the stop drawn at random (seed printed).
 TEST(Replay, ReplayFromRecordsInMemoryIsTheReplayAndStopsWhereAsked) {
-  const auto dir = navimpact::test::tempDir();
-  const auto [withGt, noGt] = writeWithAndWithoutGt(dir, "mem_");
-  const std::uint64_t seed = std::random_device{}();
-  std::mt19937_64 rng(seed);
-  for (int draw = 0; draw < 2; ++draw) {
-    const navimpact::OutagePattern pattern = drawPattern(rng, 20.0);
-    const double u = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
-    std::printf("seed %llu draw %d: outages every %.4f:%.4f s, stop at %.4f of the filter's time\n",
-                static_cast<unsigned long long>(seed), draw, pattern.period_s, pattern.duration_s, u);
+  const auto [withGt, noGt] = writeWithAndWithoutGt(navimpact::test::tempDir(), "mem_");
+  for (const PatternDraw& d : drawPatterns(2, 20.0, 0.0, 1.0, "stop at this share of the filter's time:")) {
+    const double u = d.value;
     for (const auto& path : {withGt, noGt}) {
-      SCOPED_TRACE(path + " seed " + std::to_string(seed) + " draw " + std::to_string(draw));
-      const an::ReplayConfig c = patternReplay(path, navimpact::Outage::fromStartDuration(2.0, 3.0), pattern);
+      SCOPED_TRACE(path + " " + d.trace);
+      const an::ReplayConfig c = patternReplay(path, navimpact::Outage::fromStartDuration(2.0, 3.0), d.pattern);
       const an::ReplayResult whole = an::runReplay(c);
       const double stop = whole.aided_from_s + 1.0 + u * (55.0 - whole.aided_from_s);
       const navimpact::rawlog::RawlogRecords data = navimpact::rawlog::readRawlogRecords(path);
