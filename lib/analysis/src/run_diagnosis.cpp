@@ -280,17 +280,56 @@ constexpr double kFitTimeOffsetSigmaS = 0.5 * limits::kTimeOffsetS.hi;  // [s]
 constexpr double kFitLeverArmSigmaM = 0.5 * limits::kLeverArmErrorM.hi; // [m]
 constexpr double kZ95 = 1.959963984540054;                              // two-sided 95 % normal quantile
 
+/// The filter groups of a cause acting on both triads (scale factor,
+/// misalignment), gyro [0] and accelerometer [1]: their prior sigmas and
+/// initial values (ExtraStates), their estimates (SensorParams), the prior
+/// of the fitting replays, the ranges, and how a finding names them.
+struct TriadGroups {
+  double filter::ExtraStates::*sigma[2];
+  Eigen::Vector3d filter::ExtraStates::*initial[2];
+  Eigen::Vector3d filter::SensorParams::*estimate[2];
+  double fit_sigma;
+  limits::Range sigma_range, range;
+  const char* cause;
+  const char* param;
+  const char* note;
+};
+
+/// The triad groups of @p kind; nullptr for a cause that is not one.
+const TriadGroups* triadGroups(ExtraCause kind) {
+  using X = filter::ExtraStates;
+  using P = filter::SensorParams;
+  static const TriadGroups scale{{&X::gyro_scale_sigma, &X::acc_scale_sigma},
+                                 {&X::gyro_scale0, &X::acc_scale0},
+                                 {&P::gyro_scale, &P::acc_scale},
+                                 kFitScaleSigma,
+                                 limits::kScaleFactorSigma,
+                                 limits::kScaleFactor,
+                                 "scale_factor",
+                                 "scale",
+                                 "scale factor [ratio]: "};
+  static const TriadGroups misalignment{{&X::gyro_misalignment_sigma_rad, &X::acc_misalignment_sigma_rad},
+                                        {&X::gyro_misalignment0_rad, &X::acc_misalignment0_rad},
+                                        {&P::gyro_misalignment_rad, &P::acc_misalignment_rad},
+                                        kFitMisalignmentSigmaRad,
+                                        limits::kMisalignmentSigmaRad,
+                                        limits::kMisalignmentRad,
+                                        "misalignment",
+                                        "angle",
+                                        "misalignment angle of the triad about this axis [rad]: "};
+  return kind == ExtraCause::ScaleFactor ? &scale : kind == ExtraCause::Misalignment ? &misalignment : nullptr;
+}
+
 /// @p base with the group(s) of @p kind on at the fitting prior (the configured one when larger).
 filter::ExtraStates withFitPrior(ExtraCause kind, filter::ExtraStates x) {
+  if (const TriadGroups* t = triadGroups(kind)) {
+    for (int i = 0; i < 2; ++i) x.*t->sigma[i] = std::max(x.*t->sigma[i], t->fit_sigma);
+    return x;
+  }
   switch (kind) {
     case ExtraCause::ScaleFactor:
-      x.gyro_scale_sigma = std::max(x.gyro_scale_sigma, kFitScaleSigma);
-      x.acc_scale_sigma = std::max(x.acc_scale_sigma, kFitScaleSigma);
-      break;
     case ExtraCause::Misalignment:
-      x.gyro_misalignment_sigma_rad = std::max(x.gyro_misalignment_sigma_rad, kFitMisalignmentSigmaRad);
-      x.acc_misalignment_sigma_rad = std::max(x.acc_misalignment_sigma_rad, kFitMisalignmentSigmaRad);
-      break;
+      break;  // triad groups, above
     case ExtraCause::TimeOffset:
       x.time_offset_sigma_s = std::max(x.time_offset_sigma_s, kFitTimeOffsetSigmaS);
       break;
@@ -316,19 +355,17 @@ Eigen::Vector3d clampTo(const Eigen::Vector3d& e, const limits::Range& r) {
 /// @p x with the group(s) of @p kind on, initialised at a replay's estimates with its sigmas as prior.
 filter::ExtraStates withFitted(ExtraCause kind, filter::ExtraStates x, const filter::SensorParams& e,
                                const filter::SensorParams& s) {
+  if (const TriadGroups* t = triadGroups(kind)) {
+    for (int i = 0; i < 2; ++i) {
+      x.*t->sigma[i] = fittedSigma(s.*t->estimate[i], 3, t->sigma_range.hi);
+      x.*t->initial[i] = clampTo(e.*t->estimate[i], t->range);
+    }
+    return x;
+  }
   switch (kind) {
     case ExtraCause::ScaleFactor:
-      x.gyro_scale_sigma = fittedSigma(s.gyro_scale, 3, limits::kScaleFactorSigma.hi);
-      x.acc_scale_sigma = fittedSigma(s.acc_scale, 3, limits::kScaleFactorSigma.hi);
-      x.gyro_scale0 = clampTo(e.gyro_scale, limits::kScaleFactor);
-      x.acc_scale0 = clampTo(e.acc_scale, limits::kScaleFactor);
-      break;
     case ExtraCause::Misalignment:
-      x.gyro_misalignment_sigma_rad = fittedSigma(s.gyro_misalignment_rad, 3, limits::kMisalignmentSigmaRad.hi);
-      x.acc_misalignment_sigma_rad = fittedSigma(s.acc_misalignment_rad, 3, limits::kMisalignmentSigmaRad.hi);
-      x.gyro_misalignment0_rad = clampTo(e.gyro_misalignment_rad, limits::kMisalignmentRad);
-      x.acc_misalignment0_rad = clampTo(e.acc_misalignment_rad, limits::kMisalignmentRad);
-      break;
+      break;  // triad groups, above
     case ExtraCause::TimeOffset:
       x.time_offset_sigma_s = fittedSigma(Eigen::Vector3d(s.time_offset_s, 0, 0), 1, limits::kTimeOffsetSigmaS.hi);
       x.time_offset0_s = std::min(limits::kTimeOffsetS.hi, std::max(limits::kTimeOffsetS.lo, e.time_offset_s));
@@ -356,18 +393,16 @@ std::vector<RunFinding> extraFindings(ExtraCause kind, const filter::SensorParam
   };
   const std::string how = "the filter's estimate of the state at the end of the whole run (GNSS throughout), 95 % "
                           "interval +- 1.96 sigma from its covariance";
+  if (const TriadGroups* t = triadGroups(kind)) {
+    for (int c = 0; c < 6; ++c)
+      add(t->cause, kChannelNames[c], t->param, (e.*t->estimate[c / 3])(c % 3), (s.*t->estimate[c / 3])(c % 3),
+          t->note + how);
+    return v;
+  }
   switch (kind) {
     case ExtraCause::ScaleFactor:
-      for (int c = 0; c < 6; ++c)
-        add("scale_factor", kChannelNames[c], "scale", c < 3 ? e.gyro_scale(c) : e.acc_scale(c - 3),
-            c < 3 ? s.gyro_scale(c) : s.acc_scale(c - 3), "scale factor [ratio]: " + how);
-      break;
     case ExtraCause::Misalignment:
-      for (int c = 0; c < 6; ++c)
-        add("misalignment", kChannelNames[c], "angle", c < 3 ? e.gyro_misalignment_rad(c) : e.acc_misalignment_rad(c - 3),
-            c < 3 ? s.gyro_misalignment_rad(c) : s.acc_misalignment_rad(c - 3),
-            "misalignment angle of the triad about this axis [rad]: " + how);
-      break;
+      break;  // triad groups, above
     case ExtraCause::TimeOffset:
       add("time_offset", "all", "time_offset", e.time_offset_s, s.time_offset_s,
           "IMU-GNSS time offset t_IMU - t_true [s]: " + how);
