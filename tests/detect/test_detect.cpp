@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "detect_test_util.hpp"
 #include "navimpact/detect/change_points.hpp"
 #include "navimpact/detect/lines.hpp"
 #include "navimpact/detect/null_model.hpp"
@@ -44,13 +45,10 @@ struct Drawn {
 };
 
 Drawn drawNull(std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> U(0, 1);
-  auto logU = [&](double a, double b) { return a * std::pow(b / a, U(rng)); };
-  Drawn d;
-  d.n = static_cast<std::size_t>(std::lround(logU(8192, 65536)));
-  d.model.rate_hz = logU(50, 1000);
-  const double sw = logU(1e-4, 1e-1);
-  d.model.terms = {ns::Process::wn(sw)};
+  auto logU = [&](double a, double b) { return detecttest::logUniform(rng, a, b); };
+  const detecttest::WhiteRecord w = detecttest::drawWhiteRecord(rng, 8192, 65536);
+  Drawn d{w.model, w.n, ""};
+  const double sw = w.sigma;
   const int kind = static_cast<int>(rng() % 3);
   const double record = d.n / d.model.rate_hz;
   if (kind == 1) {

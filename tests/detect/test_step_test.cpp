@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <boost/math/distributions/normal.hpp>
 
+#include "detect_test_util.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/detect/change_points.hpp"
 #include "navimpact/detect/null_model.hpp"
@@ -41,13 +42,10 @@ struct Drawn {
 
 /// WN plus a random subset of QN, RW, GM (T from 2 samples to 10 records) and DR.
 Drawn drawModel(std::mt19937_64& g) {
-  std::uniform_real_distribution<double> U(0, 1);
-  auto logU = [&](double a, double b) { return a * std::pow(b / a, U(g)); };
-  Drawn d;
-  d.n = static_cast<std::size_t>(std::lround(logU(4096, 32768)));
-  d.model.rate_hz = logU(50, 1000);
-  const double sw = logU(1e-4, 1e-1), record = d.n / d.model.rate_hz;
-  d.model.terms = {ns::Process::wn(sw)};
+  auto logU = [&](double a, double b) { return detecttest::logUniform(g, a, b); };
+  const detecttest::WhiteRecord w = detecttest::drawWhiteRecord(g, 4096, 32768);
+  Drawn d{w.model, w.n};
+  const double sw = w.sigma, record = d.n / d.model.rate_hz;
   if (g() % 4 == 0) d.model.terms.push_back(ns::Process::qn(sw * logU(0.1, 1.0)));
   if (g() % 2 == 0) d.model.terms.push_back(ns::Process::rw(sw * logU(1e-4, 3e-2)));
   if (g() % 2 == 0)
