@@ -8,6 +8,7 @@
 #include <random>
 #include <string>
 
+#include "gmwm_test_util.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/gmwm/channels.hpp"
 #include "navimpact/stochastic/datasheet.hpp"
@@ -25,9 +26,7 @@ ImuSeries simulatedRecording(std::uint64_t seed, std::size_t n, double rate_hz) 
   std::mt19937_64 g(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   auto logU = [&](double lo, double hi) { return lo * std::pow(hi / lo, u(g)); };
-  ImuSeries s;
-  s.source = "simulated.csv";
-  s.rate_hz = rate_hz;
+  ImuSeries s = gmwmtest::seriesOf("simulated.csv", rate_hz);
   for (std::size_t c = 0; c < kChannelNames.size(); ++c) {
     stochastic::Model m;
     m.rate_hz = rate_hz;

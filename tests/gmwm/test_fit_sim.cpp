@@ -68,6 +68,22 @@ std::vector<Process> gms(const Model& m) {
   return g;
 }
 
+/// Fits with @p o on the WV of two simulated records of @p truth (2^18
+/// samples, seeds 31 and 32): each one's objective_fast is R's objective of its
+/// model, its objective is positive and below @p per_scale times the scales;
+/// @p more(fit, wv) checks the rest.
+template <class More>
+void checkSimulatedFits(const Model& truth, const gmwm::FitOptions& o, double per_scale, More more) {
+  for (std::uint64_t seed : {31u, 32u}) {
+    const auto wv = simulatedWv(truth, 1u << 18, seed);
+    const auto f = gmwm::fit(kinds(truth), wv, o);
+    EXPECT_NEAR(f.objective_fast, gmwm::objective(f.model, wv), 1e-12 * f.objective_fast);
+    EXPECT_GT(f.objective, 0.0);
+    EXPECT_LT(f.objective, per_scale * wv.scales()) << stochastic::formatTerms(f.model.terms);
+    more(f, wv);
+  }
+}
+
 }  // namespace
 
 // At an exact theoretical WV the estimator returns the truth (objective ~ 0):
@@ -113,18 +129,13 @@ TEST(GmwmFit, ModelBasedWeights) {
   EXPECT_LT(fe.objective_fast, 1e-10);
   const auto fast = gmwm::fit(kinds(truth), ex);
   EXPECT_EQ(fast.objective, fast.objective_fast);
-  for (std::uint64_t seed : {31u, 32u}) {
-    const auto wv = simulatedWv(truth, 1u << 18, seed);
-    const auto f = gmwm::fit(kinds(truth), wv, o);
-    EXPECT_NEAR(f.objective_fast, gmwm::objective(f.model, wv), 1e-12 * f.objective_fast);
-    EXPECT_GT(f.objective, 0.0);
-    EXPECT_LT(f.objective, 3.0 * wv.scales()) << stochastic::formatTerms(f.model.terms);
+  checkSimulatedFits(truth, o, 3.0, [](const gmwm::FitResult& f, const gmwm::WaveletVariance& wv) {
     // At the estimate the model weights are those of the returned model (up to the last pass's change).
     const Eigen::VectorXd w = gmwm::modelWeights(f.model, wv);
     const Eigen::VectorXd nu = stochastic::haarWv(f.model, wv.tau);
     const double own = ((wv.wv - nu).array().square() * w.array()).sum();
     EXPECT_NEAR(own, f.objective, 0.05 * f.objective);
-  }
+  });
   EXPECT_EQ(gmwm::parseWeighting("model"), gmwm::Weighting::ModelBased);
   EXPECT_EQ(gmwm::weightingName(gmwm::Weighting::Fast), "fast");
   EXPECT_THROW(gmwm::parseWeighting("optimal"), Error);
@@ -179,18 +190,13 @@ TEST(GmwmFit, EfficientWeights) {
   EXPECT_EQ(fe.weighting, gmwm::Weighting::Efficient);
   EXPECT_GE(fe.weight_passes, 1);
   EXPECT_LT(fe.objective, 1e-10);
-  for (std::uint64_t seed : {31u, 32u}) {
-    const auto wv = simulatedWv(truth, 1u << 18, seed);
-    const auto f = gmwm::fit(kinds(truth), wv, o);
-    EXPECT_NEAR(f.objective_fast, gmwm::objective(f.model, wv), 1e-12 * f.objective_fast);
-    EXPECT_GT(f.objective, 0.0);
-    EXPECT_LT(f.objective, 4.0 * wv.scales()) << stochastic::formatTerms(f.model.terms);
+  checkSimulatedFits(truth, o, 4.0, [](const gmwm::FitResult& f, const gmwm::WaveletVariance&) {
     for (std::size_t i = 0; i < f.ci.size(); ++i)
       for (const auto& pi : f.ci[i]) {
         EXPECT_LT(pi.low, pi.value);
         EXPECT_GT(pi.high, pi.value);
       }
-  }
+  });
   EXPECT_EQ(gmwm::parseWeighting("efficient"), gmwm::Weighting::Efficient);
   EXPECT_EQ(gmwm::weightingName(gmwm::Weighting::Efficient), "efficient");
 }

@@ -225,13 +225,9 @@ TEST(Wv, BadInputThrows) {
 }
 
 TEST(Wv, BatchNamesSourceAndChannel) {
-  ImuSeries s;
-  s.source = "some_file.csv";
-  s.rate_hz = 100;
+  ImuSeries s = gmwmtest::seriesOf("some_file.csv", 100);
   for (int c = 0; c < 6; ++c) {
-    ImuChannel ch;
-    ch.name = kChannelNames[c];
-    ch.quantity = channelQuantity(ch.name);
+    ImuChannel ch = gmwmtest::channelOf(kChannelNames[c]);
     ch.x = {1, 2, 4, 3, 5, 1, 0, 2};
     if (c == 4) ch.x.assign(8, 9.81);
     s.channels.push_back(ch);
@@ -255,15 +251,11 @@ TEST(Wv, BatchNamesSourceAndChannel) {
 TEST(Wv, NonFiniteResultIsAnErrorNamingTheCause) {
   const std::uint64_t seed = 77;
   std::mt19937_64 rng(seed);
-  ImuSeries s;
-  s.source = "big_sample.csv";
-  s.rate_hz = 100;
+  ImuSeries s = gmwmtest::seriesOf("big_sample.csv", 100);
   const int n = 512 + int(rng() % 512), at = int(rng() % n);
   const double big = std::pow(10.0, 160.0 + 140.0 * std::uniform_real_distribution<>(0, 1)(rng));
   SCOPED_TRACE("seed 77: n " + std::to_string(n) + " sample " + std::to_string(at) + " = " + std::to_string(big));
-  ImuChannel ch;
-  ch.name = "gyro_z";
-  ch.quantity = channelQuantity(ch.name);
+  ImuChannel ch = gmwmtest::channelOf("gyro_z");
   std::normal_distribution<> g(0, 1e-3);
   for (int i = 0; i < n; ++i) ch.x.push_back(g(rng));
   ch.x[at] = big;
@@ -284,15 +276,11 @@ TEST(Wv, NonFiniteResultIsAnErrorNamingTheCause) {
 TEST(Wv, ChannelsGiveTheSameResultOnAnyNumberOfThreads) {
   const std::uint64_t seed = 20261125;
   std::mt19937_64 rng(seed);
-  ImuSeries s;
-  s.source = "threads.csv";
-  s.rate_hz = 100;
+  ImuSeries s = gmwmtest::seriesOf("threads.csv", 100);
   const int n = 1024 + int(rng() % 3000);
   std::cout << "seed " << seed << ": " << n << " samples per channel\n";
   for (int c = 0; c < 6; ++c) {
-    ImuChannel ch;
-    ch.name = kChannelNames[c];
-    ch.quantity = channelQuantity(ch.name);
+    ImuChannel ch = gmwmtest::channelOf(kChannelNames[c]);
     const double sigma = std::pow(10.0, std::uniform_real_distribution<>(-4, -1)(rng)), q = sigma * 1e-2;
     std::normal_distribution<> g(0, 1);
     double walk = 0.0;
