@@ -299,24 +299,14 @@ struct TriadGroups {
 const TriadGroups* triadGroups(ExtraCause kind) {
   using X = filter::ExtraStates;
   using P = filter::SensorParams;
-  static const TriadGroups scale{{&X::gyro_scale_sigma, &X::acc_scale_sigma},
-                                 {&X::gyro_scale0, &X::acc_scale0},
-                                 {&P::gyro_scale, &P::acc_scale},
-                                 kFitScaleSigma,
-                                 limits::kScaleFactorSigma,
-                                 limits::kScaleFactor,
-                                 "scale_factor",
-                                 "scale",
-                                 "scale factor [ratio]: "};
-  static const TriadGroups misalignment{{&X::gyro_misalignment_sigma_rad, &X::acc_misalignment_sigma_rad},
-                                        {&X::gyro_misalignment0_rad, &X::acc_misalignment0_rad},
-                                        {&P::gyro_misalignment_rad, &P::acc_misalignment_rad},
-                                        kFitMisalignmentSigmaRad,
-                                        limits::kMisalignmentSigmaRad,
-                                        limits::kMisalignmentRad,
-                                        "misalignment",
-                                        "angle",
-                                        "misalignment angle of the triad about this axis [rad]: "};
+  static const TriadGroups scale{{&X::gyro_scale_sigma, &X::acc_scale_sigma}, {&X::gyro_scale0, &X::acc_scale0},
+                                 {&P::gyro_scale, &P::acc_scale}, kFitScaleSigma, limits::kScaleFactorSigma,
+                                 limits::kScaleFactor, "scale_factor", "scale", "scale factor [ratio]: "};
+  static const TriadGroups misalignment{
+      {&X::gyro_misalignment_sigma_rad, &X::acc_misalignment_sigma_rad},
+      {&X::gyro_misalignment0_rad, &X::acc_misalignment0_rad}, {&P::gyro_misalignment_rad, &P::acc_misalignment_rad},
+      kFitMisalignmentSigmaRad, limits::kMisalignmentSigmaRad, limits::kMisalignmentRad, "misalignment", "angle",
+      "misalignment angle of the triad about this axis [rad]: "};
   return kind == ExtraCause::ScaleFactor ? &scale : kind == ExtraCause::Misalignment ? &misalignment : nullptr;
 }
 
