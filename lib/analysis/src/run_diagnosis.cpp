@@ -295,8 +295,8 @@ struct TriadGroups {
   const char* note;
 };
 
-/// The triad groups of @p kind; nullptr for a cause that is not one.
-const TriadGroups* triadGroups(ExtraCause kind) {
+/// The triad groups of @p kind (ScaleFactor or Misalignment).
+const TriadGroups& triadGroups(ExtraCause kind) {
   using X = filter::ExtraStates;
   using P = filter::SensorParams;
   static const TriadGroups scale{{&X::gyro_scale_sigma, &X::acc_scale_sigma}, {&X::gyro_scale0, &X::acc_scale0},
@@ -307,19 +307,16 @@ const TriadGroups* triadGroups(ExtraCause kind) {
       {&X::gyro_misalignment0_rad, &X::acc_misalignment0_rad}, {&P::gyro_misalignment_rad, &P::acc_misalignment_rad},
       kFitMisalignmentSigmaRad, limits::kMisalignmentSigmaRad, limits::kMisalignmentRad, "misalignment", "angle",
       "misalignment angle of the triad about this axis [rad]: "};
-  return kind == ExtraCause::ScaleFactor ? &scale : kind == ExtraCause::Misalignment ? &misalignment : nullptr;
+  return kind == ExtraCause::ScaleFactor ? scale : misalignment;
 }
 
 /// @p base with the group(s) of @p kind on at the fitting prior (the configured one when larger).
 filter::ExtraStates withFitPrior(ExtraCause kind, filter::ExtraStates x) {
-  if (const TriadGroups* t = triadGroups(kind)) {
-    for (int i = 0; i < 2; ++i) x.*t->sigma[i] = std::max(x.*t->sigma[i], t->fit_sigma);
-    return x;
-  }
   switch (kind) {
     case ExtraCause::ScaleFactor:
     case ExtraCause::Misalignment:
-      break;  // triad groups, above
+      for (const auto sigma : triadGroups(kind).sigma) x.*sigma = std::max(x.*sigma, triadGroups(kind).fit_sigma);
+      break;
     case ExtraCause::TimeOffset:
       x.time_offset_sigma_s = std::max(x.time_offset_sigma_s, kFitTimeOffsetSigmaS);
       break;
@@ -345,17 +342,16 @@ Eigen::Vector3d clampTo(const Eigen::Vector3d& e, const limits::Range& r) {
 /// @p x with the group(s) of @p kind on, initialised at a replay's estimates with its sigmas as prior.
 filter::ExtraStates withFitted(ExtraCause kind, filter::ExtraStates x, const filter::SensorParams& e,
                                const filter::SensorParams& s) {
-  if (const TriadGroups* t = triadGroups(kind)) {
-    for (int i = 0; i < 2; ++i) {
-      x.*t->sigma[i] = fittedSigma(s.*t->estimate[i], 3, t->sigma_range.hi);
-      x.*t->initial[i] = clampTo(e.*t->estimate[i], t->range);
-    }
-    return x;
-  }
   switch (kind) {
     case ExtraCause::ScaleFactor:
-    case ExtraCause::Misalignment:
-      break;  // triad groups, above
+    case ExtraCause::Misalignment: {
+      const TriadGroups& t = triadGroups(kind);
+      for (int i = 0; i < 2; ++i) {
+        x.*t.sigma[i] = fittedSigma(s.*t.estimate[i], 3, t.sigma_range.hi);
+        x.*t.initial[i] = clampTo(e.*t.estimate[i], t.range);
+      }
+      break;
+    }
     case ExtraCause::TimeOffset:
       x.time_offset_sigma_s = fittedSigma(Eigen::Vector3d(s.time_offset_s, 0, 0), 1, limits::kTimeOffsetSigmaS.hi);
       x.time_offset0_s = std::min(limits::kTimeOffsetS.hi, std::max(limits::kTimeOffsetS.lo, e.time_offset_s));
@@ -383,16 +379,15 @@ std::vector<RunFinding> extraFindings(ExtraCause kind, const filter::SensorParam
   };
   const std::string how = "the filter's estimate of the state at the end of the whole run (GNSS throughout), 95 % "
                           "interval +- 1.96 sigma from its covariance";
-  if (const TriadGroups* t = triadGroups(kind)) {
-    for (int c = 0; c < 6; ++c)
-      add(t->cause, kChannelNames[c], t->param, (e.*t->estimate[c / 3])(c % 3), (s.*t->estimate[c / 3])(c % 3),
-          t->note + how);
-    return v;
-  }
   switch (kind) {
     case ExtraCause::ScaleFactor:
-    case ExtraCause::Misalignment:
-      break;  // triad groups, above
+    case ExtraCause::Misalignment: {
+      const TriadGroups& t = triadGroups(kind);
+      for (int c = 0; c < 6; ++c)
+        add(t.cause, kChannelNames[c], t.param, (e.*t.estimate[c / 3])(c % 3), (s.*t.estimate[c / 3])(c % 3),
+            t.note + how);
+      break;
+    }
     case ExtraCause::TimeOffset:
       add("time_offset", "all", "time_offset", e.time_offset_s, s.time_offset_s,
           "IMU-GNSS time offset t_IMU - t_true [s]: " + how);
