@@ -71,13 +71,25 @@ std::vector<PatternDraw> drawPatterns(int draws, double max_period, double lo, d
   return out;
 }
 
-// The replay of @p path with the reference model, the outage @p outage and
-// outages laid every @p pattern.
-an::ReplayConfig patternReplay(const std::string& path, const navimpact::Outage& outage,
-                               const navimpact::OutagePattern& pattern) {
+// The replay of @p path with the filter model of Table 1's reference.
+an::ReplayConfig refReplay(const std::string& path) {
   an::ReplayConfig c;
   c.rawlog = path;
   c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
+  return c;
+}
+
+// @p d written as the rawlog @p name in a fresh folder of the test; its path.
+std::string writtenRawlog(const navimpact::Recording& d, const std::string& name) {
+  const auto path = (navimpact::test::tempDir() / name).string();
+  navimpact::rawlog::writeRawlog(path, d);
+  return path;
+}
+
+// refReplay of @p path with the outage @p outage and outages laid every @p pattern.
+an::ReplayConfig patternReplay(const std::string& path, const navimpact::Outage& outage,
+                               const navimpact::OutagePattern& pattern) {
+  an::ReplayConfig c = refReplay(path);
   c.outages.push_back(outage);
   c.outages_every = pattern;
   return c;
@@ -90,12 +102,7 @@ std::string errorOf(const an::ReplayConfig& c) {
 }  // namespace
 
 TEST(Replay, PerfectImuStaysWithinItsPredictedSigmaThroughAnOutage) {
-  const auto dir = navimpact::test::tempDir();
-  const auto path = (dir / "perfect.rawlog").string();
-  navimpact::rawlog::writeRawlog(path, emulate60("none"));
-  an::ReplayConfig c;
-  c.rawlog = path;
-  c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
+  an::ReplayConfig c = refReplay(writtenRawlog(emulate60("none"), "perfect.rawlog"));
   c.outages.push_back(navimpact::Outage::fromStartDuration(30.0, 20.0));
   const auto r = an::runReplay(c);
   ASSERT_EQ(r.run.epochs.size(), 601u);  // GT at 10 Hz over 60 s
@@ -116,11 +123,7 @@ TEST(Replay, PerfectImuStaysWithinItsPredictedSigmaThroughAnOutage) {
 TEST(Replay, BadInputIsAClearError) {
   const auto dir = navimpact::test::tempDir();
   auto d = emulate60("none");
-  const auto ok = (dir / "ok.rawlog").string();
-  navimpact::rawlog::writeRawlog(ok, d);
-  an::ReplayConfig c;
-  c.rawlog = ok;
-  c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
+  an::ReplayConfig c = refReplay(writtenRawlog(d, "ok.rawlog"));
   c.outages.push_back(navimpact::Outage::fromStartDuration(50.0, 20.0));
   EXPECT_NE(errorOf(c).find("outage 50:20 ends at 70 s, after the data"), std::string::npos) << errorOf(c);
   c.outages.clear();
@@ -155,11 +158,8 @@ TEST(Replay, ImuGapIsAnErrorUnlessAllowedThenPropagatedAcross) {
               static_cast<unsigned long long>(seed), missing, d.imu[first].t, gap, dt);
   d.imu.erase(d.imu.begin() + static_cast<std::ptrdiff_t>(first), d.imu.begin() + static_cast<std::ptrdiff_t>(first + missing));
   ASSERT_EQ(d.imu.size(), n - missing);
-  const auto path = (navimpact::test::tempDir() / "gap.rawlog").string();
-  navimpact::rawlog::writeRawlog(path, d);
-  an::ReplayConfig c;
-  c.rawlog = path;
-  c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
+  const auto path = writtenRawlog(d, "gap.rawlog");
+  an::ReplayConfig c = refReplay(path);
   const std::string m = errorOf(c);
   EXPECT_NE(m.find(path + ": IMU gap of "), std::string::npos) << m;
   EXPECT_NE(m.find("max_imu_gap_s"), std::string::npos) << m;
@@ -189,11 +189,8 @@ TEST(Replay, DuplicatedGnssRecordIsAnError) {
   std::printf("seed %llu: GNSS fix %zu of %zu (t = %.3f s) recorded twice\n", static_cast<unsigned long long>(seed), i,
               d.gnss.size(), d.gnss[i].t);
   d.gnss.insert(d.gnss.begin() + static_cast<std::ptrdiff_t>(i), d.gnss[i]);
-  const auto path = (navimpact::test::tempDir() / "dup.rawlog").string();
-  navimpact::rawlog::writeRawlog(path, d);
-  an::ReplayConfig c;
-  c.rawlog = path;
-  c.model_spec = navimpact::test::sourcePath("config/models/navchip_table1.yaml:ref");
+  const auto path = writtenRawlog(d, "dup.rawlog");
+  const an::ReplayConfig c = refReplay(path);
   const std::string m = errorOf(c);
   EXPECT_NE(m.find(path + ": entry "), std::string::npos) << m;
   EXPECT_NE(m.find("(label GNSS"), std::string::npos) << m;
