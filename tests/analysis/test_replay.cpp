@@ -245,7 +245,6 @@ TEST(Replay, OutagesEveryAreScoredAgainstTheReference) {
 // aligning phase (reported) instead of a refusal; the filter starts when it
 // ends and then navigates within a few metres of the (withheld) truth.
 TEST(Replay, WithoutGroundTruthTheFilterStartsAfterAnAligningPhase) {
-  const auto dir = navimpact::test::tempDir();
   auto d = emulate60("model");
   const auto truth = d.reference;
   const auto origin = d.origin;
@@ -253,10 +252,8 @@ TEST(Replay, WithoutGroundTruthTheFilterStartsAfterAnAligningPhase) {
   // no GNSS fix at the first IMU sample
   ASSERT_NEAR(d.gnss.front().t, d.imu.front().t - (d.imu[1].t - d.imu[0].t), 1e-6);
   d.gnss.erase(d.gnss.begin());
-  const auto path = (dir / "nogt.rawlog").string();
-  navimpact::rawlog::writeRawlog(path, d);
   an::ReplayConfig c;
-  c.rawlog = path;
+  c.rawlog = writtenRawlog(d, "nogt.rawlog");
   c.use_gnss_velocity = true;
   const auto r = an::runReplay(c);
   ASSERT_TRUE(r.alignment.has_value());
@@ -280,15 +277,14 @@ TEST(Replay, WithoutGroundTruthTheFilterStartsAfterAnAligningPhase) {
 }
 
 // The aligning phase of the run @p d (its reference without velocity) written
-// to @p path, replayed with GNSS velocity: the heading comes from the reference,
-// measured at @p heading_at_s from time zero (reported, also in summary.json),
-// and is within 3 sigma of the reference's yaw at the filter start; with
-// yaw_from_reference false, from the GNSS course. Returns {with, without}.
+// as the rawlog @p name, replayed with GNSS velocity: the heading comes from the
+// reference, measured at @p heading_at_s from time zero (reported, also in
+// summary.json), and is within 3 sigma of the reference's yaw at the filter
+// start; with yaw_from_reference false, from the GNSS course. Returns {with, without}.
 std::pair<an::ReplayResult, an::ReplayResult> checkReferenceHeading(const navimpact::Recording& d,
-                                                                    const std::string& path, double heading_at_s) {
-  navimpact::rawlog::writeRawlog(path, d);
+                                                                    const std::string& name, double heading_at_s) {
   an::ReplayConfig c;
-  c.rawlog = path;
+  c.rawlog = writtenRawlog(d, name);
   c.use_gnss_velocity = true;
   an::ReplayResult r = an::runReplay(c);
   EXPECT_TRUE(r.alignment.has_value());
@@ -325,7 +321,7 @@ std::pair<an::ReplayResult, an::ReplayResult> checkReferenceHeading(const navimp
 TEST(Replay, AligningPhaseTakesItsHeadingFromTheReferenceAtTimeZero) {
   auto d = emulate60("model");
   for (auto& g : d.reference) g.v_N.reset();
-  const auto [r, r2] = checkReferenceHeading(d, (navimpact::test::tempDir() / "refatt.rawlog").string(), 0.0);
+  const auto [r, r2] = checkReferenceHeading(d, "refatt.rawlog", 0.0);
   ASSERT_TRUE(r.alignment && r2.alignment);
   ASSERT_TRUE(r.score.has_value());  // scored on position and attitude
   // the heading at time zero is known, not waited for: the filter starts no later
@@ -351,7 +347,7 @@ TEST(Replay, AligningPhaseWaitsForAReferenceAttitudeThatStartsLate) {
     if (g.t < t_zero + delay) g.q_BtoN.reset();
     else if (!std::isfinite(t_first)) t_first = g.t - t_zero;
   }
-  const auto [r, r2] = checkReferenceHeading(d, (navimpact::test::tempDir() / "refattlate.rawlog").string(), t_first);
+  const auto [r, r2] = checkReferenceHeading(d, "refattlate.rawlog", t_first);
   ASSERT_TRUE(r.alignment && r2.alignment);
   EXPECT_GE(r.aided_from_s, t_first);  // the phase waited for it
 }
