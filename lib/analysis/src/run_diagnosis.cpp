@@ -268,6 +268,19 @@ void addRandomWalk(stochastic::ImuModel& m, int ch, double q) {
   m.axis[ch].terms.push_back(stochastic::Process::rw(std::sqrt(q / r)));
 }
 
+/// @p base with the IMU model @p m (an extension); @p cr, when given, records
+/// the model and what the extension changes.
+ReplayConfig withModel(const ReplayConfig& base, const stochastic::ImuModel& m, CauseResult* cr,
+                       const std::string& extension) {
+  if (cr) {
+    cr->model_after = m;
+    cr->extension = extension;
+  }
+  ReplayConfig c = base;
+  c.model = m;
+  return c;
+}
+
 /// The causes an optional filter state carries (filter::ExtraStates).
 enum class ExtraCause { ScaleFactor, Misalignment, TimeOffset, LeverArm };
 
@@ -561,13 +574,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
       }
     }
     m.source += " with in-motion white noise";
-    if (cr) {
-      cr->model_after = m;
-      cr->extension = "each channel's white noise multiplied by its in-motion factor";
-    }
-    ReplayConfig c = base;
-    c.model = m;
-    return c;
+    return withModel(base, m, cr, "each channel's white noise multiplied by its in-motion factor");
   };
   auto fitGnss = [&](const ReplayConfig& base, const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
     // per axis group (horizontal N, E pooled; vertical): innovations outside the block
@@ -711,13 +718,9 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
         fnd->push_back(f);
       }
     }
-    if (cr) {
-      cr->model_after = m;
-      cr->extension = "an accelerometer bias random walk added (horizontal channels from the horizontal errors, acc_z from the vertical)";
-    }
-    ReplayConfig c = base;
-    c.model = m;
-    return c;
+    return withModel(base, m, cr,
+                     "an accelerometer bias random walk added (horizontal channels from the horizontal errors, acc_z "
+                     "from the vertical)");
   };
   // Causes a filter state carries (scale factor, misalignment, lever arm, time
   // offset): fitted by replaying the run with that state on, GNSS dropped in
