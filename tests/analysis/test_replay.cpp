@@ -203,11 +203,8 @@ TEST(Replay, DuplicatedGnssRecordIsAnError) {
 // reference_errors and the flat per-outage keys, and the NEES counts the
 // reference's sigma (a larger reference sigma can only lower it).
 TEST(Replay, OutagesEveryAreScoredAgainstTheReference) {
-  const auto dir = navimpact::test::tempDir();
-  const auto path = (dir / "model.rawlog").string();
-  navimpact::rawlog::writeRawlog(path, emulate60("model"));
   an::ReplayConfig c;
-  c.rawlog = path;
+  c.rawlog = writtenRawlog(emulate60("model"), "model.rawlog");
   c.outages_every = navimpact::parseOutagePattern("15:5");
   const auto r = an::runReplay(c);
   // starts 10, 25, 40 (ends 15, 30, 45); 55..60 ends at 60 = the data end
@@ -385,11 +382,8 @@ TEST(Replay, ConfigLoadsScoringAlignmentAndAids) {
 // Aids wired into the run: the non-holonomic constraint is applied at its
 // interval while moving; in flight the static detector never fires, so no ZUPT.
 TEST(Replay, AidsAreAppliedOnlyWhenTheirConditionHolds) {
-  const auto dir = navimpact::test::tempDir();
-  const auto path = (dir / "aids.rawlog").string();
-  navimpact::rawlog::writeRawlog(path, emulate60("model"));
   an::ReplayConfig c;
-  c.rawlog = path;
+  c.rawlog = writtenRawlog(emulate60("model"), "aids.rawlog");
   c.aids.zupt = true;
   c.aids.nhc = true;
   c.aids.nhc_sigma_lateral_mps = c.aids.nhc_sigma_vertical_mps = 50.0;  // a UAV is no ground vehicle: loose
