@@ -421,8 +421,8 @@ TEST(Alignment, HeadingGivenLaterIsCarriedToTheStart) {
     opt.detector.gyro_sigma_rad_s.setConstant(1e-3);
     opt.detector.acc_sigma_mps2.setConstant(1e-2);
     opt.yaw_sigma_rad = 1.0 * kDeg;
-    const ins::NavState truth_y = truthAt(makeTrajectory(sc), t_y);
-    const double yaw_true_y = truth_y.rollPitchYaw()[2], yaw_true_0 = truthAt(makeTrajectory(sc), 0.0).rollPitchYaw()[2];
+    const ins::NavState truth_y = emulation::truthNavState(makeTrajectory(sc), t_y);
+    const double yaw_true_y = truth_y.rollPitchYaw()[2], yaw_true_0 = emulation::truthNavState(makeTrajectory(sc), 0.0).rollPitchYaw()[2];
     const double yaw_err = opt.yaw_sigma_rad * N01(rng);
     opt.yaw_rad = yaw_true_y + yaw_err;
     opt.yaw_t_s = t_y;
