@@ -11,7 +11,6 @@
 
 #include <boost/math/distributions/normal.hpp>
 
-#include "diagnosis_internal.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/parallel.hpp"

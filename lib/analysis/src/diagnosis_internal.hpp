@@ -1,12 +1,33 @@
-// Internal helpers shared by the diagnosis sources (not installed).
+// Internal declarations shared by the diagnosis sources (not installed).
+//
+// diagnosis_extensions.cpp: the extensions of a model fitted to a measured
+// wavelet variance (WV) -- one process family added or one term retuned
+// (Candidate), sets of them backfitted jointly (Extension), chosen by AIC on
+// the chi-square (gamma) deviance -- and the GMWM refit of an extension.
 #pragma once
 
+#include <cstddef>
+#include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "navimpact/analysis/diagnosis.hpp"
+#include <Eigen/Core>
 
-namespace navimpact::analysis {
+#include "navimpact/analysis/diagnosis.hpp"
+#include "navimpact/gmwm/wavelet_variance.hpp"
+#include "navimpact/stochastic/process.hpp"
+
+namespace navimpact::analysis::detail {
+
+using stochastic::Model;
+using stochastic::Process;
+using stochastic::ProcessKind;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// --------------------------------------------------------------------------
+// Wavelet variances of models
 
 /**
  * Chi-square (gamma) deviance of measured WV @p nu_hat against model WV @p nu
@@ -15,4 +36,153 @@ namespace navimpact::analysis {
 double wvDeviance(const std::vector<double>& nu_hat, const std::vector<double>& nu,
                   const std::vector<double>& eta);
 
-}  // namespace navimpact::analysis
+/// The cause a process kind stands for.
+Cause causeOf(ProcessKind k);
+
+/// The parameter of a process whose square scales its WV: the first
+/// parameter of its kind in the registry (WN sigma, QN Q, RW gamma, DR omega,
+/// GM sigma, SIN amp).
+double& mainParam(Process& p);
+
+/// A process of kind @p k with unit scale and, where the kind has a second
+/// (shape) parameter, that parameter set to @p shape (GM T [s], SIN freq [Hz]).
+Process unitProcess(ProcessKind k, double shape = 1.0);
+
+/// Haar WV of a process at @p rate [Hz], or of a model, at scales @p tau [samples].
+std::vector<double> wvOf(const Process& p, double rate, const std::vector<double>& tau);
+std::vector<double> wvOf(const Model& m, const std::vector<double>& tau);
+
+std::vector<double> toStd(const Eigen::VectorXd& v);
+
+/// Model without its SIN terms (the null of the detectors; lines are excluded by frequency).
+Model withoutSin(const Model& m);
+
+/// A measured WV: scales, values and the chi-square dof they are judged with.
+struct WvData {
+  std::vector<double> tau;   ///< samples
+  std::vector<double> nu;    ///< measured
+  std::vector<double> dof;
+  double samples = 0;        ///< record length [samples] (0: from the scales)
+};
+
+/// The WV test of a model on WvData: per-scale bounds on measured / model
+/// outside which a scale is significant (two-sided, chi-square with the
+/// data's dof, at @p p_thr), and the width of the 95 % CI per unit model WV.
+struct WvTest {
+  std::vector<double> lo, hi, ci95;
+  double p_thr = 0;
+};
+
+WvTest wvTest(const WvData& d, double p_thr);
+
+/// Scales of @p d significant under the model WV @p nu_m.
+int significantScales(const WvData& d, const WvTest& t, const std::vector<double>& nu_m);
+
+// --------------------------------------------------------------------------
+// Candidate extensions: the WV of the current model plus (or with one term
+// replaced by) one process family, its variance-like parameter a (sigma^2,
+// Q^2, gamma^2, omega^2, GM sigma^2) and, for GM, T fitted by minimising the
+// gamma deviance. Everything else in the model is kept as it is.
+
+struct Candidate {
+  bool retune = false;       ///< replace term `term` instead of adding
+  int term = -1;
+  ProcessKind kind = ProcessKind::WN;
+  Process proc;              ///< fitted process (added or replacing)
+  double deviance = kNaN;
+  int params = 1;
+  double T_lo = kNaN, T_hi = kNaN;  ///< GM: profile interval of T
+  bool T_hi_open = false;            ///< GM: interval reaches the top of the T grid
+  bool T_top_only = false;           ///< GM: only the interval reaches it (best T inside)
+  bool T_bottom = false;             ///< GM: best T at one sample (white noise)
+  double scale = 1;          ///< retune: new / old variance parameter
+  double p_lo = kNaN, p_hi = kNaN;   ///< 95 % profile interval of the main parameter
+};
+
+/// Fit @p kind added to @p model (or, @p retune, replacing its term @p term)
+/// on @p d. @p T_hint (GM only, finite): search T only near it (a refinement
+/// step of a joint fit; no profile interval), else over the whole grid.
+/// Without @p intervals the 95 % interval of the main parameter is left out.
+Candidate fitCandidate(bool retune, int term, ProcessKind kind, const Model& model,
+                       const WvData& d, double T_hint = kNaN, bool intervals = true);
+
+/// Apply a candidate to a model: add (merging WN/QN/RW/DR into an existing
+/// term of the same kind, their variances add) or replace the tuned term.
+Model applyCandidate(const Model& m, const Candidate& c);
+
+/// A candidate's term in words ("retuned " first when it replaces one).
+std::string candidateText(const Candidate& c);
+
+// --------------------------------------------------------------------------
+// Joint extensions: a set of terms added to (or retuning terms of) the user's
+// model, every term refitted with the others held (backfitting: each term's
+// least-deviance fit given the rest, sweeps until the deviance settles). Two
+// effects on one channel are told apart only when both are fitted together:
+// a term fitted alone absorbs what the other explains (a random walk into a
+// longer GM, white noise into a short GM's T, leaving a residue of the
+// wrong shape for the next term).
+
+/// @p base with @p cs applied, every added term kept as its own term (the WV
+/// is additive; merging is for the model file). @p skip: leave that one out.
+Model assemble(const Model& base, const std::vector<Candidate>& cs, int skip = -1);
+
+/// Index of cs[i]'s term in assemble(base, cs).
+int assembledIndex(const Model& base, const std::vector<Candidate>& cs, std::size_t i);
+
+/// The same set as in the model file: retunes, then additions merged into a
+/// term of the same kind (applyCandidate); vanishing terms are left out.
+Model merged(const Model& base, const std::vector<Candidate>& cs);
+
+/// AIC penalty of a set (from its term @p from on): 2 per parameter; retuning
+/// a term of the user's model discards what they had and is charged as two
+/// more parameters.
+double penalty(const std::vector<Candidate>& cs, std::size_t from = 0);
+
+/// Refit every term of @p cs given the others on @p d (warm start: their
+/// current values); the last pass profiles each GM over the whole T grid
+/// (its interval and whether the data bound T). Returns the deviance of
+/// assemble(base, cs).
+double backfit(const Model& base, std::vector<Candidate>& cs, const WvData& d);
+
+/// One extension of the committed set: its terms (the committed ones,
+/// refitted, then `added` new ones at the end), deviance and AIC.
+struct Extension {
+  Extension() = default;
+  /// The committed set @p committed, to which the caller adds @p added new terms.
+  Extension(std::vector<Candidate> committed, int added) : terms(std::move(committed)), added(added) {}
+  std::vector<Candidate> terms;
+  int added = 0;
+  double deviance = kNaN, crit = kNaN;
+  bool valid = false;
+  int significant = 0;  ///< scales still significant under it
+  bool needed = true;   ///< a pair: each term needed (nested likelihood-ratio test on the WV)
+  bool open_top = false;  ///< invalid only by a GM whose WV profile interval of T reaches record/5
+  std::string why_not;  ///< why it is not valid
+};
+
+/// The new terms of an extension in words ('+' between them).
+std::string newTermsText(const Extension& e);
+
+/// Every extension of the committed set @p S (already backfitted on @p d)
+/// by one new term (each family added, or one of the user's terms retuned)
+/// or, when @p max_new >= 2, by two new terms fitted jointly. Each set is
+/// backfitted. Valid: no vanishing term and no GM whose T the data do not
+/// bound inside (1 sample, record/5); a pair only when each of its terms
+/// alone (with S) still leaves scales significant, and each changes the WV
+/// by at least its 95 % CI width at some scale (both are needed).
+std::vector<Extension> extensions(const Model& base, const std::vector<Candidate>& S, const WvData& d,
+                                  const WvTest& wt, int max_new);
+
+/// Best stochastic extension of @p m on the WV @p d: terms added (one or two
+/// at a time, jointly fitted) while AIC improves, up to @p max_terms, as the
+/// cause search; used as the alternative explanation of candidate level
+/// shifts. *params: parameters added.
+Model greedyExtension(const Model& m, const WvData& d, int max_terms, double p_thr, int* params);
+
+/// GMWM refit of @p start's structure (SIN terms kept as they are) on @p wv,
+/// warm-started at @p start; returns the refit when its gamma deviance on @p d
+/// is not above the start's, else @p start. @p how says which was kept.
+Model gmwmRefit(const Model& start, const gmwm::WaveletVariance& wv, const WvData& d,
+                std::string* how);
+
+}  // namespace navimpact::analysis::detail

@@ -11,7 +11,6 @@
 #include <boost/math/distributions/binomial.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
-#include "diagnosis_internal.hpp"
 #include "navimpact/analysis/diagnosis.hpp"
 #include "navimpact/filter/model_entry.hpp"
 #include "navimpact/analysis/run_plan.hpp"
