@@ -1,12 +1,19 @@
 // Internal declarations shared by the diagnosis sources (not installed).
 //
-// diagnosis_extensions.cpp: the extensions of a model fitted to a measured
-// wavelet variance (WV) -- one process family added or one term retuned
-// (Candidate), sets of them backfitted jointly (Extension), chosen by AIC on
-// the chi-square (gamma) deviance -- and the GMWM refit of an extension.
+// diagnosis.cpp runs the pipeline of diagnosis.hpp on every channel, one
+// function per step, each reading the channel's ChannelContext:
+//  - diagnosis_detect.cpp: steps 1-3, the detectors (outliers, lines, level
+//    shifts), each taking what it finds out of the record;
+//  - diagnosis_extensions.cpp: the extensions of a model fitted to a measured
+//    wavelet variance (WV) -- one process family added or one term retuned
+//    (Candidate), sets of them backfitted jointly (Extension), chosen by AIC
+//    on the chi-square (gamma) deviance -- and the GMWM refit of an extension.
+// The steps write their findings and notes into the channel's
+// ChannelDiagnosis and return what the later steps need.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
@@ -15,6 +22,7 @@
 #include <Eigen/Core>
 
 #include "navimpact/analysis/diagnosis.hpp"
+#include "navimpact/detect/lines.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 #include "navimpact/stochastic/process.hpp"
 
@@ -184,5 +192,53 @@ Model greedyExtension(const Model& m, const WvData& d, int max_terms, double p_t
 /// is not above the start's, else @p start. @p how says which was kept.
 Model gmwmRefit(const Model& start, const gmwm::WaveletVariance& wv, const WvData& d,
                 std::string* how);
+
+// --------------------------------------------------------------------------
+// One channel's diagnosis
+
+/// Family-wise level of each test family, per channel.
+struct Budget {
+  double wv = 0, spec = 0, steps = 0, spikes = 0;
+};
+
+/// What every step of one channel's diagnosis reads.
+struct ChannelContext {
+  std::string name;             ///< e.g. "gyro_z"
+  std::string unit;             ///< its SI unit (channelUnit)
+  int index = 0;                ///< channel index (seeds its random streams)
+  double rate = 0;              ///< sampling rate [Hz]
+  std::size_t n = 0;            ///< samples
+  double record = 0;            ///< record length [s]
+  double t0 = 0;                ///< time of the first sample [s]
+  Model m0;                     ///< the user's model at the data rate
+  Model m0n;                    ///< the same without SIN terms (the detectors' null)
+  Budget B;                     ///< this channel's share of alpha per test family
+  double channels = 1;          ///< channels diagnosed (Bonferroni of WV p-values)
+  int max_terms = 3;            ///< DiagnoseOptions::max_terms
+  int simulations = 0;          ///< DiagnoseOptions::simulations
+  std::uint64_t seed = 0;       ///< DiagnoseOptions::seed
+};
+
+/// 1. Outlier events (spikes, bursts such as a knock) of @p x, interpolated
+/// out: one finding for all, each event in cd.outlier_events.
+void removeOutliers(const ChannelContext& ctx, std::vector<double>& x, ChannelDiagnosis& cd);
+
+/// 2. Spectral lines of @p x against the model's PSD, subtracted from @p x:
+/// the spectrum and line frequencies in @p cd, one finding per line (its
+/// harmonics and a line wandering within 10 bins of it with it). Returns
+/// every line found.
+std::vector<detect::SpectralLine> removeLines(const ChannelContext& ctx, std::vector<double>& x,
+                                              ChannelDiagnosis& cd);
+
+/// 3. Level shifts, detected under the model and accepted only when each is
+/// significant against the best stochastic explanation of the record
+/// without shifts, fitted to @p wv_pre (the WV of @p x as steps 1-2 left it;
+/// a random walk, a long Gauss-Markov or a drift also make large window
+/// contrasts): exact likelihood-ratio test of block means, Bonferroni over
+/// the block boundaries (detect/step_test.hpp); accepted shifts are removed
+/// from @p x. Transients of at most 1 s (knocks), tested at their own scale,
+/// are outlier events, interpolated out. Returns whether @p x changed.
+bool removeLevelShifts(const ChannelContext& ctx, const gmwm::WaveletVariance& wv_pre, std::vector<double>& x,
+                       ChannelDiagnosis& cd);
 
 }  // namespace navimpact::analysis::detail
