@@ -59,11 +59,8 @@ std::string channelUnit(const std::string& channel) {
   return channel.rfind("gyro", 0) == 0 ? "rad/s" : "m/s^2";
 }
 
-namespace {
+namespace detail {
 
-using namespace detail;
-
-/// Per-scale comparison of a measured WV with a model under chi-square(dof).
 std::vector<ScaleCheck> checkScales(const gmwm::WaveletVariance& wv, const std::vector<double>& nu_m,
                                     const std::vector<double>& dof, double p_thr,
                                     const std::vector<double>& env_lo,
@@ -103,27 +100,16 @@ std::vector<ScaleCheck> checkScales(const gmwm::WaveletVariance& wv, const std::
   return out;
 }
 
-int countSignificant(const std::vector<ScaleCheck>& s) {
-  int c = 0;
-  for (const auto& x : s) c += x.significant ? 1 : 0;
-  return c;
-}
+}  // namespace detail
+
+namespace {
+
+using namespace detail;
+
 int countOutside(const std::vector<ScaleCheck>& s) {
   int c = 0;
   for (const auto& x : s) c += x.outside95 ? 1 : 0;
   return c;
-}
-
-const char* shapeWords(ProcessKind k) {
-  switch (k) {
-    case ProcessKind::WN: return "falls as 1/tau, the shape of white noise";
-    case ProcessKind::QN: return "falls as 1/tau^2, the shape of quantization noise";
-    case ProcessKind::RW: return "grows as tau, the shape of a random walk";
-    case ProcessKind::DR: return "grows as tau^2, the shape of a drift";
-    case ProcessKind::GM: return "is peaked, the shape of a Gauss-Markov process";
-    case ProcessKind::SIN: return "oscillates, the shape of a sinusoid";
-  }
-  return "";
 }
 
 // --------------------------------------------------------------------------
@@ -145,109 +131,6 @@ struct Shared {
     }
   }
 };
-
-std::string scaleRange(double lo, double hi) {
-  if (!(hi > lo * 1.0001)) return "tau = " + formatNumber(lo, 3) + " s";
-  return "tau = " + formatNumber(lo, 3) + "–" + formatNumber(hi, 3) + " s";
-}
-
-/// Largest |WV change| of a model change relative to the CI width of the
-/// measured WV at that scale (a finding must reach 1 somewhere).
-double wvChangeInCiWidths(const std::vector<ScaleCheck>& chk, const std::vector<double>& nu_before,
-                          const std::vector<double>& nu_after) {
-  double best = 0;
-  for (std::size_t j = 0; j < chk.size(); ++j) {
-    const double w = chk[j].ci_high - chk[j].ci_low;
-    if (w > 0) best = std::max(best, std::abs(nu_after[j] - nu_before[j]) / w);
-  }
-  return best;
-}
-
-/// Scales where a change of model explains the misfit: outside the per-scale
-/// 95 % CI before, with the log misfit reduced by more than half.
-void explainedRange(const std::vector<ScaleCheck>& chk, const std::vector<double>& nu_before,
-                    const std::vector<double>& nu_after, double* lo, double* hi, double* max_ratio,
-                    int* count) {
-  *lo = kNaN;
-  *hi = kNaN;
-  *max_ratio = 1;
-  *count = 0;
-  for (std::size_t j = 0; j < chk.size(); ++j) {
-    const double mb = std::abs(std::log(chk[j].measured / std::max(nu_before[j], 1e-300)));
-    const double ma = std::abs(std::log(chk[j].measured / std::max(nu_after[j], 1e-300)));
-    if (!chk[j].outside95 || !(mb - ma > 0.5 * mb)) continue;
-    if (std::isnan(*lo)) *lo = chk[j].tau_s;
-    *hi = chk[j].tau_s;
-    ++*count;
-    const double r = chk[j].ratio;
-    if (std::abs(std::log(r)) > std::abs(std::log(*max_ratio))) *max_ratio = r;
-  }
-}
-
-Finding broadbandFinding(const std::string& ch, const Candidate& c, const Model& before,
-                         const std::vector<ScaleCheck>& chk, const std::vector<double>& tau,
-                         double rate) {
-  Finding f;
-  f.channel = ch;
-  f.cause = causeOf(c.kind);
-  const Model after = applyCandidate(before, c);
-  const auto nb = wvOf(before, tau), na = wvOf(after, tau);
-  double lo, hi, ratio;
-  int count;
-  explainedRange(chk, nb, na, &lo, &hi, &ratio, &count);
-  f.range_key = "scales_s";
-  f.range_lo = lo;
-  f.range_hi = hi;
-  const std::string unit = channelUnit(ch);
-  Process p = c.proc;
-  std::ostringstream ex;
-  const bool above = ratio >= 1;
-  f.direction = (c.retune && c.scale < 1) ? "overstated" : "missing";
-  const double factor = above ? ratio : 1.0 / ratio;
-  if (count > 0)
-    ex << "the measured WV is "
-       << (factor < 1.5  // a small excess as a percentage ("1x" says nothing)
-               ? formatNumber(100.0 * std::abs(ratio - 1.0), 2) + " % "
-               : formatNumber(factor, 2) + "x ")
-       << (above ? "above" : "below") << " the model at " << scaleRange(lo, hi) << " ("
-       << count << " scale" << (count > 1 ? "s" : "") << " outside the 95 % CI); ";
-  switch (c.kind) {
-    case ProcessKind::WN: f.params = {{"sigma", p.sigma}}; break;
-    case ProcessKind::QN: f.params = {{"Q", p.Q}}; break;
-    case ProcessKind::RW: f.params = {{"gamma", p.gamma}}; break;
-    case ProcessKind::DR: f.params = {{"omega", p.omega}}; break;
-    case ProcessKind::GM:
-      f.params = {{"sigma", p.sigma}, {"T", p.T}};
-      f.T_interval_s = std::make_pair(c.T_lo, c.T_hi);
-      f.intervals.push_back({"T", {c.T_lo, c.T_hi}});
-      break;
-    case ProcessKind::SIN: f.params = {{"amplitude", p.amp}, {"freq_hz", p.freq_hz}}; break;
-  }
-  if (c.kind != ProcessKind::GM && std::isfinite(c.p_lo))
-    f.intervals.push_back({f.params.front().first, {c.p_lo, c.p_hi}});
-  if (c.retune) {
-    Process old = before.terms[c.term];
-    ex << "the model's " << stochastic::formatTerms({old}, 3) << " is "
-       << (c.scale < 1 ? "overstated" : "understated") << "; the data fit "
-       << stochastic::formatTerms({p}, 3);
-  } else {
-    ex << "the excess " << shapeWords(c.kind);
-    if (c.kind == ProcessKind::GM)
-      ex << " with T = " << formatNumber(p.T, 3) << " s (95 % interval " << formatNumber(c.T_lo, 3) << "–"
-         << formatNumber(c.T_hi, 3) << " s), sigma = " << formatNumber(p.sigma, 3) << " " << unit;
-    else
-      ex << ": " << stochastic::formatTerms({p}, 3) << " (" << unit << ", per sample at "
-         << formatNumber(rate, 4) << " Hz)";
-  }
-  ex << ".";
-  f.explanation = ex.str();
-  f.action = c.retune ? "retune it in the model (model_extended.yaml)"
-                      : "add it to the model (model_extended.yaml); the filter takes it as " +
-                            std::string(c.kind == ProcessKind::WN || c.kind == ProcessKind::QN
-                                            ? "measurement noise"
-                                            : "error state(s)");
-  return f;
-}
 
 
 /// Paired one-sided test over scales of the per-scale deviances (Vuong 1989
@@ -276,6 +159,63 @@ void pairedScaleTest(const std::vector<double>& nu_b_hat, const std::vector<doub
   *p = boost::math::cdf(boost::math::complement(boost::math::normal(), *z));
 }
 
+
+/// 4 (its test). The WV of the raw and of the cleaned record against the
+/// user's model, with the model's simulations: their envelope, the dof of
+/// each scale lowered to what they show, the per-scale threshold (Bonferroni
+/// over scales) and cd.scales (the raw record against the model). A WV is
+/// recomputed only where the record changed since @p wv_pre (@p raw_differs:
+/// steps 1-2 took something out; @p cleaned_differs: step 3 did).
+WvCheck checkWv(Shared& sh, const ChannelContext& ctx, const std::vector<double>& raw, const std::vector<double>& x,
+                const gmwm::WaveletVariance& wv_pre, bool raw_differs, bool cleaned_differs, ChannelDiagnosis& cd) {
+  const double rate = ctx.rate;
+  const std::size_t n = ctx.n;
+  const Model& m0 = ctx.m0;
+  WvCheck w;
+  w.raw = raw_differs ? gmwm::waveletVariance(raw.data(), n, rate) : wv_pre;
+  w.cleaned = cleaned_differs ? gmwm::waveletVariance(x.data(), n, rate) : wv_pre;
+  w.tau = toStd(wv_pre.tau);
+  const int J = w.raw.scales();
+  const auto nu0 = wvOf(m0, w.tau);
+  std::vector<double> env_lo(J, std::numeric_limits<double>::infinity()), env_hi(J, 0.0);
+  std::vector<double>& dof = w.dof;
+  dof = toStd(w.raw.eta);
+  if (!m0.empty() && ctx.simulations >= 2) {
+    std::vector<double> s1(J, 0.0), s2(J, 0.0);
+    for (int s = 0; s < ctx.simulations; ++s) {
+      const auto sim = stochastic::simulate(
+          m0, n, stochastic::deriveSeed(ctx.seed, 1000u * static_cast<unsigned>(ctx.index) + s));
+      const auto ws = gmwm::waveletVariance(sim.data(), n, rate);
+      for (int j = 0; j < J && j < ws.scales(); ++j) {
+        env_lo[j] = std::min(env_lo[j], ws.wv(j));
+        env_hi[j] = std::max(env_hi[j], ws.wv(j));
+        const double r = nu0[j] > 0 ? ws.wv(j) / nu0[j] : 0;
+        s1[j] += r;
+        s2[j] += r * r;
+      }
+      sh.tick(cd.name + ": simulations");
+    }
+    // Moment-matched dof of the simulated ratios (var of chi2_eta / eta = 2 / eta),
+    // used where fewer than eta (the theory would be over-confident there).
+    const double S = ctx.simulations;
+    for (int j = 0; j < J; ++j) {
+      const double m = s1[j] / S, v = (s2[j] - S * m * m) / (S - 1);
+      if (v > 0 && m > 0) dof[j] = std::max(1.0, std::min(dof[j], 2.0 * m * m / v));
+    }
+  } else {
+    env_lo.clear();
+    env_hi.clear();
+    sh.tick(cd.name + ": simulations", ctx.simulations);
+  }
+  w.p_thr = ctx.B.wv / J;  // two-sided p-value vs alpha / J (Bonferroni over scales)
+  cd.wv_threshold_p = w.p_thr;
+  cd.scales = checkScales(w.raw, nu0, dof, w.p_thr, env_lo, env_hi);
+  w.full = WvData{w.tau, toStd(w.cleaned.wv), dof, static_cast<double>(n)};
+  // The WV test on the cleaned record against the model without its SIN
+  // terms (the lines are subtracted from the record).
+  w.cleaned_vs_model = checkScales(w.cleaned, wvOf(ctx.m0n, w.tau), dof, w.p_thr, env_lo, env_hi);
+  return w;
+}
 
 ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   const ImuChannel& chan = sh.data->channels[ci];
@@ -324,441 +264,34 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   const bool x_after_pre_changed = removeLevelShifts(ctx, wv_pre, x, cd);
   sh.tick(cd.name + ": level shifts");
 
-  // 4. WV of the raw and cleaned record vs the model, with simulations.
-  // (A WV is recomputed only where the record changed since wv_pre.)
-  const bool changed_before_pre = findings_pre > 0;  // outliers or lines removed
-  const bool changed_after_pre = x_after_pre_changed;
-  const auto wv_raw = changed_before_pre ? gmwm::waveletVariance(raw.data(), n, rate) : wv_pre;
-  const auto wv_cl = changed_after_pre ? gmwm::waveletVariance(x.data(), n, rate) : wv_pre;
-  const int J = wv_raw.scales();
-  const auto nu0 = wvOf(m0, tau);
-  std::vector<double> env_lo(J, std::numeric_limits<double>::infinity()), env_hi(J, 0.0);
-  std::vector<double> dof = toStd(wv_raw.eta);
-  if (!m0.empty() && opt.simulations >= 2) {
-    std::vector<double> s1(J, 0.0), s2(J, 0.0);
-    for (int s = 0; s < opt.simulations; ++s) {
-      const auto sim = stochastic::simulate(
-          m0, n, stochastic::deriveSeed(opt.seed, 1000u * static_cast<unsigned>(ci) + s));
-      const auto w = gmwm::waveletVariance(sim.data(), n, rate);
-      for (int j = 0; j < J && j < w.scales(); ++j) {
-        env_lo[j] = std::min(env_lo[j], w.wv(j));
-        env_hi[j] = std::max(env_hi[j], w.wv(j));
-        const double r = nu0[j] > 0 ? w.wv(j) / nu0[j] : 0;
-        s1[j] += r;
-        s2[j] += r * r;
-      }
-      sh.tick(cd.name + ": simulations");
-    }
-    // Moment-matched dof of the simulated ratios (var of chi2_eta / eta = 2 / eta),
-    // used where fewer than eta (the theory would be over-confident there).
-    const double S = opt.simulations;
-    for (int j = 0; j < J; ++j) {
-      const double m = s1[j] / S, v = (s2[j] - S * m * m) / (S - 1);
-      if (v > 0 && m > 0) dof[j] = std::max(1.0, std::min(dof[j], 2.0 * m * m / v));
-    }
-  } else {
-    env_lo.clear();
-    env_hi.clear();
-    sh.tick(cd.name + ": simulations", opt.simulations);
-  }
-  const double p_thr = B.wv / J;  // two-sided p-value vs alpha / J (Bonferroni over scales)
-  cd.wv_threshold_p = p_thr;
-  cd.scales = checkScales(wv_raw, nu0, dof, p_thr, env_lo, env_hi);
-  // The WV test on the cleaned record against the model with its lines.
-  const auto nu0n = wvOf(m0n, tau);
-  auto chk_cl = checkScales(wv_cl, nu0n, dof, p_thr, env_lo, env_hi);
+  // 4. WV of the raw and cleaned record vs the model, with simulations, and
+  // the cause of the broadband misfit.
+  const WvCheck w = checkWv(sh, ctx, raw, x, wv_pre, findings_pre > 0, x_after_pre_changed, cd);
+  const gmwm::WaveletVariance& wv_raw = w.raw;
+  const gmwm::WaveletVariance& wv_cl = w.cleaned;
+  const std::vector<double>& dof = w.dof;
+  const double p_thr = w.p_thr;
+  const WvData& full = w.full;
+  const std::vector<Candidate> S = searchCauses(ctx, x, w, cd);
 
   // 5. Cause of the broadband misfit: candidates on the first half, refit on all.
   const std::size_t nh = n / 2;
   const auto wv_h1 = gmwm::waveletVariance(x.data(), nh, rate);
   const auto wv_h2c = gmwm::waveletVariance(x.data() + nh, n - nh, rate);
   const auto wv_h2r = gmwm::waveletVariance(raw.data() + nh, n - nh, rate);
-  auto halfDof = [&](const gmwm::WaveletVariance& w) {
-    std::vector<double> d(w.scales());
-    for (int j = 0; j < w.scales(); ++j) {
+  auto halfDof = [&](const gmwm::WaveletVariance& hw) {
+    std::vector<double> d(hw.scales());
+    for (int j = 0; j < hw.scales(); ++j) {
       const double ratio = wv_raw.eta(j) > 0 ? dof[j] / wv_raw.eta(j) : 1.0;
-      d[j] = std::max(1.0, w.eta(j) * std::min(1.0, ratio));
+      d[j] = std::max(1.0, hw.eta(j) * std::min(1.0, ratio));
     }
     return d;
   };
-  WvData full{tau, toStd(wv_cl.wv), dof, static_cast<double>(n)};
   WvData h1{toStd(wv_h1.tau), toStd(wv_h1.wv), halfDof(wv_h1), static_cast<double>(nh)};
 
   Model m_full = m0n, m_half = m0n;
   int added_params = 0;
-  // Block means of the cleaned record for the exact likelihood that decides
-  // between the slow explanations (random walk, drift, long Gauss-Markov),
-  // which differ only at the coarsest WV scales where it has few dof.
-  const std::size_t blk = std::max<std::size_t>(1, n / 512);
-  const std::vector<double> yb = stochastic::blockMeans(x.data(), n, blk);
-  auto isSlow = [&](const Candidate& c) {
-    if (c.kind == ProcessKind::RW || c.kind == ProcessKind::DR) return true;
-    return c.kind == ProcessKind::GM && !c.retune && c.proc.T * rate >= 4.0 * static_cast<double>(blk);
-  };
-  // The new terms of an extension that are not slow: extensions with the
-  // same such part differ only in their slow explanation.
-  auto fastPart = [&](const Extension& e) {
-    std::vector<std::tuple<int, int, int>> k;
-    for (std::size_t i = e.terms.size() - e.added; i < e.terms.size(); ++i)
-      if (!isSlow(e.terms[i])) k.emplace_back(e.terms[i].retune, e.terms[i].term, static_cast<int>(e.terms[i].kind));
-    std::sort(k.begin(), k.end());
-    return k;
-  };
-  auto hasSlow = [&](const Extension& e) {
-    for (std::size_t i = e.terms.size() - e.added; i < e.terms.size(); ++i)
-      if (isSlow(e.terms[i])) return true;
-    return false;
-  };
-  // Regressors of the block means: the mean, a trend when the model has a
-  // drift, and optionally a level shift at block boundary @p step.
-  auto blockRegressors = [&](bool trend, std::size_t step) {
-    Eigen::MatrixXd X(static_cast<Eigen::Index>(yb.size()), 1 + (trend ? 1 : 0) + (step > 0 ? 1 : 0));
-    for (std::size_t k = 0; k < yb.size(); ++k) {
-      const auto r = static_cast<Eigen::Index>(k);
-      X(r, 0) = 1.0;
-      if (trend) X(r, 1) = (static_cast<double>(k) + 0.5) / static_cast<double>(yb.size()) - 0.5;
-      if (step > 0) X(r, X.cols() - 1) = k >= step ? 1.0 : 0.0;
-    }
-    return X;
-  };
-  // AIC on the exact likelihood of the block means of an extension: only its
-  // new terms profiled (a drift's slope is the GLS trend), their parameters
-  // counted. NaN when the likelihood cannot be evaluated.
-  auto exactAic = [&](const Extension& e, double* loglik) {
-    Model mc = withoutSin(assemble(m0n, e.terms));
-    const Eigen::MatrixXd X = blockRegressors(mc.count(ProcessKind::DR) > 0, 0);
-    std::vector<int> own;
-    for (std::size_t q = e.terms.size() - e.added; q < e.terms.size(); ++q)
-      if (e.terms[q].kind != ProcessKind::DR) own.push_back(assembledIndex(m0n, e.terms, q));
-    if (own.empty()) own.push_back(-1);
-    try {
-      const double l = stochastic::profileBlockLogLikelihood(mc, yb, blk, X, own);
-      *loglik = l;
-      return -2.0 * l + penalty(e.terms, e.terms.size() - e.added);
-    } catch (const Error&) {
-      return kNaN;
-    }
-  };
-  // The best single level shift on top of @p terms (block boundaries in the
-  // middle 90 %, every 4th then refined): exact AIC with the shift's size and
-  // time as its two parameters; *t_s, *size where it sits.
-  auto bestShiftAic = [&](const std::vector<Candidate>& terms, double* t_s, double* size) {
-    const Model mb = withoutSin(assemble(m0n, terms));
-    const bool trend = mb.count(ProcessKind::DR) > 0;
-    const std::size_t nb = yb.size(), k0 = std::max<std::size_t>(1, nb / 20), k1 = nb - k0;
-    double best_l = -std::numeric_limits<double>::infinity();
-    std::size_t best_k = 0;
-    double best_size = kNaN;
-    auto at = [&](std::size_t k) {
-      try {
-        const auto r = stochastic::blockLogLikelihood(mb, yb, blk, blockRegressors(trend, k));
-        if (r.loglik > best_l) {
-          best_l = r.loglik;
-          best_k = k;
-          best_size = r.beta(r.beta.size() - 1);
-        }
-      } catch (const Error&) {
-      }
-    };
-    for (std::size_t k = k0; k <= k1; k += 4) at(k);
-    const std::size_t c = best_k;
-    for (std::size_t k = c > k0 + 3 ? c - 3 : k0; k <= std::min(k1, c + 3); ++k)
-      if (k != c) at(k);
-    if (best_k == 0) return kNaN;
-    *t_s = t0 + static_cast<double>(best_k * blk) / rate;
-    *size = best_size;
-    return -2.0 * best_l + 4.0;
-  };
-  auto causesOf = [&](const Extension& e) {
-    std::vector<std::string> c;
-    for (std::size_t q = e.terms.size() - e.added; q < e.terms.size(); ++q) c.push_back(causeName(causeOf(e.terms[q].kind)));
-    std::sort(c.begin(), c.end());
-    c.erase(std::unique(c.begin(), c.end()), c.end());
-    std::string j;
-    for (const auto& x : c) j += (j.empty() ? "" : "+") + x;
-    return j;
-  };
-  const WvTest wt = wvTest(full, p_thr);
-  std::vector<Candidate> S;          // the terms found, backfitted on the whole record
-  std::vector<std::size_t> found_at;  // S[i]'s finding in cd.findings
-  double cur_crit = wvDeviance(full.nu, wvOf(m0n, tau), full.dof);
-  auto chk = chk_cl;
-  while (static_cast<int>(S.size()) < opt.max_terms && countSignificant(chk) > 0) {
-    // Cause chosen on the whole cleaned record (all scales: the coarsest
-    // ones separate random walk, drift and long Gauss-Markov), by AIC over
-    // every extension by one term or two jointly fitted ones.
-    const auto ext = extensions(m0n, S, full, wt, opt.max_terms - static_cast<int>(S.size()));
-    std::vector<int> order, order_all;
-    for (std::size_t i = 0; i < ext.size(); ++i)
-      if (ext[i].valid) (ext[i].needed ? order : order_all).push_back(static_cast<int>(i));
-      else if (ext[i].open_top) order_all.push_back(static_cast<int>(i));
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return ext[a].crit < ext[b].crit; });
-    if (order.empty() || !(ext[order[0]].crit < cur_crit)) break;
-    int best = order[0];
-    int second = order.size() > 1 ? order[1] : -1;
-    // Slow explanations compared by the exact Gaussian likelihood of the block
-    // means (the new terms' variances profiled, a drift's slope by GLS), AIC.
-    std::string exact_evidence;
-    std::vector<std::pair<double, int>> ranked_exact;  // (exact AIC, extension) when the slow ones were ranked
-    std::vector<std::pair<double, int>> excluded;      // larger sets the nested test kept out
-    if (hasSlow(ext[best]) && yb.size() >= 16) {
-      const auto key = fastPart(ext[best]);
-      std::vector<std::pair<double, int>> ranked;
-      std::vector<double> loglik(ext.size(), kNaN);
-      std::vector<int> pool = order;
-      pool.insert(pool.end(), order_all.begin(), order_all.end());
-      for (int i : pool) {
-        const Extension& e = ext[i];
-        if (!hasSlow(e) || fastPart(e) != key) continue;
-        double l = kNaN;
-        const double aic = exactAic(e, &l);
-        if (!std::isfinite(aic)) continue;
-        loglik[i] = l;
-        ranked.push_back({aic, i});
-      }
-      std::stable_sort(ranked.begin(), ranked.end());
-      // The reference is the best explanation with the fewest terms whose
-      // GMs the WV bounds (a GM whose WV profile interval of T reaches
-      // record/5 competes by AIC). One with more terms that the WV did not
-      // need replaces it only when it contains the reference's terms and its
-      // exact likelihood ratio against the reference rejects at 1 %
-      // (nested: chi-square with the added parameters as dof).
-      {
-        int simple = -1;
-        for (const auto& r : ranked)
-          if (!ext[r.second].open_top && (simple < 0 || ext[r.second].added < ext[simple].added)) simple = r.second;
-        if (simple >= 0) {
-          std::vector<std::pair<double, int>> kept;
-          for (const auto& r : ranked) {
-            const Extension& e = ext[r.second];
-            auto contains = [&](const Extension& big, const Extension& small) {
-              for (std::size_t q = small.terms.size() - small.added; q < small.terms.size(); ++q) {
-                bool in = false;
-                for (std::size_t k = big.terms.size() - big.added; k < big.terms.size(); ++k)
-                  in = in || (big.terms[k].kind == small.terms[q].kind && big.terms[k].retune == small.terms[q].retune &&
-                              big.terms[k].term == small.terms[q].term);
-                if (!in) return false;
-              }
-              return true;
-            };
-            if (e.added > ext[simple].added && !e.needed) {
-              if (!contains(e, ext[simple])) continue;
-              const double dof_lr = std::max(1.0, (penalty(e.terms, e.terms.size() - e.added) -
-                                                   penalty(ext[simple].terms, ext[simple].terms.size() - ext[simple].added)) / 2.0);
-              const double lr = 2.0 * (loglik[r.second] - loglik[simple]);
-              if (!(lr > boost::math::quantile(boost::math::complement(boost::math::chi_squared(dof_lr), 0.01)))) {
-                excluded.push_back(r);
-                continue;
-              }
-            }
-            kept.push_back(r);
-          }
-          ranked = kept;
-        }
-      }
-      ranked_exact = ranked;
-      if (ranked.size() >= 2) {
-        const int wv_best = best;
-        best = ranked[0].second;
-        second = ranked[1].second;
-        exact_evidence = "; among the slow explanations the exact likelihood of " + std::to_string(yb.size()) +
-                         " block means (variances profiled) gives AIC " + formatNumber(ranked[0].first, 7) + " against " +
-                         formatNumber(ranked[1].first, 7) + " for " + newTermsText(ext[second]) +
-                         (best != wv_best ? " (the WV alone preferred " + newTermsText(ext[wv_best]) + ")" : std::string());
-      }
-    }
-    if (second == best) second = -1;
-    if (second < 0)
-      for (int i : order)
-        if (i != best) {
-          second = i;
-          break;
-        }
-    // The slow decision on the exact likelihood of the block means
-    // (diagnosis_slow.hpp): it may replace the WV's slow terms by the slow
-    // explanation the block means prefer, and it judges the runner-up.
-    Extension chosen = ext[best];
-    slow::Choice sc;
-    if (hasSlow(chosen) && yb.size() >= 16) {
-      slow::Problem sp;
-      std::vector<Candidate> fast_terms(chosen.terms.begin(), chosen.terms.end() - chosen.added);
-      for (std::size_t q = chosen.terms.size() - chosen.added; q < chosen.terms.size(); ++q) {
-        const Candidate& c = chosen.terms[q];
-        if (isSlow(c)) {
-          sp.wv_slow.push_back(causeOf(c.kind));
-        } else {
-          fast_terms.push_back(c);
-          sp.fast_causes.push_back(causeName(causeOf(c.kind)));
-        }
-      }
-      sp.base = withoutSin(assemble(m0n, fast_terms));
-      sp.fast_pen = penalty(fast_terms, S.size());
-      sp.wv_start = withoutSin(assemble(m0n, chosen.terms));
-      for (std::size_t q = chosen.terms.size() - chosen.added; q < chosen.terms.size(); ++q)
-        if (isSlow(chosen.terms[q]) && chosen.terms[q].kind != ProcessKind::DR)
-          sp.wv_own.push_back(assembledIndex(m0n, chosen.terms, q));
-      sp.wv_pen = penalty(chosen.terms, chosen.terms.size() - chosen.added);
-      sp.wv_text = newTermsText(chosen);
-      sp.y = &yb;
-      sp.block = blk;
-      sp.rate_hz = rate;
-      sp.record_s = record;
-      sp.seed = stochastic::deriveSeed(opt.seed, 7000000u + 1000u * static_cast<unsigned>(ci) + static_cast<unsigned>(S.size()));
-      sc = slow::decide(sp);
-      if (sc.decided_here && sc.swapped) {
-        Extension e;
-        e.terms = fast_terms;
-        for (const auto& t : sc.terms) {
-          Candidate c;
-          c.kind = t.proc.kind;
-          c.proc = t.proc;
-          c.params = c.kind == ProcessKind::GM ? 2 : 1;
-          if (c.kind == ProcessKind::GM) {
-            c.T_lo = t.lo;
-            c.T_hi = t.hi;
-            c.T_hi_open = c.T_top_only = t.open_top;
-          } else {
-            c.p_lo = t.lo;
-            c.p_hi = t.hi;
-          }
-          e.terms.push_back(c);
-        }
-        e.added = static_cast<int>(e.terms.size() - S.size());
-        e.deviance = wvDeviance(full.nu, wvOf(assemble(m0n, e.terms), tau), full.dof);
-        e.crit = e.deviance + penalty(e.terms);
-        e.valid = true;
-        chosen = e;
-      }
-    }
-    const Extension& win = chosen;
-    const Model before = merged(m0n, S);
-    const Model after = merged(m0n, win.terms);
-    // A finding must change the WV by at least its CI width at some scale.
-    if (win.added == 1 && wvChangeInCiWidths(chk, wvOf(before, tau), wvOf(after, tau)) < 1.0) break;
-    double pmin = 1;
-    for (const auto& s : chk) pmin = std::min(pmin, s.p_value);
-    std::string evidence = "AIC " + formatNumber(win.crit, 5) +
-                           (second >= 0 ? " against " + formatNumber(ext[second].crit, 5) + " for the runner-up, " + newTermsText(ext[second])
-                                        : std::string(" (no other family fits)"));
-    if (win.added == 2) {
-      // Name the best one-term explanation the pair beat.
-      int single = -1;
-      for (int i : order)
-        if (ext[i].added == 1) {
-          single = i;
-          break;
-        }
-      evidence += "; fitted jointly: " + newTermsText(win) +
-                  (single >= 0 ? " against the best single term " + newTermsText(ext[single]) + " (AIC " +
-                                     formatNumber(ext[single].crit, 5) + ", " + std::to_string(ext[single].significant) +
-                                     " scale(s) still significant)"
-                               : std::string()) +
-                  (win.needed ? ", below every single term by more than the 1 % chi-square margin"
-                              : ", both needed by the exact likelihood (nested likelihood ratio at 1 %)");
-    }
-    if (sc.decided_here) evidence = (sc.swapped ? "the WV's coarsest scales leave the slow explanations open" : evidence) + sc.evidence;
-    else evidence += exact_evidence;
-    // The runner-up naming other causes, on the criterion that chose (the
-    // exact likelihood among the slow explanations, else the WV AIC), and a
-    // single level shift against a slow explanation (a shift near its
-    // detection limit that the shift test could not accept looks like a
-    // random walk): decided only when the winner is lower by at least 2 in
-    // AIC (below 2 both have substantial support; Burnham & Anderson 2002,
-    // §2.6).
-    std::string ru, ru_detail;
-    double ru_margin = kNaN, ru_p = kNaN;
-    int ru_draws = 0;
-    bool ru_larger = false;  // the runner-up contains the winner (ru_p: its lead under the winner)
-    {
-      const std::string mine = causesOf(win);
-      if (sc.decided_here) {
-        // The slow decision (diagnosis_slow.hpp): its runner-up and bootstrap.
-        ru = sc.runner_up;
-        ru_detail = sc.runner_up_detail;
-        ru_margin = sc.runner_up.empty() ? kNaN : sc.aic_margin;
-        ru_p = sc.runner_up.empty() ? kNaN : sc.p;
-        ru_draws = sc.draws;
-        ru_larger = sc.larger;
-      } else {
-        for (int i : order)
-          if (i != best && causesOf(ext[i]) != mine) {
-            ru = causesOf(ext[i]);
-            ru_detail = newTermsText(ext[i]) + " (WV deviance)";
-            ru_margin = ext[i].crit - win.crit;
-            break;
-          }
-      }
-      if (hasSlow(win) && yb.size() >= 16) {
-        double l_slow = kNaN, t_shift = kNaN, size_shift = kNaN;
-        double aic_slow = kNaN;
-        for (const auto& r : ranked_exact)
-          if (r.second == best) aic_slow = r.first;
-        if (!std::isfinite(aic_slow)) aic_slow = exactAic(win, &l_slow);
-        const double aic_shift = bestShiftAic(S, &t_shift, &size_shift);
-        // The shift is the runner-up when it is closer than the slow one (by
-        // AIC, or, when the slow one was simulated and rejected, whenever it
-        // is within the AIC margin of 2 that decides against a shift).
-        const double shift_margin = aic_shift - aic_slow;
-        const bool slow_open = std::isfinite(ru_p) && (ru_larger ? ru_p <= slow::kLevel : ru_p > slow::kLevel);
-        const bool closer = std::isfinite(ru_p) ? !slow_open && shift_margin < 2.0
-                                                : (!std::isfinite(ru_margin) || shift_margin < ru_margin);
-        if (std::isfinite(aic_slow) && std::isfinite(aic_shift) && closer) {
-          ru_p = kNaN;
-          ru_draws = 0;
-          ru = causeName(Cause::LevelShift);
-          ru_detail = "a level shift of " + formatNumber(size_shift, 3) + " " + unit + " at t = " + formatNumber(t_shift, 6) +
-                      " s (exact likelihood of " + std::to_string(yb.size()) + " block means: AIC " +
-                      formatNumber(aic_shift, 7) + " against " + formatNumber(aic_slow, 7) + ")";
-          ru_margin = aic_shift - aic_slow;
-        }
-      }
-    }
-    for (std::size_t q = win.terms.size() - win.added; q < win.terms.size(); ++q) {
-      Finding nf;
-      nf.channel = cd.name;
-      nf.statistic = pmin;
-      nf.threshold = p_thr;
-      nf.p_value = std::min(1.0, pmin * J * sh.channels / 0.4);  // Bonferroni over scales and channels (WV share)
-      nf.evidence = evidence;
-      nf.runner_up = ru;
-      nf.runner_up_detail = ru_detail;
-      nf.aic_margin = ru_margin;
-      nf.runner_up_p = ru_p;
-      nf.runner_up_draws = ru_draws;
-      nf.decided = ru.empty() || (std::isfinite(ru_p) ? (ru_larger ? ru_p > slow::kLevel : ru_p <= slow::kLevel)
-                                                    : !(ru_margin < 2.0));
-      cd.findings.push_back(nf);
-      found_at.push_back(cd.findings.size() - 1);
-    }
-    S = win.terms;
-    cur_crit = win.crit;
-    chk = checkScales(wv_cl, wvOf(merged(m0n, S), tau), dof, p_thr, {}, {});
-  }
-  // Each finding as it stands in the joint fit: its parameters, intervals and
-  // the misfit it explains given the other terms found.
-  for (std::size_t i = 0; i < S.size(); ++i) {
-    std::vector<Candidate> others;
-    for (std::size_t q = 0; q < S.size(); ++q)
-      if (q != i) others.push_back(S[q]);
-    // The other terms as the model file has them (retune indices refer to
-    // m0n's terms, which merged() leaves in place).
-    const Model before = merged(m0n, others);
-    const auto chk_i = checkScales(wv_cl, wvOf(before, tau), dof, p_thr, {}, {});
-    Finding nf = broadbandFinding(cd.name, S[i], before, chk_i, tau, rate);
-    Finding& f = cd.findings[found_at[i]];
-    nf.statistic = f.statistic;
-    nf.threshold = f.threshold;
-    nf.p_value = f.p_value;
-    nf.evidence = f.evidence;
-    nf.runner_up = f.runner_up;
-    nf.runner_up_detail = f.runner_up_detail;
-    nf.aic_margin = f.aic_margin;
-    nf.runner_up_p = f.runner_up_p;
-    nf.runner_up_draws = f.runner_up_draws;
-    nf.decided = f.decided;
-    f = nf;
-    added_params += S[i].params;
-  }
+  for (const auto& c : S) added_params += c.params;
   m_full = merged(m0n, S);
   {
     // The same terms on the first half, for the held-out gain.

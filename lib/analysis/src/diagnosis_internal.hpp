@@ -4,6 +4,9 @@
 // function per step, each reading the channel's ChannelContext:
 //  - diagnosis_detect.cpp: steps 1-3, the detectors (outliers, lines, level
 //    shifts), each taking what it finds out of the record;
+//  - diagnosis_search.cpp: step 4, the search for the cause of the broadband
+//    misfit on the cleaned record's WV, with the slow decision
+//    (diagnosis_slow.hpp);
 //  - diagnosis_extensions.cpp: the extensions of a model fitted to a measured
 //    wavelet variance (WV) -- one process family added or one term retuned
 //    (Candidate), sets of them backfitted jointly (Extension), chosen by AIC
@@ -240,5 +243,37 @@ std::vector<detect::SpectralLine> removeLines(const ChannelContext& ctx, std::ve
 /// are outlier events, interpolated out. Returns whether @p x changed.
 bool removeLevelShifts(const ChannelContext& ctx, const gmwm::WaveletVariance& wv_pre, std::vector<double>& x,
                        ChannelDiagnosis& cd);
+
+/// Per-scale comparison of a measured WV with a model WV @p nu_m under
+/// chi-square(@p dof), significant below @p p_thr; the simulation envelope
+/// @p env_lo / @p env_hi may be empty (NaN in the result).
+std::vector<ScaleCheck> checkScales(const gmwm::WaveletVariance& wv, const std::vector<double>& nu_m,
+                                    const std::vector<double>& dof, double p_thr,
+                                    const std::vector<double>& env_lo,
+                                    const std::vector<double>& env_hi);
+
+/// The WV of the raw and of the cleaned record against the user's model
+/// (diagnosis.cpp, the start of step 4).
+struct WvCheck {
+  gmwm::WaveletVariance raw;      ///< WV of the raw record (its mean removed)
+  gmwm::WaveletVariance cleaned;  ///< WV of the record steps 1-3 cleaned
+  std::vector<double> tau;        ///< scales [samples]
+  /// Chi-square dof per scale: the WV's, lowered to those seen in the model's
+  /// own simulations where those are fewer.
+  std::vector<double> dof;
+  double p_thr = 0;               ///< per-scale p-value threshold (Bonferroni over scales)
+  WvData full;                    ///< the cleaned WV with those dof, on the whole record
+  std::vector<ScaleCheck> cleaned_vs_model;  ///< the cleaned WV against the model without its lines
+};
+
+/// 4. The cause of the broadband misfit of the cleaned record @p x: while
+/// scales stay significant, the extension of the terms found so far (one
+/// term, or two fitted jointly) chosen by AIC on the cleaned WV, the slow
+/// explanations ranked again on the exact likelihood of the block means and
+/// put to the slow decision (diagnosis_slow.hpp); a finding per new term
+/// with its evidence and runner-up, restated as it stands in the joint fit
+/// of all. Returns the terms found (backfitted on the whole record).
+std::vector<Candidate> searchCauses(const ChannelContext& ctx, const std::vector<double>& x, const WvCheck& w,
+                                    ChannelDiagnosis& cd);
 
 }  // namespace navimpact::analysis::detail
