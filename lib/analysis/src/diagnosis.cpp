@@ -1,37 +1,28 @@
 // navimpact diagnose: what a simulation with the user's model gets wrong, why,
-// and what an extended model gains (see diagnosis.hpp for the method).
+// and what an extended model gains (see diagnosis.hpp for the method). Every
+// channel goes through the pipeline in diagnoseChannel(), one function per
+// step: 1-3 in diagnosis_detect.cpp, the cause search of step 4 in
+// diagnosis_search.cpp, the WV test of step 4, the extension (5) and the
+// held-out gain (6) here; the channels run in parallel in diagnose().
 #include "navimpact/analysis/diagnosis.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <mutex>
-#include <sstream>
-#include <tuple>
+#include <string>
+#include <vector>
 
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
 
 #include "diagnosis_internal.hpp"
-#include "diagnosis_slow.hpp"
 #include "navimpact/core/error.hpp"
-#include "navimpact/core/format.hpp"
-#include "navimpact/core/golden_section.hpp"
 #include "navimpact/core/parallel.hpp"
-#include "navimpact/detect/change_points.hpp"
-#include "navimpact/detect/lines.hpp"
-#include "navimpact/detect/null_model.hpp"
-#include "navimpact/detect/outliers.hpp"
-#include "navimpact/detect/step_test.hpp"
-#include "navimpact/gmwm/wavelet_variance.hpp"
 #include "navimpact/gmwm/estimator.hpp"
-#include "navimpact/stochastic/block_likelihood.hpp"
-#include "navimpact/stochastic/model_text.hpp"
-#include "navimpact/stochastic/process_kind.hpp"
+#include "navimpact/gmwm/wavelet_variance.hpp"
 #include "navimpact/stochastic/simulate.hpp"
-#include "navimpact/stochastic/theoretical_wv.hpp"
 
 namespace navimpact::analysis {
 
@@ -106,14 +97,8 @@ namespace {
 
 using namespace detail;
 
-int countOutside(const std::vector<ScaleCheck>& s) {
-  int c = 0;
-  for (const auto& x : s) c += x.outside95 ? 1 : 0;
-  return c;
-}
-
-// --------------------------------------------------------------------------
-
+/// What the channels share: the record, the model at its rate, the options,
+/// the alpha budget per channel and the progress reported so far.
 struct Shared {
   const ImuSeries* data;
   const stochastic::ImuModel* model;
@@ -132,35 +117,39 @@ struct Shared {
   }
 };
 
-
-/// Paired one-sided test over scales of the per-scale deviances (Vuong 1989
-/// style): z = mean(d_b - d_a) / (sd / sqrt(J)), H1: the extension fits better.
-void pairedScaleTest(const std::vector<double>& nu_b_hat, const std::vector<double>& nu_b,
-                     const std::vector<double>& eta_b, const std::vector<double>& nu_a_hat,
-                     const std::vector<double>& nu_a, const std::vector<double>& eta_a,
-                     double* z, double* p) {
-  const std::size_t J = std::min(nu_b_hat.size(), nu_a_hat.size());
-  std::vector<double> d(J);
-  double m = 0;
-  for (std::size_t j = 0; j < J; ++j) {
-    d[j] = wvDeviance({nu_b_hat[j]}, {nu_b[j]}, {eta_b[j]}) - wvDeviance({nu_a_hat[j]}, {nu_a[j]}, {eta_a[j]});
-    m += d[j];
-  }
-  m /= static_cast<double>(std::max<std::size_t>(1, J));
-  double v = 0;
-  for (double x : d) v += (x - m) * (x - m);
-  v /= static_cast<double>(std::max<std::size_t>(2, J) - 1);
-  if (!(v > 0)) {
-    *z = m > 0 ? std::numeric_limits<double>::infinity() : 0.0;
-    *p = m > 0 ? 0.0 : 1.0;
-    return;
-  }
-  *z = m / std::sqrt(v / static_cast<double>(J));
-  *p = boost::math::cdf(boost::math::complement(boost::math::normal(), *z));
+/// The context of channel @p ci: its record's rate, length and start, the
+/// user's model for it, its share of alpha, the options the steps read.
+ChannelContext channelContext(const Shared& sh, int ci) {
+  const ImuChannel& chan = sh.data->channels[ci];
+  const DiagnoseOptions& opt = *sh.opt;
+  ChannelContext ctx;
+  ctx.name = chan.name;
+  ctx.unit = channelUnit(chan.name);
+  ctx.index = ci;
+  ctx.rate = sh.data->rate_hz;
+  ctx.n = chan.x.size();
+  ctx.record = static_cast<double>(ctx.n) / ctx.rate;
+  ctx.t0 = sh.data->t0_s;
+  ctx.m0 = sh.model->forChannel(chan.name);
+  ctx.m0n = withoutSin(ctx.m0);
+  ctx.B = sh.per_channel;
+  ctx.channels = sh.channels;
+  ctx.max_terms = opt.max_terms;
+  ctx.simulations = opt.simulations;
+  ctx.seed = opt.seed;
+  return ctx;
 }
 
+/// @p x with its mean removed.
+std::vector<double> withoutMean(std::vector<double> x) {
+  double mean = 0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(x.size());
+  for (double& v : x) v -= mean;
+  return x;
+}
 
-/// 4 (its test). The WV of the raw and of the cleaned record against the
+/// 4, first part. The WV of the raw and of the cleaned record against the
 /// user's model, with the model's simulations: their envelope, the dof of
 /// each scale lowered to what they show, the per-scale threshold (Bonferroni
 /// over scales) and cd.scales (the raw record against the model). A WV is
@@ -217,95 +206,43 @@ WvCheck checkWv(Shared& sh, const ChannelContext& ctx, const std::vector<double>
   return w;
 }
 
-ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
-  const ImuChannel& chan = sh.data->channels[ci];
-  const DiagnoseOptions& opt = *sh.opt;
-  const double rate = sh.data->rate_hz;
-  const std::size_t n = chan.x.size();
-  const double record = static_cast<double>(n) / rate;
-  const double t0 = sh.data->t0_s;
-  ChannelDiagnosis cd;
-  cd.name = chan.name;
-  cd.model_before = sh.model->forChannel(chan.name);
-  const Model& m0 = cd.model_before;
-  const Model m0n = withoutSin(m0);
-  const Budget& B = sh.per_channel;
-  const std::string unit = channelUnit(cd.name);
-  ChannelContext ctx;
-  ctx.name = cd.name;
-  ctx.unit = unit;
-  ctx.index = ci;
-  ctx.rate = rate;
-  ctx.n = n;
-  ctx.record = record;
-  ctx.t0 = t0;
-  ctx.m0 = m0;
-  ctx.m0n = m0n;
-  ctx.B = B;
-  ctx.channels = sh.channels;
-  ctx.max_terms = opt.max_terms;
-  ctx.simulations = opt.simulations;
-  ctx.seed = opt.seed;
+/// The dof of the WV of one half of the record: its own, lowered in the
+/// proportion the simulations lowered the whole record's (WvCheck::dof).
+std::vector<double> halfDof(const gmwm::WaveletVariance& half, const WvCheck& w) {
+  std::vector<double> d(half.scales());
+  for (int j = 0; j < half.scales(); ++j) {
+    const double ratio = w.raw.eta(j) > 0 ? w.dof[j] / w.raw.eta(j) : 1.0;
+    d[j] = std::max(1.0, half.eta(j) * std::min(1.0, ratio));
+  }
+  return d;
+}
 
-  std::vector<double> x = chan.x;
-  double mean = 0;
-  for (double v : x) mean += v;
-  mean /= static_cast<double>(n);
-  for (double& v : x) v -= mean;
-  const std::vector<double> raw = x;
-
-  removeOutliers(ctx, x, cd);
-  sh.tick(cd.name + ": outliers");
-  const std::vector<detect::SpectralLine> lines = removeLines(ctx, x, cd);
-  sh.tick(cd.name + ": spectrum");
-  const auto wv_pre = gmwm::waveletVariance(x.data(), n, rate);
-  const std::vector<double> tau = toStd(wv_pre.tau);
-  const std::size_t findings_pre = cd.findings.size();
-  const bool x_after_pre_changed = removeLevelShifts(ctx, wv_pre, x, cd);
-  sh.tick(cd.name + ": level shifts");
-
-  // 4. WV of the raw and cleaned record vs the model, with simulations, and
-  // the cause of the broadband misfit.
-  const WvCheck w = checkWv(sh, ctx, raw, x, wv_pre, findings_pre > 0, x_after_pre_changed, cd);
-  const gmwm::WaveletVariance& wv_raw = w.raw;
-  const gmwm::WaveletVariance& wv_cl = w.cleaned;
-  const std::vector<double>& dof = w.dof;
-  const double p_thr = w.p_thr;
-  const WvData& full = w.full;
-  const std::vector<Candidate> S = searchCauses(ctx, x, w, cd);
-
-  // 5. Cause of the broadband misfit: candidates on the first half, refit on all.
-  const std::size_t nh = n / 2;
-  const auto wv_h1 = gmwm::waveletVariance(x.data(), nh, rate);
-  const auto wv_h2c = gmwm::waveletVariance(x.data() + nh, n - nh, rate);
-  const auto wv_h2r = gmwm::waveletVariance(raw.data() + nh, n - nh, rate);
-  auto halfDof = [&](const gmwm::WaveletVariance& hw) {
-    std::vector<double> d(hw.scales());
-    for (int j = 0; j < hw.scales(); ++j) {
-      const double ratio = wv_raw.eta(j) > 0 ? dof[j] / wv_raw.eta(j) : 1.0;
-      d[j] = std::max(1.0, hw.eta(j) * std::min(1.0, ratio));
-    }
-    return d;
-  };
-  WvData h1{toStd(wv_h1.tau), toStd(wv_h1.wv), halfDof(wv_h1), static_cast<double>(nh)};
-
-  Model m_full = m0n, m_half = m0n;
+/// 5. The extension: the terms found @p S added to the user's model, on the
+/// whole cleaned record and, backfitted again, on the first half of @p x
+/// (for the held-out gain), each refitted by GMWM when a broadband term was
+/// found; the user's SIN terms and the lines found join as SIN terms. Fills
+/// the models after, their refits, scales_after and wv_cleaned of @p cd.
+/// Returns the parameters the broadband terms add.
+int extendModel(const ChannelContext& ctx, const std::vector<double>& x, const WvCheck& w,
+                const std::vector<Candidate>& S, const std::vector<detect::SpectralLine>& lines,
+                ChannelDiagnosis& cd) {
+  const Model& m0n = ctx.m0n;
+  const std::size_t nh = ctx.n / 2;
+  const auto wv_h1 = gmwm::waveletVariance(x.data(), nh, ctx.rate);
+  const WvData h1{toStd(wv_h1.tau), toStd(wv_h1.wv), halfDof(wv_h1, w), static_cast<double>(nh)};
   int added_params = 0;
   for (const auto& c : S) added_params += c.params;
-  m_full = merged(m0n, S);
-  {
-    // The same terms on the first half, for the held-out gain.
-    std::vector<Candidate> Sh = S;
-    if (!Sh.empty()) backfit(m0n, Sh, h1);
-    m_half = merged(m0n, Sh);
-  }
+  Model m_full = merged(m0n, S);
+  std::vector<Candidate> Sh = S;  // the same terms on the first half
+  if (!Sh.empty()) backfit(m0n, Sh, h1);
+  Model m_half = merged(m0n, Sh);
   if (added_params > 0) {
     m_half = gmwmRefit(m_half, wv_h1, h1, &cd.refit_half);
-    m_full = gmwmRefit(m_full, wv_cl, full, &cd.refit_full);
+    m_full = gmwmRefit(m_full, w.cleaned, w.full, &cd.refit_full);
   }
-  cd.scales_after = checkScales(wv_cl, wvOf(m_full, tau), dof, p_thr, {}, {});
+  cd.scales_after = checkScales(w.cleaned, wvOf(m_full, w.tau), w.dof, w.p_thr, {}, {});
   // The user's SIN terms and the lines found become SIN terms of the extension.
-  for (const auto& p : m0.terms)
+  for (const auto& p : ctx.m0.terms)
     if (p.kind == ProcessKind::SIN) {
       m_full.terms.push_back(p);
       m_half.terms.push_back(p);
@@ -316,32 +253,71 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   }
   cd.model_after = m_full;
   cd.model_after_half = m_half;
-  cd.wv_cleaned = toStd(wv_cl.wv);
-  cd.adequate = cd.findings.empty();
+  cd.wv_cleaned = toStd(w.cleaned.wv);
+  return added_params;
+}
 
-  // 6. Gain, held out: the user's model on the raw second half against the
-  // first-half extension (its lines, outliers and steps removed with the
-  // detectors' whole-record estimates) on the cleaned second half. Without a
-  // fitted broadband term (cleaning or lines only) nothing was fitted to the
-  // WV and the whole record is used.
-  GainCheck& g = cd.gain;
+int countOutside(const std::vector<ScaleCheck>& s) {
+  int c = 0;
+  for (const auto& x : s) c += x.outside95 ? 1 : 0;
+  return c;
+}
+
+/// Paired one-sided test over scales of the per-scale deviances (Vuong 1989
+/// style): z = mean(d_b - d_a) / (sd / sqrt(J)), H1: the extension fits better.
+void pairedScaleTest(const std::vector<double>& nu_b_hat, const std::vector<double>& nu_b,
+                     const std::vector<double>& eta_b, const std::vector<double>& nu_a_hat,
+                     const std::vector<double>& nu_a, const std::vector<double>& eta_a,
+                     double* z, double* p) {
+  const std::size_t J = std::min(nu_b_hat.size(), nu_a_hat.size());
+  std::vector<double> d(J);
+  double m = 0;
+  for (std::size_t j = 0; j < J; ++j) {
+    d[j] = wvDeviance({nu_b_hat[j]}, {nu_b[j]}, {eta_b[j]}) - wvDeviance({nu_a_hat[j]}, {nu_a[j]}, {eta_a[j]});
+    m += d[j];
+  }
+  m /= static_cast<double>(std::max<std::size_t>(1, J));
+  double v = 0;
+  for (double x : d) v += (x - m) * (x - m);
+  v /= static_cast<double>(std::max<std::size_t>(2, J) - 1);
+  if (!(v > 0)) {
+    *z = m > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+    *p = m > 0 ? 0.0 : 1.0;
+    return;
+  }
+  *z = m / std::sqrt(v / static_cast<double>(J));
+  *p = boost::math::cdf(boost::math::complement(boost::math::normal(), *z));
+}
+
+/// 6. Gain, held out: the user's model on the raw second half against the
+/// first-half extension @p after_half (its lines, outliers and steps removed
+/// with the detectors' whole-record estimates) on the cleaned second half.
+/// Without a fitted broadband term (@p added_params 0: cleaning or lines
+/// only) nothing was fitted to the WV and the whole record is used, with the
+/// whole-record extension @p after_full. @p lines: the lines found.
+GainCheck heldOutGain(const ChannelContext& ctx, const std::vector<double>& raw, const std::vector<double>& x,
+                      const WvCheck& w, const Model& after_full, const Model& after_half, int added_params,
+                      std::size_t lines) {
+  const Model& m0 = ctx.m0;
+  const std::size_t n = ctx.n, nh = n / 2;
+  GainCheck g;
   const bool held_out = added_params > 0;
   g.basis = held_out ? "second_half" : "full_record";
-  const gmwm::WaveletVariance& wb = held_out ? wv_h2r : wv_raw;
-  const gmwm::WaveletVariance& wa = held_out ? wv_h2c : wv_cl;
-  const Model after_eval = withoutSin(held_out ? m_half : m_full);
+  const gmwm::WaveletVariance wb = held_out ? gmwm::waveletVariance(raw.data() + nh, n - nh, ctx.rate) : w.raw;
+  const gmwm::WaveletVariance wa = held_out ? gmwm::waveletVariance(x.data() + nh, n - nh, ctx.rate) : w.cleaned;
+  const Model after_eval = withoutSin(held_out ? after_half : after_full);
   const auto tb = toStd(wb.tau), ta = toStd(wa.tau);
-  const auto db = held_out ? halfDof(wb) : dof;
-  const auto da = held_out ? halfDof(wa) : dof;
+  const auto db = held_out ? halfDof(wb, w) : w.dof;
+  const auto da = held_out ? halfDof(wa, w) : w.dof;
   const auto nub = wvOf(m0, tb), nua = wvOf(after_eval, ta);
   g.scales = wb.scales();
-  g.added_params = added_params + 2 * static_cast<int>(lines.size());
+  g.added_params = added_params + 2 * static_cast<int>(lines);
   g.objective_before = m0.empty() ? kNaN : gmwm::objective(m0, wb);
   g.objective_after = after_eval.empty() ? kNaN : gmwm::objective(after_eval, wa);
   g.deviance_before = wvDeviance(toStd(wb.wv), nub, db);
   g.deviance_after = wvDeviance(toStd(wa.wv), nua, da);
-  g.outside_before = countOutside(checkScales(wb, nub, db, p_thr, {}, {}));
-  g.outside_after = countOutside(checkScales(wa, nua, da, p_thr, {}, {}));
+  g.outside_before = countOutside(checkScales(wb, nub, db, w.p_thr, {}, {}));
+  g.outside_after = countOutside(checkScales(wa, nua, da, w.p_thr, {}, {}));
   pairedScaleTest(toStd(wb.wv), nub, db, toStd(wa.wv), nua, da, &g.z, &g.p_value);
   g.test = std::string("one-sided paired z test over the ") + std::to_string(g.scales) + " " +
            (held_out ? "held-out (second-half)" : "whole-record") +
@@ -350,7 +326,38 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   const bool obj_better = !(g.objective_after >= g.objective_before);  // NaN (empty model) counts as not worse
   g.direction = dev_better && obj_better ? "better" : (!dev_better && !obj_better ? "worse" : "mixed");
   g.significant = dev_better && obj_better && g.p_value < 0.05;
-  sh.tick(cd.name + ": model extension");
+  return g;
+}
+
+/// One channel through the pipeline of diagnosis.hpp.
+ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
+  const ChannelContext ctx = channelContext(sh, ci);
+  ChannelDiagnosis cd;
+  cd.name = ctx.name;
+  cd.model_before = ctx.m0;
+  // The record with its mean removed: `raw` as measured, `x` as steps 1-3 clean it.
+  const std::vector<double> raw = withoutMean(sh.data->channels[ci].x);
+  std::vector<double> x = raw;
+  // 1. Outlier events.
+  removeOutliers(ctx, x, cd);
+  sh.tick(ctx.name + ": outliers");
+  // 2. Spectral lines.
+  const std::vector<detect::SpectralLine> lines = removeLines(ctx, x, cd);
+  sh.tick(ctx.name + ": spectrum");
+  // 3. Level shifts and knocks.
+  const bool outliers_or_lines = !cd.findings.empty();
+  const auto wv_pre = gmwm::waveletVariance(x.data(), ctx.n, ctx.rate);
+  const bool shifts_or_knocks = removeLevelShifts(ctx, wv_pre, x, cd);
+  sh.tick(ctx.name + ": level shifts");
+  // 4. The WV against the model, then the cause of the broadband misfit.
+  const WvCheck w = checkWv(sh, ctx, raw, x, wv_pre, outliers_or_lines, shifts_or_knocks, cd);
+  const std::vector<Candidate> found = searchCauses(ctx, x, w, cd);
+  // 5. The extension.
+  const int added_params = extendModel(ctx, x, w, found, lines, cd);
+  cd.adequate = cd.findings.empty();
+  // 6. The gain, held out.
+  cd.gain = heldOutGain(ctx, raw, x, w, cd.model_after, cd.model_after_half, added_params, lines.size());
+  sh.tick(ctx.name + ": model extension");
   return cd;
 }
 

@@ -1,7 +1,8 @@
 // Internal declarations shared by the diagnosis sources (not installed).
 //
 // diagnosis.cpp runs the pipeline of diagnosis.hpp on every channel, one
-// function per step, each reading the channel's ChannelContext:
+// function per step, each reading the channel's ChannelContext; it holds the
+// WV test of step 4 (checkWv), the extension (5) and the held-out gain (6):
 //  - diagnosis_detect.cpp: steps 1-3, the detectors (outliers, lines, level
 //    shifts), each taking what it finds out of the record;
 //  - diagnosis_search.cpp: step 4, the search for the cause of the broadband
