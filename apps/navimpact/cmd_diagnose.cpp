@@ -59,7 +59,7 @@ struct Opts {
 /// `diagnose --run`: predicted against measured outage errors of a real run.
 int runOnRun(const Opts& o) {
   na::RunDiagnosisOptions ro;
-  if (!o.replay_config.empty()) ro.replay = na::loadReplayConfig(o.replay_config);
+  if (!o.replay_config.empty()) ro.replay = na::loadReplayConfig(o.replay_config, {"rawlog", "model"});  // --run, --model
   ro.replay.rawlog = o.run_rawlog;
   ro.replay.model_spec = o.model;
   ro.durations_s = o.durations;

@@ -53,7 +53,12 @@ navimpact::cli::Registrar reg({
       return [o]() -> int {
         navimpact::OutputSet out(o->out, navimpact::cli::overwriteMode(o->overwrite));
         navimpact::analysis::ReplayConfig cfg;
-        if (!o->config.empty()) cfg = navimpact::analysis::loadReplayConfig(o->config);
+        if (!o->config.empty()) {
+          std::vector<std::string> flags;  // keys the command line replaces
+          if (!o->rawlog.empty()) flags.push_back("rawlog");
+          if (!o->model.empty()) flags.push_back("model");
+          cfg = navimpact::analysis::loadReplayConfig(o->config, flags);
+        }
         if (!o->rawlog.empty()) cfg.rawlog = o->rawlog;
         if (!o->model.empty()) cfg.model_spec = o->model;
         if (!o->imu_label.empty()) cfg.imu_label = o->imu_label;

@@ -50,3 +50,58 @@ string(REPEAT "GM(sigma=1, T=2) + " 200 _longmodel)
 file(WRITE ${_erd}/long_model.yaml "rate_hz: 100\ngyroscope: \"${_longmodel}XX(a=1)\"\n")
 navimpact_cli_fail(cli_error_model_text_long EXIT 1 ARGS model show ${_erd}/long_model.yaml
   REGEX "long_model.yaml: key 'gyroscope': model '.*\\.\\.\\.\\([0-9]+ bytes\\)': at position 3801: expected a process name")
+
+# A file named by a configuration key that cannot be read (missing, a folder)
+# is named with the configuration and the key as well as the path, in every
+# command that reads such keys (ConfigNode::inputFile / modelRef), before any
+# work and with no output left behind.
+set(_fk ${_erd}/filekeys)
+file(MAKE_DIRECTORY ${_fk}/folder)
+set(_m ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml)
+set(_traj ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz)
+file(WRITE ${_fk}/replay_rawlog.yaml "rawlog: no_such.rawlog\n")
+file(WRITE ${_fk}/replay_model.yaml "rawlog: ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog\nmodel: folder:ref\n")
+file(READ ${CMAKE_SOURCE_DIR}/datasets/katwijk_rover/manifest.yaml _man)
+string(REPLACE "file: imu.csv.gz" "file: no_such_imu.csv" _man "${_man}")
+string(REPLACE "file: gnss.csv" "file: ${CMAKE_SOURCE_DIR}/datasets/katwijk_rover/gnss.csv" _man "${_man}")
+string(REPLACE "file: reference.csv" "file: ${CMAKE_SOURCE_DIR}/datasets/katwijk_rover/reference.csv" _man "${_man}")
+file(WRITE ${_fk}/manifest.yaml "${_man}")
+file(WRITE ${_fk}/emulate_traj.yaml "trajectory: {file: folder}\nimu: {errors: none}\n")
+file(WRITE ${_fk}/emulate_model.yaml "trajectory: {file: ${_traj}}\nimu: {errors: model, model: no_such.yaml:ref}\n")
+file(WRITE ${_fk}/emulate_static.yaml
+  "trajectory: {file: ${_traj}}\nimu: {errors: static, static: {file: no_such.csv, gyro_unit: deg/s, acc_unit: g}}\n")
+file(WRITE ${_fk}/study.yaml "trajectory: {file: ${_traj}}
+truth: {errors: model, model: ${_m}:ref}
+candidates:
+  - {label: A, model: ${_m}:ref}
+  - {label: B, accelerometer: ${_m}:acc_ref, gyroscope: no_such.yaml:gyro_ref}
+")
+file(WRITE ${_fk}/covariance.yaml "model_file: no_such.yaml\nmodel_sets: [{name: a, models: [ref]}]\n")
+# _file_key(NAME CONFIG KEY PATH REASON COMMAND...): COMMAND fails naming CONFIG, KEY, PATH and REASON.
+function(_file_key name config key path reason)
+  navimpact_cli_fail(cli_error_file_key_${name} EXIT 1 ARGS ${ARGN} NOOUT ${_fk}/out_${name}
+    REGEX "^navimpact: [^ ]*/${config}: key '${key}': cannot open '[^']*/filekeys/${path}' \\(${reason}\\)$")
+endfunction()
+set(_none "No such file or directory")
+_file_key(replay_rawlog replay_rawlog.yaml rawlog no_such.rawlog "${_none}"
+  replay --config ${_fk}/replay_rawlog.yaml --out ${_fk}/out_replay_rawlog)
+_file_key(replay_model replay_model.yaml model folder "Is a directory"
+  replay --config ${_fk}/replay_model.yaml --out ${_fk}/out_replay_model)
+_file_key(import manifest.yaml imu.file no_such_imu.csv "${_none}"
+  import --manifest ${_fk}/manifest.yaml --out ${_fk}/out_import)
+_file_key(emulate_trajectory emulate_traj.yaml trajectory.file folder "Is a directory"
+  emulate --config ${_fk}/emulate_traj.yaml --out ${_fk}/out_emulate_trajectory)
+_file_key(emulate_model emulate_model.yaml imu.model no_such.yaml "${_none}"
+  emulate --config ${_fk}/emulate_model.yaml --out ${_fk}/out_emulate_model)
+_file_key(emulate_static emulate_static.yaml imu.static.file no_such.csv "${_none}"
+  emulate --config ${_fk}/emulate_static.yaml --out ${_fk}/out_emulate_static)
+_file_key(study study.yaml "candidates\\[1\\].gyroscope" no_such.yaml "${_none}"
+  study --config ${_fk}/study.yaml --out ${_fk}/out_study)
+_file_key(covariance covariance.yaml model_file no_such.yaml "${_none}"
+  covariance --config ${_fk}/covariance.yaml --out ${_fk}/out_covariance)
+# A flag that replaces the key leaves its file unchecked (the file is not read).
+add_test(NAME cli_error_file_key_replaced_by_flag
+  COMMAND ${NI} replay --config ${_fk}/replay_rawlog.yaml --rawlog ${CMAKE_BINARY_DIR}/tests/cli/emulate_cli/uav30.rawlog
+          --outage 15:10 --out ${_fk}/o9 --overwrite)
+set_tests_properties(cli_error_file_key_replaced_by_flag PROPERTIES FIXTURES_REQUIRED emu_rawlog
+  PASS_REGULAR_EXPRESSION "6000 IMU steps at 200 Hz")

@@ -3,7 +3,10 @@
 // for type, unit (the range names it) and range.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 
 #include "navimpact/core/config.hpp"
@@ -176,17 +179,25 @@ TEST(Config, RangeAndUnitOfEveryNumber) {
 
 TEST(Config, FilesAreNamedInEveryMessageAndPathsAreRelativeToTheirFolder) {
   const auto dir = navimpact::test::tempDir();
+  std::filesystem::create_directories(dir / "sub");
+  std::ofstream(dir / "sub" / "x.csv") << "t\n";
+  std::ofstream(dir / "m.yaml") << "rate_hz: 100\n";
+  std::ofstream(dir / "a:b.yaml") << "rate_hz: 100\n";
   const auto f = (dir / "c.yaml").string();
-  std::ofstream(f) << "data: ../x.csv\nabs: /tmp/y.csv\nmodel: m.yaml:ref\nfilter: {propagate_every: 0}\n";
+  std::ofstream(f) << "data: sub/../sub/x.csv\nabs: " << (dir / "sub" / "x.csv").string()
+                   << "\nmodel: m.yaml:ref\nwhole: a:b.yaml\nfilter: {propagate_every: 0}\n";
   const ConfigNode c = ConfigNode::load(f);
-  EXPECT_EQ(c.filePath("data"), (dir.parent_path() / "x.csv").string());
-  EXPECT_EQ(c.filePath("abs"), "/tmp/y.csv");
-  EXPECT_EQ(c.filePath("none"), "");
+  EXPECT_EQ(c.inputFile("data", "a CSV"), (dir / "sub" / "x.csv").string());
+  EXPECT_EQ(c.inputFile("abs", "a CSV"), (dir / "sub" / "x.csv").string());
+  EXPECT_EQ(errorOf([&] { c.inputFile("none", "the IMU CSV"); }), f + ": key 'none': missing (the IMU CSV)");
   EXPECT_EQ(c.modelRef("model"), (dir / "m.yaml").string() + ":ref");
+  EXPECT_EQ(c.modelRef("whole"), (dir / "a:b.yaml").string());
+  EXPECT_EQ(c.modelRef("none"), "");
   int k = 1;
   EXPECT_EQ(errorOf([&] { c.map("filter").read("propagate_every", k, 1, 1000); }),
             f + ": key 'filter.propagate_every': must be an integer in 1..1000, got 0");
-  EXPECT_EQ(errorOf([] { ConfigNode::load("/nonexistent/c.yaml"); }), "/nonexistent/c.yaml: cannot open (no such file)");
+  EXPECT_EQ(errorOf([] { ConfigNode::load("/nonexistent/c.yaml"); }),
+            "/nonexistent/c.yaml: cannot open (No such file or directory)");
   const auto bad = (dir / "bad.yaml").string();
   std::ofstream(bad) << "a: 1\nb: [unclosed\n";
   EXPECT_NE(errorOf([&] { ConfigNode::load(bad); }).find(bad + ":3:1: YAML syntax error: "), std::string::npos)
@@ -195,4 +206,31 @@ TEST(Config, FilesAreNamedInEveryMessageAndPathsAreRelativeToTheirFolder) {
   std::ofstream(lst) << "- 1\n- 2\n";
   EXPECT_EQ(errorOf([&] { ConfigNode::load(lst); }), lst + ": expected a map of keys at the top level, got a list");
   EXPECT_TRUE(ConfigNode::parse("", "empty.yaml").keys().empty());
+}
+
+// A file named by a key that cannot be read is named with the configuration,
+// the key and the path it was resolved to, with the system's reason, whatever
+// the key (an input file or the FILE of a model reference).
+TEST(Config, AnInputFileThatCannotBeReadNamesTheConfigurationAndTheKey) {
+  const auto dir = navimpact::test::tempDir();
+  std::filesystem::create_directories(dir / "folder");
+  ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0600), 0);
+  const auto f = (dir / "c.yaml").string();
+  std::ofstream(f) << "imu: {file: x.csv}\nfolder: folder\nfifo: fifo\nempty: ''\nlist: [a]\n"
+                      "model: nope.yaml:ref\nmodel_folder: folder:ref\n";
+  const ConfigNode c = ConfigNode::load(f);
+  const std::string d = dir.string() + "/";
+  EXPECT_EQ(errorOf([&] { c.map("imu").inputFile("file", "the IMU CSV"); }),
+            f + ": key 'imu.file': cannot open '" + d + "x.csv' (No such file or directory)");
+  EXPECT_EQ(errorOf([&] { c.inputFile("folder", "a CSV"); }),
+            f + ": key 'folder': cannot open '" + d + "folder' (Is a directory)");
+  EXPECT_EQ(errorOf([&] { c.inputFile("fifo", "a CSV"); }),  // (opening a FIFO would block)
+            f + ": key 'fifo': cannot open '" + d + "fifo' (not a regular file)");
+  EXPECT_EQ(errorOf([&] { c.inputFile("empty", "the rawlog"); }),
+            f + ": key 'empty': must be a non-empty path (the rawlog)");
+  EXPECT_EQ(errorOf([&] { c.inputFile("list", "the rawlog"); }), f + ": key 'list': must be a text, got a list");
+  EXPECT_EQ(errorOf([&] { c.modelRef("model"); }),
+            f + ": key 'model': cannot open '" + d + "nope.yaml' (No such file or directory)");
+  EXPECT_EQ(errorOf([&] { c.modelRef("model_folder"); }),
+            f + ": key 'model_folder': cannot open '" + d + "folder' (Is a directory)");
 }

@@ -58,7 +58,7 @@ void CovarianceStudyConfig::loadFrom(const ConfigNode& root) {
   // model file, relative to the configuration file
   const std::string mf = root.has("model_file") ? root.text("model_file") : std::string();
   if (mf.empty()) throw root.error("model_file", "required: path of the IMU error model file");
-  c.model_file = root.resolve(mf);
+  c.model_file = root.inputFile("model_file", "the IMU error model file");
   echo["model_file"] = mf;
 
   root.read("duration_s", c.duration_s, limits::kDurationS);

@@ -64,19 +64,24 @@ Eigen::Vector3d sigma3(const ConfigNode& n, const std::string& k, const limits::
 
 }  // namespace
 
-ReplayConfig loadReplayConfig(const std::string& path) {
-  return loadConfigFile(path, &ReplayConfig::config_file);
+ReplayConfig loadReplayConfig(const std::string& path, const std::vector<std::string>& given_by_flags) {
+  return loadConfigFile(path, &ReplayConfig::config_file, given_by_flags);
 }
 
-void ReplayConfig::loadFrom(const ConfigNode& root) {
+void ReplayConfig::loadFrom(const ConfigNode& root, const std::vector<std::string>& given_by_flags) {
   ReplayConfig& c = *this;
   root.allowKeys({"rawlog", "model", "outages", "filter", "initial_sigma", "noise", "gnss_lever_arm_B_m",
                   "initial_attitude_deg", "record_interval_s", "outages_every", "reference_sigma",
                   "reference_lever_arm_B_m", "alignment", "imu_at_rest", "aids", "imu_label", "gnss_label"});
-  if (root.has("rawlog")) c.rawlog = root.filePath("rawlog");
+  // the files of rawlog and model are checked unless a flag replaces them
+  auto flagged = [&](const char* k) {
+    return std::find(given_by_flags.begin(), given_by_flags.end(), k) != given_by_flags.end();
+  };
+  if (root.has("rawlog"))
+    c.rawlog = flagged("rawlog") ? root.text("rawlog") : root.inputFile("rawlog", "the rawlog to replay");
   if (root.has("imu_label")) c.imu_label = root.text("imu_label", "the sensor label of the IMU entries", true);
   if (root.has("gnss_label")) c.gnss_label = root.text("gnss_label", "the sensor label of the GNSS entries", true);
-  if (root.has("model")) c.model_spec = root.modelRef("model");
+  if (root.has("model")) c.model_spec = flagged("model") ? root.text("model") : root.modelRef("model");
   for (const ConfigNode& o : root.list("outages", 0, SIZE_MAX, "a list of {start_s, duration_s}")) {
     o.allowKeys({"start_s", "duration_s"});
     const double st = o.number("start_s", kOutageStartS, "seconds from time zero");

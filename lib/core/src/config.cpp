@@ -108,8 +108,8 @@ ConfigNode::ConfigNode(std::shared_ptr<const Doc> doc, std::shared_ptr<const Nod
     : doc_(std::move(doc)), node_(std::move(node)), path_(std::move(path)) {}
 
 ConfigNode ConfigNode::load(const std::string& file) {
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) throw Error(file + ": cannot open (no such file)");
+  const std::string why = unreadableReason(file);
+  if (!why.empty()) throw Error(printable(file, 160) + ": cannot open (" + why + ")");
   return parse(readFileMaybeGz(file), file);
 }
 
@@ -365,21 +365,29 @@ std::string ConfigNode::resolve(const std::string& p) const {
   return (doc_->dir / p).lexically_normal().string();
 }
 
-std::string ConfigNode::filePath(const std::string& k) const {
-  std::string p;
-  read(k, p);
-  return resolve(p);
+/// @p path (named by key @p k) if it can be read, else the one error naming the key.
+std::string ConfigNode::checkedInput(const std::string& k, const std::string& path) const {
+  const std::string why = unreadableReason(path);
+  if (!why.empty()) throw error(k, "cannot open '" + printable(path, 160) + "' (" + why + ")");
+  return path;
+}
+
+std::string ConfigNode::inputFile(const std::string& k, const std::string& what_for) const {
+  const std::string p = text(k, what_for);
+  if (p.empty()) throw error(k, "must be a non-empty path (" + what_for + ")");
+  return checkedInput(k, resolve(p));
 }
 
 std::string ConfigNode::modelRef(const std::string& k) const {
   std::string spec;
   read(k, spec);
   if (spec.empty()) return spec;
+  if (unreadableReason(resolve(spec)).empty()) return resolve(spec);  // the whole text names a file
   const auto colon = spec.rfind(':');
-  if (colon == std::string::npos || colon == 0) return resolve(spec);
+  if (colon == std::string::npos || colon == 0) return checkedInput(k, resolve(spec));
   const std::string name = spec.substr(colon + 1);
-  if (name.find('/') != std::string::npos) return resolve(spec);
-  return resolve(spec.substr(0, colon)) + ":" + name;
+  if (name.find('/') != std::string::npos) return checkedInput(k, resolve(spec));
+  return checkedInput(k, resolve(spec.substr(0, colon))) + ":" + name;
 }
 
 double ConfigNode::asNumber(const limits::Range& r) const {

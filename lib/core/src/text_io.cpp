@@ -1,8 +1,11 @@
 #include "navimpact/core/text_io.hpp"
 
+#include <sys/stat.h>
 #include <zlib.h>
 
+#include <cerrno>
 #include <charconv>
+#include <cstring>
 #include <cstdio>
 #include <memory>
 
@@ -26,6 +29,18 @@ std::string readFileMaybeGz(const std::string& path, std::size_t max_bytes) {
     if (chunk < (std::size_t(1) << 24)) chunk *= 2;
   }
   return out;
+}
+
+std::string unreadableReason(const std::string& path) {
+  if (path.empty()) return std::strerror(ENOENT);
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return std::strerror(errno);
+  if (S_ISDIR(st.st_mode)) return std::strerror(EISDIR);
+  if (!S_ISREG(st.st_mode)) return "not a regular file";
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return std::strerror(errno);
+  std::fclose(f);
+  return "";
 }
 
 std::vector<std::string_view> splitView(std::string_view s, char delim) {

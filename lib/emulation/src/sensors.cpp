@@ -255,7 +255,7 @@ void StaticRecordingSpec::loadFrom(const ConfigNode& n, bool with_window) {
   std::vector<std::string> keys{"file", "gyro_unit", "acc_unit", "rate_hz", "axes"};
   if (with_window) keys.insert(keys.end(), {"offset_s", "seed"});
   n.allowKeys(keys);
-  file = n.resolve(n.text("file", "the static recording CSV", true));
+  file = n.inputFile("file", "the static recording CSV");
   n.readChoice("gyro_unit", csv.gyro_unit, units::acceptedUnits(units::Quantity::AngularRate));
   n.readChoice("acc_unit", csv.acc_unit, units::acceptedUnits(units::Quantity::SpecificForce));
   double rate = 0.0;

@@ -223,7 +223,7 @@ namespace navimpact::emulation {
 void TrajectorySpec::loadFrom(const ConfigNode& n) {
   n.allowKeys({"file", "system", "columns", "latlon_unit", "attitude_unit", "time_unit", "origin", "max_gap_s",
                "start_s", "end_s"});
-  file = n.resolve(n.text("file", "the trajectory CSV", true));
+  file = n.inputFile("file", "the trajectory CSV");
   n.readChoice("system", system, {"geodetic", "ned"});
   if (const auto cols = n.optMap("columns")) {
     cols->allowKeys({"time", "lat", "lon", "height", "north", "east", "down", "roll", "pitch", "yaw"});

@@ -97,7 +97,7 @@ struct StreamSpec {
 StreamSpec streamSpec(const Keys& k, const ConfigNode& n, const std::string& name) {
   StreamSpec s;
   s.name = name;
-  s.file = n.resolve(k.text(n["file"], name + ".file"));
+  s.file = n.inputFile("file", "the " + name + " CSV");
   if (n["delimiter"]) {
     const std::size_t i = k.oneOf(n["delimiter"], name + ".delimiter", {",", ";", "tab"});
     s.delimiter = i == 0 ? ',' : i == 1 ? ';' : '\t';

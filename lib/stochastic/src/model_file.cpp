@@ -14,6 +14,7 @@
 #include "navimpact/core/imu_series.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/core/limits.hpp"
+#include "navimpact/core/text_io.hpp"
 
 namespace navimpact::stochastic {
 
@@ -71,8 +72,8 @@ ImuModel readModel(const ConfigNode& node, double default_rate) {
 }
 
 ConfigNode loadYaml(const std::string& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw Error(printable(file, 1024) + ": cannot open model file (no such file)");
+  const std::string why = unreadableReason(file);
+  if (!why.empty()) throw Error(printable(file, 1024) + ": cannot open model file (" + why + ")");
   return ConfigNode::load(file);
 }
 

@@ -132,12 +132,14 @@ struct ReplayConfig {
   std::optional<stochastic::ImuModel> model;
 
   /// Read the keys of a replay configuration (see the file comment), with the
-  /// ranges of core/limits.hpp; paths relative to the configuration's folder.
-  void loadFrom(const ConfigNode& root);
+  /// ranges of core/limits.hpp; paths relative to the configuration's folder,
+  /// their files checked (ConfigNode::inputFile). Keys in @p given_by_flags
+  /// ("rawlog", "model") are replaced by a command-line flag: read as text, their files not checked.
+  void loadFrom(const ConfigNode& root, const std::vector<std::string>& given_by_flags = {});
 };
 
 /// Read a replay configuration. @throws navimpact::Error naming file and key.
-ReplayConfig loadReplayConfig(const std::string& path);
+ReplayConfig loadReplayConfig(const std::string& path, const std::vector<std::string>& given_by_flags = {});
 
 /// Everything a replay computed.
 struct ReplayResult {

@@ -48,7 +48,7 @@ namespace navimpact {
 class ConfigNode {
  public:
   /// Read and parse a YAML file (plain or gzip, at most 64 MiB).
-  /// @throws navimpact::Error "FILE: cannot open ...", "FILE:LINE:COLUMN: YAML syntax error: ...",
+  /// @throws navimpact::Error "FILE: cannot open (REASON)", "FILE:LINE:COLUMN: YAML syntax error: ...",
   ///         a duplicate or non-name key anywhere, or a top level that is not a map.
   static ConfigNode load(const std::string& file);
   /// Parse YAML @p text that came from @p file (named in messages; paths are relative to its folder).
@@ -132,11 +132,17 @@ class ConfigNode {
   /// A list of @p min..@p max texts.
   bool read(const std::string& k, std::vector<std::string>& out, std::size_t min = 0,
             std::size_t max = SIZE_MAX) const;
-  /// A file path resolved against the file's folder when relative ("" when absent).
-  std::string filePath(const std::string& k) const;
+  /// The input file named by key @p k (@p what_for says what it holds, for
+  /// "missing (WHAT_FOR)"), resolved against this file's folder when relative
+  /// and checked when the configuration is read, so that a file that cannot be
+  /// read is named with the configuration and the key:
+  /// "FILE: key 'K': cannot open 'PATH' (No such file or directory)" (or
+  /// "Permission denied", "Is a directory", "not a regular file").
+  std::string inputFile(const std::string& k, const std::string& what_for) const;
   /// A model reference FILE[:NAME], FILE resolved against the file's folder
-  /// when relative ("" when absent). A colon at position 0 or followed by a
-  /// name containing '/' belongs to the path.
+  /// when relative and checked like inputFile() ("" when absent). A colon at
+  /// position 0 or followed by a name containing '/' belongs to the path, and
+  /// so does every colon when the whole text names a file.
   std::string modelRef(const std::string& k) const;
   /// @p p resolved against the file's folder when relative.
   std::string resolve(const std::string& p) const;
@@ -152,6 +158,7 @@ class ConfigNode {
  private:
   ConfigNode(std::shared_ptr<const Doc> doc, std::shared_ptr<const Node> node, std::string path);
   ConfigNode at(const std::string& k) const;
+  std::string checkedInput(const std::string& k, const std::string& path) const;
   std::shared_ptr<const Doc> doc_;
   std::shared_ptr<const Node> node_;
   std::string path_;
@@ -160,12 +167,12 @@ class ConfigNode {
 /// The configuration file @p path read by @p Config::loadFrom(ConfigNode),
 /// with the path kept in its member @p file; an exception other than
 /// navimpact::Error leaving the read names the file (InputScope).
-template <class Config>
-Config loadConfigFile(const std::string& path, std::string Config::*file) {
+template <class Config, class... Args>
+Config loadConfigFile(const std::string& path, std::string Config::*file, const Args&... args) {
   InputScope scope(path);
   Config c;
   c.*file = path;
-  c.loadFrom(ConfigNode::load(path));
+  c.loadFrom(ConfigNode::load(path), args...);
   return c;
 }
 

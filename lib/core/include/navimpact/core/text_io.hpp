@@ -19,6 +19,14 @@ namespace navimpact {
  */
 std::string readFileMaybeGz(const std::string& path, std::size_t max_bytes = std::size_t(64) << 20);
 
+/**
+ * Why @p path cannot be read as an input file, or "" when it can: the
+ * system's reason ("No such file or directory", "Permission denied", "Is a
+ * directory", ...), or "not a regular file" for a FIFO, socket or device
+ * (reading one could block or never end).
+ */
+std::string unreadableReason(const std::string& path);
+
 /// Split on a delimiter, no trimming; empty fields are kept.
 std::vector<std::string_view> splitView(std::string_view s, char delim);
 
