@@ -433,7 +433,7 @@ TEST(Replay, ExtraStatesFromTheConfigurationAreEstimated) {
     an::loadReplayConfig(path);
     ADD_FAILURE() << "a lever-arm sigma of 20 m was accepted";
   } catch (const navimpact::Error& err) {
-    EXPECT_NE(std::string(err.what()).find("key 'filter.extra_states.lever_arm.sigma_m': must be in (0, 10] m"),
+    EXPECT_NE(std::string(err.what()).find("key 'filter.extra_states.lever_arm.sigma_m': must be in [0.0001, 10] m"),
               std::string::npos)
         << err.what();
   }

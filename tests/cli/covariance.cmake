@@ -45,7 +45,7 @@ _cov_bad(wrong_type "model_file: ${_models}\nduration_s: sixty\nstatic_state: {l
 _cov_bad(duplicate_set_name "model_file: ${_models}\n${_base}model_sets: [{name: a, models: [acc_ref]}, {name: a, models: [gyro_ref]}]\n"
          "model_sets\\[1\\]\\.name.*'a' is used by an earlier model set")
 _cov_bad(negative_baro_sigma "model_file: ${_models}\n${_base}baro: {rate_hz: 10, sigma_m: -1}\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
-         "baro\\.sigma_m.*must be in .0, 10000. m, got -1")
+         "baro\\.sigma_m.*must be in .0.0001, 10000. m, got -1")
 # one value cannot make a run spin or exhaust memory: ranges at load, work budget before the run
 _cov_bad(huge_rate "model_file: ${_models}\n${_base}imu_rate_hz: 1e12\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
          "key 'imu_rate_hz': must be in \\[1, 10000\\] Hz, got 1e\\+12")

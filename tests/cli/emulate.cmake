@@ -56,11 +56,14 @@ add_test(NAME cli_emulate_bad_gzip_level
 set_tests_properties(cli_emulate_bad_gzip_level PROPERTIES WILL_FAIL TRUE)
 
 # Values beyond their documented physical range are refused at load, naming the key.
-foreach(_case "baro_sigma|imu: {errors: none}\nbaro: {sigma_m: 1e308}|key 'baro.sigma_m': must be in .0, 10000. m, got 1e.308"
+foreach(_case "baro_sigma|imu: {errors: none}\nbaro: {sigma_m: 1e308}|key 'baro.sigma_m': must be in .0.0001, 10000. m, got 1e.308"
+              "baro_sigma_tiny|imu: {errors: none}\nbaro: {sigma_m: 1e-300}|key 'baro.sigma_m': must be in .0.0001, 10000. m, got 1e-300"
               "lever_arm|imu: {errors: none}\ngnss: {lever_arm_B_m: [0, 1e308, 0]}|key 'gnss.lever_arm_B_m.1.': must be in .-100, 100. m"
               "imu_rate|imu: {rate_hz: 1e7, errors: none}|key 'imu.rate_hz': must be in .1, 10000. Hz, got 1e.07"
-              "knot_step_tiny|imu: {errors: none}\nsmoothing: {knot_step_s: 1e-308}|key 'smoothing.knot_step_s': cutoff 1 Hz times knot step 1e-308 s is 1e-308, below 0.0002"
-              "cutoff_tiny|imu: {errors: none}\nsmoothing: {position_cutoff_hz: 1e-308}|key 'smoothing.position_cutoff_hz': cutoff 1e-308 Hz"
+              "knot_step_range|imu: {errors: none}\nsmoothing: {knot_step_s: 1e-308}|key 'smoothing.knot_step_s': must be in .0.0001, 604800. s, got 1e-308"
+              "cutoff_range|imu: {errors: none}\nsmoothing: {position_cutoff_hz: 1e-308}|key 'smoothing.position_cutoff_hz': must be in .0.001, 10000. Hz, got 1e-308"
+              "knot_step_tiny|imu: {errors: none}\nsmoothing: {knot_step_s: 0.0001}|key 'smoothing.knot_step_s': cutoff 1 Hz times knot step 0.0001 s is 0.0001, below 0.0002"
+              "cutoff_tiny|imu: {errors: none}\nsmoothing: {position_cutoff_hz: 0.001}|key 'smoothing.position_cutoff_hz': cutoff 0.001 Hz"
               "knots_finer_than_samples|imu: {errors: none}\nsmoothing: {knot_step_s: 0.0001, position_cutoff_hz: 2, attitude_cutoff_hz: 2}|uav_flight_260s.csv.gz: smoothing spline: knot step 0.0001 s gives 300000 knot intervals for 3001 samples .at most 64 per sample")
   navimpact_cli_case("${_case}" _n _body _re)
   file(WRITE ${_edir}/range_${_n}.yaml
@@ -100,6 +103,13 @@ navimpact_cli_check(cli_emulate_effects_diagnose_run CHECK run_json
        "findings/0/params/scale=^0[.]0(09|1)" "gain/cause=^scale_factor$" "gain/significant=^(true|ON)$"
   FILES report.md model_extended.yaml filter_extended.yaml)
 set_tests_properties(cli_emulate_effects_diagnose_run PROPERTIES FIXTURES_REQUIRED emu_effects)
+# the extension it writes is a replay configuration that loads (its prior sigmas
+# are written within the ranges the replay reads them with) and runs
+add_test(NAME cli_emulate_effects_extension_replays
+  COMMAND ${NI} replay --config ${_edir}/gyro_scale_diagnosis/filter_extended.yaml --rawlog ${_edir}/gyro_scale.rawlog
+          --outage 100:10 --out ${_edir}/gyro_scale_extension --overwrite)
+set_tests_properties(cli_emulate_effects_extension_replays PROPERTIES FIXTURES_REQUIRED emu_effects
+  DEPENDS cli_emulate_effects_diagnose_run PASS_REGULAR_EXPRESSION "outage 1 \\(10 s from 100 s\\): horizontal error at end")
 # an effect out of its documented range is refused, naming the key
 navimpact_cli_fail(cli_emulate_effects_bad_range
   ARGS emulate --config ${_edir}/gyro_scale_bad.yaml --out ${_edir}/gyro_scale_bad.rawlog

@@ -40,3 +40,18 @@ file(WRITE ${_rdir}/gate_tiny.yaml "rawlog: ${_rlog}\nfilter: {gate_probability:
 navimpact_cli_fail(cli_replay_gate_below_median
   ARGS replay --config ${_rdir}/gate_tiny.yaml --out ${_rdir}/gate_tiny
   REGEX "gate_tiny.yaml: key 'filter.gate_probability': must be 0 \\(gate off\\) or in .0.5, 1." NOOUT ${_rdir}/gate_tiny)
+
+# A positive value below its realistic lower bound is refused at load, naming
+# the key (a sigma of 1e-300 squared to 0 and failed at t = 0 naming no file or
+# key; an outage of 1e-300 s was reported as 'outage 100:0').
+foreach(_case "noise_tiny|noise: {sigma_pos_h_m: 1e-300}|key 'noise.sigma_pos_h_m': must be in .0.0001, 10000. m, got 1e-300"
+              "outage_tiny|outages: [{start_s: 100, duration_s: 1e-300}]|key 'outages.0..duration_s': must be in .0.0001, 604800. s, got 1e-300"
+              "prior_tiny|filter: {extra_states: {time_offset: {sigma_s: 1e-9}}}|key 'filter.extra_states.time_offset.sigma_s': must be in .1e-07, 0.1. s, got 1e-09")
+  string(REPLACE "|" ";" _p "${_case}")
+  list(GET _p 0 _n)
+  list(GET _p 1 _body)
+  list(GET _p 2 _re)
+  file(WRITE ${_rdir}/${_n}.yaml "rawlog: ${_rlog}\n${_body}\n")
+  navimpact_cli_fail(cli_replay_range_${_n} ARGS replay --config ${_rdir}/${_n}.yaml --out ${_rdir}/${_n}
+    REGEX "${_n}.yaml: ${_re}$" NOOUT ${_rdir}/${_n})
+endforeach()

@@ -127,9 +127,9 @@ TEST(Config, WrongTypeSaysWhatWasExpectedAndWhatCame) {
   EXPECT_EQ(errorOf([&] { c.read("flag", b); }), "cfg.yaml: key 'flag': must be true or false, got 'perhaps'");
   double x = 0;
   EXPECT_EQ(errorOf([&] { c.read("n", x, limits::kDurationS); }),
-            "cfg.yaml: key 'n': must be a number in (0, 604800] s, got a list");
+            "cfg.yaml: key 'n': must be a number in [0.0001, 604800] s, got a list");
   EXPECT_EQ(errorOf([&] { c.read("sigma_m", x, limits::kPositionSigmaM); }),
-            "cfg.yaml: key 'sigma_m': must be a number in (0, 10000] m, got 'two'");
+            "cfg.yaml: key 'sigma_m': must be a number in [0.0001, 10000] m, got 'two'");
   std::uint64_t s = 0;
   EXPECT_EQ(errorOf([&] { c.readSeed("seed", s); }),
             "cfg.yaml: key 'seed': must be an integer seed in 0..18446744073709551615, got '-5'");
@@ -161,11 +161,16 @@ TEST(Config, RangeAndUnitOfEveryNumber) {
   EXPECT_NO_THROW(c.read("high_hz", x, limits::kImuRateHz));
   EXPECT_EQ(x, 1e4);
   EXPECT_EQ(errorOf([&] { c.read("sigma_m", x, limits::kPositionSigmaM); }),
-            "cfg.yaml: key 'sigma_m': must be in (0, 10000] m, got 0");
-  EXPECT_NO_THROW(c.read("tiny_m", x, limits::kPositionSigmaM));
-  EXPECT_NE(errorOf([&] { c.read("nan_m", x, limits::kPositionSigmaM); }).find("key 'nan_m': must be in (0, 10000] m"),
+            "cfg.yaml: key 'sigma_m': must be in [0.0001, 10000] m, got 0");
+  // a positive value has a realistic lower bound, not 0 (1e-300 squared is 0)
+  EXPECT_EQ(errorOf([&] { c.read("tiny_m", x, limits::kPositionSigmaM); }),
+            "cfg.yaml: key 'tiny_m': must be in [0.0001, 10000] m, got 1e-300");
+  EXPECT_EQ(errorOf([&] { c.read("tiny_m", x, limits::Range{0.0, 1.0, true, "m"}); }), "(no error)");  // an open end excludes only 0
+  EXPECT_EQ(errorOf([&] { c.read("sigma_m", x, limits::Range{0.0, 1.0, true, "m"}); }),
+            "cfg.yaml: key 'sigma_m': must be in (0, 1] m, got 0");
+  EXPECT_NE(errorOf([&] { c.read("nan_m", x, limits::kPositionSigmaM); }).find("key 'nan_m': must be in [0.0001, 10000] m"),
             std::string::npos);
-  EXPECT_NE(errorOf([&] { c.read("inf_m", x, limits::kPositionSigmaM); }).find("key 'inf_m': must be in (0, 10000] m"),
+  EXPECT_NE(errorOf([&] { c.read("inf_m", x, limits::kPositionSigmaM); }).find("key 'inf_m': must be in [0.0001, 10000] m"),
             std::string::npos);
   Eigen::Vector3d v;
   EXPECT_EQ(errorOf([&] { c.read("lever", v, limits::kLeverArmM); }),
@@ -174,7 +179,7 @@ TEST(Config, RangeAndUnitOfEveryNumber) {
   EXPECT_EQ(errorOf([&] { c.read("runs", runs, 1, limits::kMaxMonteCarloRuns); }),
             "cfg.yaml: key 'runs': must be an integer in 1..1000000, got 1000001");
   EXPECT_EQ(errorOf([&] { c.number("absent_s", limits::kDurationS, "the outage"); }),
-            "cfg.yaml: key 'absent_s': missing (a number in (0, 604800] s: the outage)");
+            "cfg.yaml: key 'absent_s': missing (a number in [0.0001, 604800] s: the outage)");
 }
 
 TEST(Config, FilesAreNamedInEveryMessageAndPathsAreRelativeToTheirFolder) {

@@ -123,9 +123,9 @@ TEST(ExtraStates, ConfigKeysSwitchThemOn) {
     return std::string();
   };
   EXPECT_EQ(err("extra_states: {time_offset: {sigma_s: 0.5}}"),
-            "f.yaml: key 'extra_states.time_offset.sigma_s': must be in (0, 0.1] s, got 0.5");
+            "f.yaml: key 'extra_states.time_offset.sigma_s': must be in [1e-07, 0.1] s, got 0.5");
   EXPECT_NE(err("extra_states: {scale: {gyro_sigma: 0.01}}").find("unknown key"), std::string::npos);
-  EXPECT_NE(err("extra_states: {lever_arm: {sigma_m: 0}}").find("(0, 10] m"), std::string::npos);
+  EXPECT_NE(err("extra_states: {lever_arm: {sigma_m: 0}}").find("[0.0001, 10] m"), std::string::npos);
 }
 
 // Initial estimates (prior means): read from the configuration within the

@@ -40,15 +40,10 @@ constexpr double kDeg = M_PI / 180.0;
 
 /// Angles given in degrees (attitude, heading) [deg].
 constexpr limits::Range kAngleDeg{-360.0, 360.0, false, "deg"};
-/// Angle sigmas [deg].
-constexpr limits::Range kAngleSigmaDeg{0.0, 180.0, true, "deg"};
 /// Start of an outage from time zero [s].
 constexpr limits::Range kOutageStartS{0.0, limits::kDurationS.hi, false, "s"};
 /// The reference's own sigmas (0: exact) [m].
 constexpr limits::Range kReferenceSigmaM{0.0, limits::kPositionSigmaM.hi, false, "m"};
-/// Sigmas of the at-rest detector: gyroscope [rad/s], accelerometer [m/s^2].
-constexpr limits::Range kGyroSigmaRadS{0.0, 1000.0, true, "rad/s"};
-constexpr limits::Range kAccSigmaMps2{0.0, 1.0e5, true, "m/s^2"};
 /// A speed (0 allowed) [m/s].
 constexpr limits::Range kSpeedMps{0.0, 1.0e3, false, "m/s"};
 
@@ -107,8 +102,8 @@ void ReplayConfig::loadFrom(const ConfigNode& root, const std::vector<std::strin
     p->read("pos_h_m", c.p0_pos_h_m, limits::kPositionSigmaM);
     p->read("pos_v_m", c.p0_pos_v_m, limits::kPositionSigmaM);
     p->read("vel_mps", c.p0_vel_mps, limits::kVelocitySigmaMps);
-    p->read("roll_pitch_deg", c.p0_roll_pitch_deg, kAngleSigmaDeg);
-    p->read("yaw_deg", c.p0_yaw_deg, kAngleSigmaDeg);
+    p->read("roll_pitch_deg", c.p0_roll_pitch_deg, limits::kAttitudeSigmaDeg);
+    p->read("yaw_deg", c.p0_yaw_deg, limits::kAttitudeSigmaDeg);
   }
   if (const auto n = root.optMap("noise")) {
     n->allowKeys({"sigma_pos_h_m", "sigma_pos_v_m", "sigma_vel_h_mps", "sigma_vel_v_mps", "sigma_baro_m"});
@@ -144,23 +139,23 @@ void ReplayConfig::loadFrom(const ConfigNode& root, const std::vector<std::strin
       c.alignment.yaw_rad = x * kDeg;
       c.alignment.yaw_source = "configuration";
     }
-    if (a->read("yaw_sigma_deg", x, kAngleSigmaDeg)) c.alignment.yaw_sigma_rad = x * kDeg;
+    if (a->read("yaw_sigma_deg", x, limits::kAttitudeSigmaDeg)) c.alignment.yaw_sigma_rad = x * kDeg;
     a->read("max_align_s", c.alignment.max_align_s, limits::kDurationS);
-    if (a->read("max_course_sigma_deg", x, kAngleSigmaDeg)) c.alignment.max_course_sigma_rad = x * kDeg;
-    if (a->read("sideslip_sigma_deg", x, kAngleSigmaDeg)) c.alignment.sideslip_sigma_rad = x * kDeg;
+    if (a->read("max_course_sigma_deg", x, limits::kAttitudeSigmaDeg)) c.alignment.max_course_sigma_rad = x * kDeg;
+    if (a->read("sideslip_sigma_deg", x, limits::kAttitudeSigmaDeg)) c.alignment.sideslip_sigma_rad = x * kDeg;
     a->read("min_static_s", c.alignment.min_static_s, limits::kDurationS);
     a->read("max_level_s", c.alignment.max_level_s, limits::kDurationS);
   }
   if (const auto r = root.optMap("imu_at_rest")) {
     r->allowKeys({"gyro_sigma_rad_s", "acc_sigma_mps2", "window_s", "false_alarm", "max_mean_rate_rad_s"});
     auto& d = c.alignment.detector;
-    if (r->has("gyro_sigma_rad_s")) d.gyro_sigma_rad_s = sigma3(*r, "gyro_sigma_rad_s", kGyroSigmaRadS);
-    if (r->has("acc_sigma_mps2")) d.acc_sigma_mps2 = sigma3(*r, "acc_sigma_mps2", kAccSigmaMps2);
+    if (r->has("gyro_sigma_rad_s")) d.gyro_sigma_rad_s = sigma3(*r, "gyro_sigma_rad_s", limits::kAtRestGyroSigmaRadS);
+    if (r->has("acc_sigma_mps2")) d.acc_sigma_mps2 = sigma3(*r, "acc_sigma_mps2", limits::kAtRestAccSigmaMps2);
     r->read("window_s", d.window_s, limits::kDurationS);
     if (r->read("false_alarm", d.false_alarm, limits::Range{0.0, 0.5, true, "(probability)"}) &&
         !(d.false_alarm < 0.5))
       throw r->error("false_alarm", "must be in (0, 0.5)");
-    r->read("max_mean_rate_rad_s", d.max_mean_rate_rad_s, kGyroSigmaRadS);
+    r->read("max_mean_rate_rad_s", d.max_mean_rate_rad_s, limits::kAtRestGyroSigmaRadS);
   }
   c.aids.zupt_detector = c.alignment.detector;
   if (const auto a = root.optMap("aids")) {

@@ -341,10 +341,10 @@ filter::ExtraStates withFitPrior(ExtraCause kind, filter::ExtraStates x) {
 }
 
 /// Prior sigma of a group fitted from a replay's sigmas: max_i s_i, within (0, hi].
-double fittedSigma(const Eigen::Vector3d& s, int n, double hi) {
+double fittedSigma(const Eigen::Vector3d& s, int n, const limits::Range& r) {
   double v = 0.0;
   for (int i = 0; i < n; ++i) v = std::max(v, s(i));
-  return std::min(hi, std::max(1e-9 * hi, v));
+  return std::min(r.hi, std::max(r.lo, v));  // within the range filter_extended.yaml is read back with
 }
 
 /// An estimate clamped into the effect's range (the extension's initial value).
@@ -360,17 +360,17 @@ filter::ExtraStates withFitted(ExtraCause kind, filter::ExtraStates x, const fil
     case ExtraCause::Misalignment: {
       const TriadGroups& t = triadGroups(kind);
       for (int i = 0; i < 2; ++i) {
-        x.*t.sigma[i] = fittedSigma(s.*t.estimate[i], 3, t.sigma_range.hi);
+        x.*t.sigma[i] = fittedSigma(s.*t.estimate[i], 3, t.sigma_range);
         x.*t.initial[i] = clampTo(e.*t.estimate[i], t.range);
       }
       break;
     }
     case ExtraCause::TimeOffset:
-      x.time_offset_sigma_s = fittedSigma(Eigen::Vector3d(s.time_offset_s, 0, 0), 1, limits::kTimeOffsetSigmaS.hi);
+      x.time_offset_sigma_s = fittedSigma(Eigen::Vector3d(s.time_offset_s, 0, 0), 1, limits::kTimeOffsetSigmaS);
       x.time_offset0_s = std::min(limits::kTimeOffsetS.hi, std::max(limits::kTimeOffsetS.lo, e.time_offset_s));
       break;
     case ExtraCause::LeverArm:
-      x.lever_arm_sigma_m = fittedSigma(s.lever_arm_error_B_m, 3, limits::kLeverArmErrorSigmaM.hi);
+      x.lever_arm_sigma_m = fittedSigma(s.lever_arm_error_B_m, 3, limits::kLeverArmErrorSigmaM);
       x.lever_arm_error0_m = clampTo(e.lever_arm_error_B_m, limits::kLeverArmErrorM);
       break;
   }

@@ -23,8 +23,6 @@ StudyConfig::StudyConfig() {
 
 namespace {
 
-/// An angle sigma of the initial attitude [deg].
-constexpr limits::Range kAttitudeSigmaDeg{0.0, 180.0, true, "deg"};
 /// Threads of one process.
 constexpr long long kMaxThreads = 1024;
 /// Start of an outage, seconds from the trajectory start.
@@ -165,8 +163,8 @@ void StudyConfig::loadFrom(const ConfigNode& root, const std::vector<std::string
       s->read("pos_h_m", ph, limits::kPositionSigmaM);
       s->read("pos_v_m", pv, limits::kPositionSigmaM);
       s->read("vel_mps", v, limits::kVelocitySigmaMps);
-      s->read("roll_pitch_deg", rp, kAttitudeSigmaDeg);
-      s->read("yaw_deg", y, kAttitudeSigmaDeg);
+      s->read("roll_pitch_deg", rp, limits::kAttitudeSigmaDeg);
+      s->read("yaw_deg", y, limits::kAttitudeSigmaDeg);
       initial_sigma << ph, ph, pv, v, v, v, rp * units::kDeg, rp * units::kDeg, y * units::kDeg;
     }
   }

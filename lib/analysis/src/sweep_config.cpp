@@ -13,10 +13,11 @@ namespace navimpact::analysis {
 namespace {
 
 constexpr limits::Range kOutageStartS{0.0, 1.0e6, false, "s"};
-constexpr limits::Range kSweepDurationS{0.0, 1.0e5, true, "s"};
+// the lower bounds of limits.hpp, narrower upper bounds for the axes of a map
+constexpr limits::Range kSweepDurationS{limits::kDurationS.lo, 1.0e5, false, "s"};
 constexpr limits::Range kSweepGnssRateHz{0.01, 100.0, false, "Hz"};
-constexpr limits::Range kSweepPosSigmaM{0.0, 1000.0, true, "m"};
-constexpr limits::Range kSweepVelSigmaMps{0.0, 100.0, true, "m/s"};
+constexpr limits::Range kSweepPosSigmaM{limits::kPositionSigmaM.lo, 1000.0, false, "m"};
+constexpr limits::Range kSweepVelSigmaMps{limits::kVelocitySigmaMps.lo, 100.0, false, "m/s"};
 constexpr limits::Range kAlpha{0.0, 0.5, true, "(probability)"};
 
 }  // namespace

@@ -44,8 +44,9 @@ struct Keys {
   double number(const ConfigNode& n, const std::string& /*key*/, double lo, double hi, const char* unit) const {
     return n.asNumber(limits::Range{lo, hi, false, unit});
   }
-  double positive(const ConfigNode& n, const std::string& /*key*/, double hi, const char* unit) const {
-    return n.asNumber(limits::Range{0.0, hi, true, unit});
+  /// A positive value: from the lower bound of @p r (limits.hpp: no real sensor has less) to @p hi.
+  double positive(const ConfigNode& n, const limits::Range& r, double hi) const {
+    return n.asNumber(limits::Range{r.lo, hi, false, r.unit});
   }
   std::string text(const ConfigNode& n, const std::string& /*key*/) const {
     const std::string s = n.asText();
@@ -107,7 +108,7 @@ StreamSpec streamSpec(const Keys& k, const ConfigNode& n, const std::string& nam
   if (t && t.isMap() && t["rate_hz"]) {
     if (name != "imu") throw k.err(tk + ".rate_hz", "only the IMU stream may be given by a rate (others need a time column)");
     k.map(t, tk, {"rate_hz", "start_s"}, {"rate_hz"});
-    s.rate_hz = k.positive(t["rate_hz"], tk + ".rate_hz", 1e5, "Hz");
+    s.rate_hz = t["rate_hz"].asNumber(limits::kImuRateHz);
     if (t["start_s"]) s.start_s = t["start_s"].asNumber(limits::kFileTimeS);
   } else {
     k.map(t, tk, {"column", "unit"}, {"column", "unit"});
@@ -116,7 +117,7 @@ StreamSpec streamSpec(const Keys& k, const ConfigNode& n, const std::string& nam
     static const double f[] = {1.0, 1e-3, 1e-6, 1e-9};
     s.time_factor = f[k.oneOf(t["unit"], tk + ".unit", {"s", "ms", "us", "ns"})];
   }
-  if (n["max_gap_s"]) s.max_gap_s = k.positive(n["max_gap_s"], name + ".max_gap_s", 1e9, "s");
+  if (n["max_gap_s"]) s.max_gap_s = k.positive(n["max_gap_s"], limits::kDurationS, 1e9);
   return s;
 }
 
@@ -264,8 +265,9 @@ SigmaSpec sigmaSpec(const Keys& k, const ConfigNode& n, const std::string& key, 
     return s;
   }
   k.map(n, key, {hKey, vKey, "columns"}, {hKey, vKey});
-  s.h = k.positive(n[hKey], key + "." + hKey, 1e6, unitName);
-  s.v = k.positive(n[vKey], key + "." + vKey, 1e6, unitName);
+  const limits::Range& range = std::string(unitName) == "m" ? limits::kPositionSigmaM : limits::kVelocitySigmaMps;
+  s.h = k.positive(n[hKey], range, 1e6);
+  s.v = k.positive(n[vKey], range, 1e6);
   return s;
 }
 
@@ -500,7 +502,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     else if (gnssUndulation) und = *gnssUndulation;
     else throw k.err("baro.height_datum", "missing (required without a gnss stream, whose datum it otherwise takes)");
     std::optional<double> sigma;
-    if (n["sigma_m"]) sigma = k.positive(n["sigma_m"], "baro.sigma_m", 1e4, "m");
+    if (n["sigma_m"]) sigma = n["sigma_m"].asNumber(limits::kPositionSigmaM);
     const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
     const std::vector<double> t = streamTimes(s, tab, tc);
     d.baro.resize(tab.rows());

@@ -5,14 +5,20 @@
  *        loaded (with the file and key named), not left to luck at run time.
  *
  * The ranges are wide (beyond any real sensor or mission) but finite, so that
- * no single value can make a run spin, overflow or exhaust memory:
+ * no single value can make a run spin, overflow or exhaust memory. Values that
+ * must be positive have a lower bound below any real sensor or mission too,
+ * not 0: a sigma of 1e-300 squares to 0 and ends in "sigma must be > 0" at run
+ * time with no file or key, a duration of 1e-300 s is an outage of nothing.
+ * (The parameters of a stochastic model stay open at 0: a fitted white-noise
+ * sigma may legitimately be tiny, and a model file GMWM writes must load.)
  *  - IMU rate 1 Hz - 10 kHz; aiding and output rates (GNSS, barometer, ground
  *    truth, records) 0.001 Hz - 10 kHz;
- *  - position and altitude sigmas (0, 10 km]; velocity sigmas (0, 1 km/s];
+ *  - position and altitude sigmas [0.1 mm, 10 km]; velocity sigmas
+ *    [0.1 mm/s, 1 km/s]; attitude sigmas [1e-4, 180] deg;
  *  - lever-arm components [-100, 100] m;
- *  - durations (0, 7 days]; times on a file's axis [-1e10, 1e10] s;
+ *  - durations [0.1 ms, 7 days]; times on a file's axis [-1e10, 1e10] s;
  *  - origins: latitude [-90, 90] deg, longitude [-360, 360] deg, height
- *    [-11 km, 100 km]; smoother cut-offs (0, 10 kHz];
+ *    [-11 km, 100 km]; smoother cut-offs [1 mHz, 10 kHz];
  *  - IMU error states per axis at most 32 (a model has a handful);
  *  - Monte Carlo runs of a study at most 10^6;
  *  - sensor effects of an emulation and the extra filter states that model
@@ -20,7 +26,10 @@
  *    +-50 000 ppm), misalignment and non-orthogonality angles [-0.05, 0.05] rad,
  *    IMU-GNSS time offset [-0.1, 0.1] s, lever-arm error components [-10, 10] m,
  *    in-motion white-noise factor [1, 100], motion thresholds
- *    [1e-3, 10] rad/s and [0.05, 100] m/s^2.
+ *    [1e-3, 10] rad/s and [0.05, 100] m/s^2; prior sigmas of the filter
+ *    states that estimate them: scale factors [1e-6, 0.05], angles
+ *    [1e-6, 0.05] rad, lever-arm error [0.1 mm, 10 m], time offset
+ *    [100 ns, 0.1 s].
  * README ("Ranges and budgets") lists them with the budgets.
  */
 #pragma once
@@ -39,18 +48,32 @@ struct Range {
 
 inline constexpr Range kImuRateHz{1.0, 1.0e4, false, "Hz"};
 inline constexpr Range kAidingRateHz{1.0e-3, 1.0e4, false, "Hz"};
-inline constexpr Range kPositionSigmaM{0.0, 1.0e4, true, "m"};
-inline constexpr Range kVelocitySigmaMps{0.0, 1.0e3, true, "m/s"};
+/// Position and altitude sigmas (GNSS, barometer, replay noise, initial
+/// sigmas) [m]: from 0.1 mm, a tenth of the best survey-grade fix (RTK, laser
+/// tracker ~1 mm); below it the variance is no sensor's and the Kalman gain is
+/// 1 to rounding (1e-300 squared is 0).
+inline constexpr Range kPositionSigmaM{1.0e-4, 1.0e4, false, "m"};
+/// Velocity sigmas (GNSS, replay noise, initial sigma, aids) [m/s]: from
+/// 0.1 mm/s, below the best carrier-phase Doppler velocity (~1 mm/s).
+inline constexpr Range kVelocitySigmaMps{1.0e-4, 1.0e3, false, "m/s"};
+/// Attitude sigmas (initial roll, pitch and yaw sigmas, alignment sigmas)
+/// [deg]: from 1e-4 deg (1.7 urad), below the alignment of a strategic-grade
+/// INS (~1e-3 deg).
+inline constexpr Range kAttitudeSigmaDeg{1.0e-4, 180.0, false, "deg"};
 inline constexpr Range kLeverArmM{-100.0, 100.0, false, "m"};
-inline constexpr Range kDurationS{0.0, 7.0 * 86400.0, true, "s"};
+/// Durations and intervals (outages, record intervals, windows, gaps, knot
+/// steps) [s]: from 0.1 ms, one sample interval at the highest IMU rate
+/// (10 kHz); nothing shorter can be sampled.
+inline constexpr Range kDurationS{1.0e-4, 7.0 * 86400.0, false, "s"};
 /// A time on a file's own axis (trajectory start_s/end_s: file time, e.g. Unix seconds) [s].
 inline constexpr Range kFileTimeS{-1.0e10, 1.0e10, false, "s"};
 /// Geodetic latitude, longitude and height of an origin [deg, deg, m].
 inline constexpr Range kLatitudeDeg{-90.0, 90.0, false, "deg"};
 inline constexpr Range kLongitudeDeg{-360.0, 360.0, false, "deg"};
 inline constexpr Range kHeightM{-1.1e4, 1.0e5, false, "m"};
-/// Cut-off frequency of a smoother [Hz].
-inline constexpr Range kCutoffHz{0.0, 1.0e4, true, "Hz"};
+/// Cut-off frequency of a smoother [Hz]: from 1 mHz (a period of 17 min; a
+/// lower cut-off smooths a vehicle's every manoeuvre into a straight line).
+inline constexpr Range kCutoffHz{1.0e-3, 1.0e4, false, "Hz"};
 
 /// Most IMU samples between two covariance propagations (filter.propagate_every, 1..1000).
 inline constexpr int kMaxPropagateEvery = 1000;
@@ -67,11 +90,21 @@ inline constexpr Range kMotionNoiseFactor{1.0, 100.0, false, "(factor)"};
 inline constexpr Range kMotionRateThresholdRadS{1.0e-3, 10.0, false, "rad/s"};
 inline constexpr Range kMotionAccThresholdMps2{0.05, 100.0, false, "m/s^2"};
 // Prior sigmas of the filter's extra states (filter::ExtraStates): the same
-// bounds as the effects they estimate, open at 0 (a state is off by leaving it out).
-inline constexpr Range kScaleFactorSigma{0.0, 0.05, true, "(ratio)"};
-inline constexpr Range kMisalignmentSigmaRad{0.0, 0.05, true, "rad"};
-inline constexpr Range kLeverArmErrorSigmaM{0.0, 10.0, true, "m"};
-inline constexpr Range kTimeOffsetSigmaS{0.0, 0.1, true, "s"};
+// upper bounds as the effects they estimate; a state is off by leaving it out,
+// and a prior below the lower bound is no uncertainty any instrument has:
+/// scale factor: from 1 ppm, the scale-factor stability of navigation-grade sensors;
+inline constexpr Range kScaleFactorSigma{1.0e-6, 0.05, false, "(ratio)"};
+/// misalignment: from 1 urad (0.2 arcsec), below any IMU's mounting accuracy (~10 urad);
+inline constexpr Range kMisalignmentSigmaRad{1.0e-6, 0.05, false, "rad"};
+/// lever-arm error: from 0.1 mm, as a position sigma;
+inline constexpr Range kLeverArmErrorSigmaM{1.0e-4, 10.0, false, "m"};
+/// IMU-GNSS time offset: from 100 ns, one tick of a rawlog's time stamps (MRPT's clock).
+inline constexpr Range kTimeOffsetSigmaS{1.0e-7, 0.1, false, "s"};
+// Sigmas of the IMU at rest (replay imu_at_rest, the static detector): below
+// the per-sample noise of a navigation-grade IMU sampled at 1 Hz
+// (ARW 0.001 deg/sqrt(h) = 2.9e-7 rad/s, VRW 0.002 m/s/sqrt(h) = 3.3e-5 m/s^2).
+inline constexpr Range kAtRestGyroSigmaRadS{1.0e-7, 1000.0, false, "rad/s"};
+inline constexpr Range kAtRestAccSigmaMps2{1.0e-6, 1.0e5, false, "m/s^2"};
 
 /// Most Monte Carlo runs of one study (monte_carlo.runs).
 inline constexpr long long kMaxMonteCarloRuns = 1000000;
