@@ -55,3 +55,9 @@ foreach(_case "noise_tiny|noise: {sigma_pos_h_m: 1e-300}|key 'noise.sigma_pos_h_
   navimpact_cli_fail(cli_replay_range_${_n} ARGS replay --config ${_rdir}/${_n}.yaml --out ${_rdir}/${_n}
     REGEX "${_n}.yaml: ${_re}$" NOOUT ${_rdir}/${_n})
 endforeach()
+
+# A configuration without rawlog: names the configuration and the key (it said
+# only 'replay: no rawlog given').
+file(WRITE ${_rdir}/no_rawlog.yaml "outages: [{start_s: 100, duration_s: 10}]\n")
+navimpact_cli_fail(cli_replay_config_without_rawlog ARGS replay --config ${_rdir}/no_rawlog.yaml --out ${_rdir}/no_rawlog
+  REGEX "no_rawlog.yaml: key 'rawlog': missing \\(the rawlog to replay, or --rawlog\\)$" NOOUT ${_rdir}/no_rawlog)

@@ -762,10 +762,17 @@ void ReplayDriver::run() {
   if (scorer_) r.score = scorer_->finish(r.run, r.t_zero, refInfo_);
 }
 
+/// A replay needs a rawlog: named by the configuration's key when there is a configuration.
+void requireRawlog(const ReplayConfig& cfg) {
+  if (!cfg.rawlog.empty()) return;
+  if (!cfg.config_file.empty()) throw keyError(cfg.config_file, "rawlog", "missing (the rawlog to replay, or --rawlog)");
+  throw Error("replay: no rawlog given (--rawlog, or 'rawlog:' in a --config)");
+}
+
 }  // namespace
 
 ReplayResult runReplay(const ReplayConfig& cfg) {
-  if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
+  requireRawlog(cfg);
   InputScope scope(cfg.rawlog);
   ReplayResult r;
   ReplayDriver(cfg, r, nullptr).run();
@@ -773,7 +780,7 @@ ReplayResult runReplay(const ReplayConfig& cfg) {
 }
 
 ReplayResult runReplay(const ReplayConfig& cfg, const rawlog::RawlogRecords& data, double stop_after_s) {
-  if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
+  requireRawlog(cfg);
   InputScope scope(cfg.rawlog);
   ReplayResult r;
   ReplayDriver(cfg, r, data, stop_after_s).run();
@@ -781,7 +788,7 @@ ReplayResult runReplay(const ReplayConfig& cfg, const rawlog::RawlogRecords& dat
 }
 
 ReplayResult runReplay(const ReplayConfig& cfg, ReplayObserver& observer) {
-  if (cfg.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
+  requireRawlog(cfg);
   InputScope scope(cfg.rawlog);
   ReplayResult r;
   ReplayDriver(cfg, r, &observer).run();
