@@ -31,6 +31,12 @@ file(READ ${_kat}/manifest.yaml _m)
 string(REPLACE "file: imu.csv.gz" "file: ${_kat}/imu.csv.gz" _m "${_m}")
 string(REPLACE "file: gnss.csv" "file: ${_kat}/gnss.csv" _m "${_m}")
 string(REPLACE "file: reference.csv" "file: ${_kat}/reference.csv" _m "${_m}")
+# a gzip-compressed manifest imports like the plain one (as every configuration; it was read raw)
+file(WRITE ${_idir}/manifest_gz/manifest.yaml "${_m}")
+file(ARCHIVE_CREATE OUTPUT ${_idir}/manifest.yaml.gz PATHS ${_idir}/manifest_gz/manifest.yaml FORMAT raw COMPRESSION GZip)
+add_test(NAME cli_import_gzip_manifest
+  COMMAND ${NI} import --manifest ${_idir}/manifest.yaml.gz --out ${_idir}/katwijk_gz.rawlog --overwrite)
+set_tests_properties(cli_import_gzip_manifest PROPERTIES PASS_REGULAR_EXPRESSION "IMU 37501 samples, 300.000 s at 125 Hz")
 # TEST|FROM|TO|REGEX: the manifest (in TEST.yaml) with FROM replaced by TO
 foreach(_case "bad_unit|unit: rad/s|unit: rpm|bad_unit.yaml: key 'imu.gyro.unit'.*rpm"
               "unknown_key|max_gap_s: 3.5|max_gapp_s: 3.5|unknown_key.yaml: key 'gnss.max_gapp_s': unknown key"
@@ -56,7 +62,7 @@ foreach(_case "nan|0.700,3.000,1448546405.617,52.2141820426667|0.700,3.000,14485
 endforeach()
 navimpact_cli_fail(cli_import_missing_manifest
   ARGS import --manifest ${_idir}/none.yaml --out ${_idir}/bad.rawlog
-  REGEX "none.yaml: cannot open the manifest" NOOUT ${_idir}/bad.rawlog)
+  REGEX "none.yaml: cannot open \\(No such file or directory\\)" NOOUT ${_idir}/bad.rawlog)
 
 # The same path for emulated and measured runs: the bundled emulated UAV rawlog
 # exported as CSV + manifest (datasets/uav_flight_260s_emulated/), imported and

@@ -120,6 +120,33 @@ TEST(Config, NestedAliasesCannotExpandWithoutBound) {
   EXPECT_EQ(errorOf([&] { doc(small); }), "(no error)");
 }
 
+// Found by the bad-input battery: texts yaml-cpp accepts and misreads. An
+// alias inside its own anchor is a node that contains itself (the key check
+// recursed until the stack overflowed: a segfault in every command); a second
+// document after '---' was ignored, a NUL byte dropped; nesting beyond
+// yaml-cpp's depth limit said "bad file".
+TEST(Config, TextsYamlCppMisreadsAreRefusedNamingFileAndPlace) {
+  for (const char* text : {"a: &x [*x]\n", "a: &x {b: *x}\n", "ok: 1\nlist: [1, &x [2, *x]]\n"}) {
+    const std::string e = errorOf([&] { doc(text); });
+    EXPECT_EQ(e.rfind("cfg.yaml: key '", 0), 0u) << text << e;
+    EXPECT_NE(e.find("nested deeper than 1200 levels (an alias *NAME inside its own anchor?)"), std::string::npos) << e;
+  }
+  EXPECT_EQ(errorOf([] { doc("a: 1\n---\na: 2\n"); }),
+            "cfg.yaml:3: a second YAML document (after '---'): a file holds one document");
+  EXPECT_EQ(errorOf([] { doc("---\na: 1\n...\n"); }), "(no error)");  // one document, its markers
+  EXPECT_EQ(errorOf([] { doc("a: 1\n---\n"); }), "(no error)");       // an empty second one says nothing
+  EXPECT_EQ(errorOf([] { doc(std::string("a: /x\0/y\n", 10)); }),
+            "cfg.yaml:1:6: control character \\x00 (YAML text holds printable characters, tabs and line breaks)");
+  EXPECT_EQ(errorOf([] { doc("a: 1\r\n\tb: 2\x7f\n"); }).rfind("cfg.yaml:2:6: control character \\x7F", 0), 0u);
+  EXPECT_EQ(errorOf([] { doc("a: 1\r\nb: [1,\t2]\r\n"); }), "(no error)");  // CRLF and tabs are YAML
+  // UTF-16 (with its byte-order mark) is YAML, decoded by yaml-cpp: its zero bytes are no NUL characters
+  const std::string utf16("\xFF\xFE" "a\0:\0 \0" "1\0\n\0", 12);
+  EXPECT_EQ(doc(utf16).number("a", limits::kImuRateHz), 1.0);
+  const std::string deep = errorOf([] { doc("a: " + std::string(5000, '[') + "\n"); });
+  EXPECT_EQ(deep.rfind("cfg.yaml:", 0), 0u) << deep;
+  EXPECT_NE(deep.find(": YAML syntax error: nested deeper than "), std::string::npos) << deep;
+}
+
 TEST(Config, WrongTypeSaysWhatWasExpectedAndWhatCame) {
   const ConfigNode c = doc("flag: perhaps\nn: [1, 2]\nseed: -5\nv: [1, 2]\nmode: fast\nk: 2.5\n"
                            "text: {a: 1}\nsigma_m: two\nlong: " + std::string(300, 'x') + "\n");
@@ -238,4 +265,7 @@ TEST(Config, AnInputFileThatCannotBeReadNamesTheConfigurationAndTheKey) {
             f + ": key 'model': cannot open '" + d + "nope.yaml' (No such file or directory)");
   EXPECT_EQ(errorOf([&] { c.modelRef("model_folder"); }),
             f + ": key 'model_folder': cannot open '" + d + "folder' (Is a directory)");
+  // a configuration itself: a FIFO is refused before it is opened (reading it would block)
+  EXPECT_EQ(errorOf([&] { ConfigNode::load(d + "fifo"); }), d + "fifo: cannot open (not a regular file)");
+  EXPECT_EQ(errorOf([&] { ConfigNode::readText(d + "folder"); }), d + "folder: cannot open (Is a directory)");
 }

@@ -40,7 +40,7 @@ StudyConfig loadStudyConfig(const std::string& path, const std::vector<std::stri
   InputScope scope(path);
   StudyConfig cfg;
   cfg.config_file = path;
-  cfg.config_text = readFileMaybeGz(path);
+  cfg.config_text = ConfigNode::readText(path);
   cfg.loadFrom(ConfigNode::parse(cfg.config_text, path), extra_keys);
   return cfg;
 }

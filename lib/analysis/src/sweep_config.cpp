@@ -6,7 +6,6 @@
 #include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
-#include "navimpact/core/text_io.hpp"
 
 namespace navimpact::analysis {
 
@@ -26,7 +25,7 @@ SweepConfig loadSweepConfig(const std::string& path) {
   InputScope scope(path);
   SweepConfig cfg;
   cfg.config_file = path;
-  cfg.config_text = readFileMaybeGz(path);
+  cfg.config_text = ConfigNode::readText(path);
   const ConfigNode root = ConfigNode::parse(cfg.config_text, path);
   if (root.has("outages"))
     throw root.error("outages", "not used by a sweep: the outage comes from sweep.outage (start_s, durations_s)");

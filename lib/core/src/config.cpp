@@ -1,6 +1,7 @@
 // The one strict YAML reader (see config.hpp).
 #include "navimpact/core/config.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -47,15 +48,42 @@ std::string joinNames(const std::vector<std::string>& v) {
 /// followed, and a few hundred bytes of nested aliases can stand for billions
 /// of nodes; without aliases a document has fewer nodes than bytes.
 constexpr std::size_t kMaxAliasNodes = 1000000;
+/// Deepest nesting the key check follows: beyond what yaml-cpp parses from
+/// text (it refuses ~1000 levels), so only an alias inside its own anchor
+/// (`a: &x [*x]`, a node that contains itself) gets there.
+constexpr int kMaxDepth = 1200;
+
+/// Control characters are no YAML (c-printable: tab, line feed, carriage return
+/// and the printable characters); yaml-cpp drops a NUL silently. Checked in
+/// UTF-8 text only: a UTF-16 or UTF-32 file (a zero byte among the first two,
+/// or its byte-order mark) is decoded by yaml-cpp itself.
+void checkCharacters(const std::string& text, const std::string& file) {
+  if (text.size() >= 2 && (text[0] == '\0' || text[1] == '\0' || (text[0] == '\xFF' && text[1] == '\xFE') ||
+                           (text[0] == '\xFE' && text[1] == '\xFF')))
+    return;
+  std::size_t line = 1, col = 1;
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7F)
+      throw Error(file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": control character " +
+                  printable(std::string(1, ch)) + " (YAML text holds printable characters, tabs and line breaks)");
+    if (c == '\n') ++line, col = 1;
+    else ++col;
+  }
+}
 
 /// Every map of the tree: keys are plain names and appear once; no merge key
 /// (yaml-cpp does not merge `<<: *NAME`, and a key given both by a merge and
 /// directly would need a precedence rule). An alias is checked like the value
 /// it stands for, within @p budget nodes in all.
-void checkKeys(const YAML::Node& n, const std::string& file, const std::string& path, std::size_t& budget) {
+void checkKeys(const YAML::Node& n, const std::string& file, const std::string& path, std::size_t& budget,
+               int depth) {
   if (budget == 0)
     throw Error(file + ": aliases (*NAME) expand the document to more than " + std::to_string(kMaxAliasNodes) +
                 " nodes beyond its size (nested aliases?)");
+  if (depth > kMaxDepth)  // only aliases reach it: yaml-cpp refuses deeper text
+    throw keyError(file, path,
+                   "nested deeper than " + std::to_string(kMaxDepth) + " levels (an alias *NAME inside its own anchor?)");
   --budget;
   if (n.IsMap()) {
     std::map<std::string, int> seen;
@@ -72,10 +100,10 @@ void checkKeys(const YAML::Node& n, const std::string& file, const std::string& 
       if (!fresh)
         throw keyError(file, join(path, k),
                        "duplicate key (line " + std::to_string(line) + "; first at line " + std::to_string(it->second) + ")");
-      checkKeys(kv.second, file, join(path, k), budget);
+      checkKeys(kv.second, file, join(path, k), budget, depth + 1);
     }
   } else if (n.IsSequence()) {
-    for (std::size_t i = 0; i < n.size(); ++i) checkKeys(n[i], file, path + "[" + std::to_string(i) + "]", budget);
+    for (std::size_t i = 0; i < n.size(); ++i) checkKeys(n[i], file, path + "[" + std::to_string(i) + "]", budget, depth + 1);
   }
 }
 
@@ -107,24 +135,35 @@ double numberOf(const YAML::Node& v, const limits::Range& r, const std::string& 
 ConfigNode::ConfigNode(std::shared_ptr<const Doc> doc, std::shared_ptr<const Node> node, std::string path)
     : doc_(std::move(doc)), node_(std::move(node)), path_(std::move(path)) {}
 
-ConfigNode ConfigNode::load(const std::string& file) {
+std::string ConfigNode::readText(const std::string& file, std::size_t max_bytes) {
   const std::string why = unreadableReason(file);
   if (!why.empty()) throw Error(printable(file, 160) + ": cannot open (" + why + ")");
-  return parse(readFileMaybeGz(file), file);
+  return readFileMaybeGz(file, max_bytes);
 }
 
+ConfigNode ConfigNode::load(const std::string& file) { return parse(readText(file), file); }
+
 ConfigNode ConfigNode::parse(const std::string& text, const std::string& file) {
-  YAML::Node root;
+  checkCharacters(text, file);
+  std::vector<YAML::Node> docs;
   try {
-    root = YAML::Load(text);
+    docs = YAML::LoadAll(text);
+  } catch (const YAML::DeepRecursion& e) {
+    throw Error(file + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                ": YAML syntax error: nested deeper than " + std::to_string(e.depth()) + " levels");
   } catch (const YAML::Exception& e) {
     throw Error(file + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
                 ": YAML syntax error: " + printable(e.msg, 120));
   }
+  YAML::Node root = docs.empty() ? YAML::Node() : docs.front();
+  for (std::size_t i = 1; i < docs.size(); ++i)
+    if (docs[i].IsDefined() && !docs[i].IsNull())
+      throw Error(file + ":" + std::to_string(docs[i].Mark().line + 1) +
+                  ": a second YAML document (after '---'): a file holds one document");
   if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) throw Error(file + ": expected a map of keys at the top level, got " + got(root));
   std::size_t budget = kMaxAliasNodes + text.size();
-  checkKeys(root, file, "", budget);
+  checkKeys(root, file, "", budget, 0);
   auto doc = std::make_shared<Doc>();
   doc->file = file;
   doc->dir = fs::path(file).parent_path();

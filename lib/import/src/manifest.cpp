@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -345,15 +344,8 @@ std::string fmt17(double x) {
 
 Recording importManifest(const std::string& manifestPath, ImportReport* report) {
   InputScope scope(manifestPath);
-  std::string manifestText;
-  {
-    std::ifstream in(manifestPath, std::ios::binary);
-    if (!in) throw Error(manifestPath + ": cannot open the manifest");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    manifestText = ss.str();
-  }
-  if (manifestText.size() > (1u << 20)) throw Error(manifestPath + ": manifest larger than 1 MiB");
+  // plain or gzip like every configuration, at most 1 MiB (a manifest is a page)
+  const std::string manifestText = ConfigNode::readText(manifestPath, std::size_t(1) << 20);
   const ConfigNode root = ConfigNode::parse(manifestText, manifestPath);
   const Keys k{manifestPath};
   k.map(root, "", {"imu", "gnss", "baro", "reference", "time_offset_s", "time_zero_unix_s", "origin"}, {"imu"});

@@ -51,8 +51,14 @@ class ConfigNode {
   /// @throws navimpact::Error "FILE: cannot open (REASON)", "FILE:LINE:COLUMN: YAML syntax error: ...",
   ///         a duplicate or non-name key anywhere, or a top level that is not a map.
   static ConfigNode load(const std::string& file);
+  /// The text of a YAML file (plain or gzip, at most @p max_bytes) for parse():
+  /// "FILE: cannot open (REASON)" when it cannot be read; a FIFO or device is
+  /// refused (its reading could block or never end).
+  static std::string readText(const std::string& file, std::size_t max_bytes = std::size_t(64) << 20);
   /// Parse YAML @p text that came from @p file (named in messages; paths are relative to its folder).
-  /// An empty text is an empty map.
+  /// An empty text is an empty map. Refused: control characters (a NUL yaml-cpp would drop
+  /// silently), a second document after '---' (yaml-cpp would ignore it), aliases that
+  /// nest without end (an alias inside its own anchor).
   static ConfigNode parse(const std::string& text, const std::string& file);
 
   /// The file as the user named it.
