@@ -5,15 +5,44 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <memory>
 #include <vector>
+
+#include "navimpact/core/error.hpp"
+#include "navimpact/core/text_io.hpp"
 
 namespace navimpact::cli {
 
 std::vector<Command>& registry() {
   static std::vector<Command> r;
   return r;
+}
+
+CLI::Validator within(const limits::Range& r, bool hi_open) {
+  std::string text = limits::describe(r);
+  if (hi_open) text[text.find(']')] = ')';
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return CLI::Validator(
+      [r, hi_open, text](std::string& s) -> std::string {
+        double v = 0.0;
+        if (!parseDouble(s, v)) return "must be a number in " + text + ", got '" + printable(s, 40) + "'";
+        const bool ok = std::isfinite(v) && (r.lo_open ? v > r.lo : v >= r.lo) && (hi_open ? v < r.hi : v <= r.hi);
+        return ok ? std::string() : "must be in " + text + ", got " + printable(s, 40);
+      },
+      text);
+}
+
+CLI::Validator seedValue() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        const std::string max = std::to_string(std::numeric_limits<std::uint64_t>::max());
+        const bool digits = !s.empty() && s.size() <= max.size() && s.find_first_not_of("0123456789") == std::string::npos;
+        if (digits && (s.size() < max.size() || s <= max)) return std::string();
+        return "must be an integer seed in 0.." + max + ", got '" + printable(s, 40) + "'";
+      },
+      "SEED");
 }
 
 void addOverwriteFlag(CLI::App& app, bool& flag) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/output.hpp"
 
 namespace navimpact::cli {
@@ -41,6 +42,16 @@ Command mergeCommand(std::string name, std::string help, std::function<int(const
 /// output is replaced whole when the job succeeds.
 void addOverwriteFlag(CLI::App& app, bool& flag);
 inline Overwrite overwriteMode(bool flag) { return flag ? Overwrite::Replace : Overwrite::Refuse; }
+
+/// A flag's number checked against a documented range (core/limits.hpp), NaN
+/// and text refused: "--rate: must be in [1, 10000] Hz, got nan". (CLI11's
+/// PositiveNumber let NaN and 1e308 through and printed DBL_MAX in 309 digits.)
+/// @p hi_open excludes the upper end too (an efficiency in (0, 1)).
+CLI::Validator within(const limits::Range& r, bool hi_open = false);
+
+/// A seed: an integer 0 .. 2^64 - 1 in decimal digits (CLI11 read "-1" as
+/// 2^64 - 1, a silent wrap), the same seeds as a configuration's seed keys.
+CLI::Validator seedValue();
 
 /// Identity of this build: navimpact version plus an FNV-1a 64 hash of the
 /// running executable (/proc/self/exe), e.g. "0.1.0+3f2a...". Shards of a

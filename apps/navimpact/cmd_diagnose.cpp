@@ -223,14 +223,18 @@ navimpact::cli::Registrar reg(
        app.add_option("--static", o->static_file,
                       "--run: simulate with windows of this static recording (CSV) instead of the model's errors")
            ->needs(runOpt);
-       app.add_option("--static-rate", o->static_rate, "--static: sampling rate [Hz] of a CSV without time column");
+       app.add_option("--static-rate", o->static_rate, "--static: sampling rate [Hz] of a CSV without time column")
+           ->check(navimpact::cli::within(navimpact::limits::kImuRateHz));
        app.add_option("--static-gyro-unit", o->static_gyro_unit, "--static: gyroscope unit");
        app.add_option("--static-acc-unit", o->static_acc_unit, "--static: accelerometer unit");
        app.add_option("--static-axes", o->static_axes, "--static: sensor-to-body FRD axes");
        app.add_option("--durations", o->durations, "--run: outage durations [s], comma separated")
            ->delimiter(',')
+           ->check(navimpact::cli::within(navimpact::limits::kDurationS))
            ->capture_default_str();
-       app.add_option("--reconverge", o->reconverge, "--run: GNSS time before each outage [s]")->capture_default_str();
+       app.add_option("--reconverge", o->reconverge, "--run: GNSS time before each outage [s]")
+           ->capture_default_str()
+           ->check(navimpact::cli::within(navimpact::limits::kDurationS));
        app.add_option("--realisations", o->realisations, "--run: simulated realisations (seeded by --seed)")
            ->capture_default_str();
        app.add_option("--folds", o->folds, "--run: cross-validation folds (time blocks of the run) for the causes")
@@ -244,6 +248,7 @@ navimpact::cli::Registrar reg(
                                    "with fit:SPEC: robust GMWM (fit the robust WV, Tukey biweight)");
        app.add_option("--eff", o->eff, "--robust: efficiency of the robust WV at the Gaussian, in (0, 1)")
            ->capture_default_str()
+           ->check(navimpact::cli::within({0.0, 1.0, true, ""}, true))
            ->needs(robust);
        app.add_option("--trajectory", o->trajectory,
                       "trajectory CSV for the navigation gain (columns time_s, lat_rad, lon_rad, "
@@ -261,7 +266,7 @@ navimpact::cli::Registrar reg(
        navimpact::cli::addOverwriteFlag(app, o->overwrite);
        app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel")
            ->capture_default_str();
-       app.add_option("--seed", o->seed, "root seed")->capture_default_str();
+       app.add_option("--seed", o->seed, "root seed")->capture_default_str()->check(navimpact::cli::seedValue());
        app.add_option("--alpha", o->alpha, "family-wise level for the whole record")
            ->capture_default_str();
        app.add_option("--threads", o->threads, "worker threads (0 = all cores)");

@@ -117,7 +117,7 @@ navimpact::cli::Registrar reg(
        app.add_option("--duration-h", o->duration_h, "record duration range LO:HI [h], log-uniform (e.g. 0.5:10; overrides --samples)");
        app.add_option("--samples", o->samples, "record length range LO:HI [samples], log-uniform")->capture_default_str();
        app.add_option("--causes", o->causes, "comma-separated causes (default: all eight)");
-       app.add_option("--seed", o->seed, "root seed")->capture_default_str();
+       app.add_option("--seed", o->seed, "root seed")->capture_default_str()->check(navimpact::cli::seedValue());
        app.add_option("--alpha", o->alpha, "family-wise level of each diagnosis")->capture_default_str();
        app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel in each diagnosis")->capture_default_str();
        app.add_option("--threads", o->threads, "worker threads over records (0 = all cores)");

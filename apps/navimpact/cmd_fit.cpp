@@ -90,8 +90,9 @@ navimpact::cli::Registrar reg({
                    "Guerrier, Molinari & Victoria-Feser 2014) with its own CI and weights; for records with outliers");
       app.add_option("--eff", o->fit.eff, "--robust: efficiency of the robust WV at the Gaussian, in (0, 1)")
           ->capture_default_str()
+          ->check(navimpact::cli::within({0.0, 1.0, true, ""}, true))
           ->needs(robust);
-      app.add_option("--seed", o->fit.seed, "seed of the bootstrap");
+      app.add_option("--seed", o->fit.seed, "seed of the bootstrap")->check(navimpact::cli::seedValue());
       app.add_option("--out", o->out, "output directory (model.yaml, fit.json, fit_*.png)")->required();
       navimpact::cli::addOverwriteFlag(app, o->overwrite);
       return [o]() -> int { return run(*o); };

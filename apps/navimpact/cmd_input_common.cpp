@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "input.hpp"
+#include "cli_common.hpp"
 #include "navimpact/core/csv_reader.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/units.hpp"
@@ -58,7 +59,7 @@ void addInputOptions(CLI::App& app, InputOpts& o) {
       ->required();
   app.add_option("--rate", o.rate_hz,
                  "sampling rate [Hz]; required for CSV without a time column, checked for rawlog")
-      ->check(CLI::PositiveNumber);
+      ->check(within(limits::kImuRateHz));
   app.add_option("--gyro-unit", o.gyro_unit,
                  "CSV gyroscope unit: rad/s, deg/s, deg/h, mrad/s (default: from the header)");
   app.add_option("--acc-unit", o.acc_unit,

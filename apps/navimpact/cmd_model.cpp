@@ -115,7 +115,7 @@ navimpact::cli::Registrar reg({"model", "Inspect IMU error model files (show, li
   auto* conv = app.add_subcommand("convert", "Convert a model exactly to another sampling rate");
   conv->add_option("model", o->spec, "Model file, FILE or FILE:NAME")->required();
   conv->add_option("--rate", o->rate_hz, "New sampling rate [Hz]")->required()->check(
-      CLI::PositiveNumber);
+      navimpact::cli::within(navimpact::limits::kImuRateHz));
   conv->add_option("--out", o->out, "Write the converted single-model YAML file here");
   navimpact::cli::addOverwriteFlag(*conv, o->overwrite);
   return [o, show, list, conv]() -> int {

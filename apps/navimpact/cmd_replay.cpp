@@ -1,5 +1,6 @@
 // navimpact replay: run the EKF over a rawlog (IMU, GNSS, BARO, GT) with GNSS outages injected.
 #include <algorithm>
+#include <optional>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -18,7 +19,7 @@ struct Opts {
   std::string rawlog, config, model, out, imu_label, gnss_label;
   std::vector<std::string> outages;
   std::string outages_every;
-  int propagate_every = 0;
+  std::optional<int> propagate_every;
   double max_imu_gap_s = -1.0;
   bool overwrite = false;
 };
@@ -40,14 +41,15 @@ navimpact::cli::Registrar reg({
                      "GNSS outages all along the run, PERIOD:DURATION [s]: each after PERIOD - DURATION s of "
                      "GNSS from the filter start; added to the other outages");
       app.add_option("--propagate-every", o->propagate_every,
-                     "propagate the covariance every k IMU samples (default 10)");
+                     "propagate the covariance every k IMU samples (default 10)")
+          ->check(CLI::Range(1, navimpact::limits::kMaxPropagateEvery));
       app.add_option("--imu-label", o->imu_label,
                      "IMU label of a rawlog navimpact did not write (default: the only one present)");
       app.add_option("--gnss-label", o->gnss_label,
                      "GNSS label of a rawlog navimpact did not write (default: the only one present)");
       app.add_option("--max-imu-gap", o->max_imu_gap_s,
                      "accept IMU gaps up to S seconds and propagate across them (default 0: a gap is an error)")
-          ->check(CLI::Range(0.0, navimpact::analysis::kMaxImuGapS));
+          ->check(navimpact::cli::within({0.0, navimpact::analysis::kMaxImuGapS, false, "s"}));
       app.add_option("--out", o->out, "output folder")->required();
       navimpact::cli::addOverwriteFlag(app, o->overwrite);
       return [o]() -> int {
@@ -68,7 +70,7 @@ navimpact::cli::Registrar reg({
           for (const auto& s : o->outages) cfg.outages.push_back(navimpact::parseOutage(s));
         }
         if (!o->outages_every.empty()) cfg.outages_every = navimpact::parseOutagePattern(o->outages_every);
-        if (o->propagate_every > 0) cfg.propagate_every = o->propagate_every;
+        if (o->propagate_every) cfg.propagate_every = *o->propagate_every;
         if (o->max_imu_gap_s >= 0.0) cfg.max_imu_gap_s = o->max_imu_gap_s;
         // read, filtered and written as it goes (bounded memory, see ReplayWriter)
         navimpact::report::ReplayWriter writer(&out);

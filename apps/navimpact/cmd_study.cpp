@@ -4,6 +4,7 @@
 //   navimpact study-merge DIR1 DIR2 ... --out DIR
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "cli_common.hpp"
 #include "navimpact/analysis/study.hpp"
@@ -17,9 +18,11 @@ namespace an = navimpact::analysis;
 
 struct StudyOpts {
   std::string config, out, shard;
-  long long runs = -1;
-  long long seed = -1;
-  int threads = -1;
+  // overrides of the configuration when given (a sentinel such as -1 let
+  // "--seed -1" silently mean "the configuration's seed")
+  std::optional<long long> runs;
+  std::optional<std::uint64_t> seed;
+  std::optional<int> threads;
   bool overwrite = false;
 };
 
@@ -32,12 +35,9 @@ void printSummary(const an::StudyResults& r, const std::string& dir) {
 int runStudyCmd(const StudyOpts& o) {
   navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
   an::StudyConfig cfg = an::loadStudyConfig(o.config);
-  if (o.runs >= 0) {
-    if (o.runs < 1) throw navimpact::Error("--runs must be >= 1, got " + std::to_string(o.runs));
-    cfg.runs = static_cast<std::size_t>(o.runs);
-  }
-  if (o.seed >= 0) cfg.seed = static_cast<std::uint64_t>(o.seed);
-  if (o.threads >= 0) cfg.threads = static_cast<unsigned>(o.threads);
+  if (o.runs) cfg.runs = static_cast<std::size_t>(*o.runs);  // (range checked by the flag)
+  if (o.seed) cfg.seed = *o.seed;
+  if (o.threads) cfg.threads = static_cast<unsigned>(*o.threads);
   const an::Shard shard = o.shard.empty() ? an::Shard{} : an::parseShard(o.shard);
 
   const auto plan = an::prepareStudy(cfg, NAVIMPACT_VERSION);  // every input error is thrown here
@@ -78,10 +78,12 @@ navimpact::cli::Registrar regStudy({"study",
                                           ->required();
                                       app.add_option("--out", o->out, "output folder")->required();
                                       navimpact::cli::addOverwriteFlag(app, o->overwrite);
-                                      app.add_option("--runs", o->runs, "Monte Carlo runs (overrides the config)");
-                                      app.add_option("--seed", o->seed, "study seed (overrides the config)");
+                                      app.add_option("--runs", o->runs, "Monte Carlo runs (overrides the config)")
+                                          ->check(CLI::Range(1LL, navimpact::limits::kMaxMonteCarloRuns));
+                                      app.add_option("--seed", o->seed, "study seed (overrides the config)")->check(navimpact::cli::seedValue());
                                       app.add_option("--threads", o->threads,
-                                                     "worker threads, 0 = all cores (overrides the config)");
+                                                     "worker threads, 0 = all cores (overrides the config)")
+                                          ->check(CLI::Range(0, 1024));
                                       app.add_option("--shard", o->shard,
                                                      "K/N: run only the run indices i with i % N == K-1 and write "
                                                      "partial results for study-merge");

@@ -37,8 +37,9 @@ struct SlurmOpts {
 struct SweepOpts {
   std::string config, out, shard;
   SlurmOpts slurm;
-  long long runs = -1, seed = -1;
-  int threads = -1;
+  std::optional<long long> runs;  // overrides of the configuration when given
+  std::optional<std::uint64_t> seed;
+  std::optional<int> threads;
   bool overwrite = false;
 };
 
@@ -75,12 +76,9 @@ int runSweepCmd(const SweepOpts& o) {
   std::optional<navimpact::OutputSet> out;
   if (!emit) out.emplace(o.out, navimpact::cli::overwriteMode(o.overwrite));  // refused before any work
   an::SweepConfig cfg = an::loadSweepConfig(o.config);
-  if (o.runs >= 0) {
-    if (o.runs < 2) throw navimpact::Error("--runs must be >= 2 for a sweep, got " + std::to_string(o.runs));
-    cfg.study.runs = static_cast<std::size_t>(o.runs);
-  }
-  if (o.seed >= 0) cfg.study.seed = static_cast<std::uint64_t>(o.seed);
-  if (o.threads >= 0) cfg.study.threads = static_cast<unsigned>(o.threads);
+  if (o.runs) cfg.study.runs = static_cast<std::size_t>(*o.runs);  // (range checked by the flag)
+  if (o.seed) cfg.study.seed = *o.seed;
+  if (o.threads) cfg.study.threads = static_cast<unsigned>(*o.threads);
   const an::Shard shard = o.shard.empty() ? an::Shard{} : an::parseShard(o.shard);
 
   const auto plan = an::prepareSweep(cfg, NAVIMPACT_VERSION);  // every input error is thrown here
@@ -152,8 +150,8 @@ int emitSlurm(const SweepOpts& o, const an::SweepConfig& cfg, const an::SweepMet
   const std::string config = shellValue(absolute(o.config), "--config");
   shellValue(dir, "--emit-slurm");
   std::string overrides;
-  if (o.runs >= 0) overrides += " --runs " + std::to_string(o.runs);
-  if (o.seed >= 0) overrides += " --seed " + std::to_string(o.seed);
+  if (o.runs) overrides += " --runs " + std::to_string(*o.runs);
+  if (o.seed) overrides += " --seed " + std::to_string(*o.seed);
 
   std::ostringstream common;
   if (!s.partition.empty()) common << "#SBATCH --partition=" << sbatchValue(s.partition, "--partition") << "\n";
@@ -253,9 +251,11 @@ navimpact::cli::Registrar regSweep(
        auto o = std::make_shared<SweepOpts>();
        app.add_option("--config", o->config, "sweep YAML (e.g. config/sweep/navchip_uav_sweep.yaml)")->required();
        app.add_option("--out", o->out, "output folder (or --emit-slurm)");
-       app.add_option("--runs", o->runs, "Monte Carlo runs per cell (overrides the config)");
-       app.add_option("--seed", o->seed, "sweep seed (overrides the config)");
-       app.add_option("--threads", o->threads, "worker threads, 0 = all cores (overrides the config)");
+       app.add_option("--runs", o->runs, "Monte Carlo runs per cell, >= 2 for its paired tests (overrides the config)")
+           ->check(CLI::Range(2LL, navimpact::limits::kMaxMonteCarloRuns));
+       app.add_option("--seed", o->seed, "sweep seed (overrides the config)")->check(navimpact::cli::seedValue());
+       app.add_option("--threads", o->threads, "worker threads, 0 = all cores (overrides the config)")
+           ->check(CLI::Range(0, 1024));
        app.add_option("--shard", o->shard,
                       "K/N: run only the run indices i with i % N == K-1 (in every column) and write partial "
                       "results for sweep-merge");

@@ -41,7 +41,8 @@ int run(const Opts& o) {
                                         {"rate_hz", s.rate_hz},
                                         {"samples", s.size()},
                                         {"units", navimpact::cli::inputUnitsNote(o.in, fmt)}};
-  for (const auto& [k, v] : navimpact::cli::inputSelectionJson(o.in).items()) input[k] = v;
+  const nlohmann::json selection = navimpact::cli::inputSelectionJson(o.in);  // (items() of a temporary dangles)
+  for (const auto& [k, v] : selection.items()) input[k] = v;
   navimpact::report::writeWvOutputs(w, input.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), outs);
   outs.commit();
 
@@ -61,7 +62,8 @@ navimpact::cli::Registrar reg({"wv",
                                               "robust WV (Tukey biweight M-estimator of scale)");
                                  app.add_option("--eff", o->eff,
                                                 "efficiency of the robust estimator, in (0, 1)")
-                                     ->capture_default_str();
+                                     ->capture_default_str()
+                                     ->check(navimpact::cli::within({0.0, 1.0, true, ""}, true));
                                  app.add_flag("--allan", o->allan,
                                               "also write overlapping Allan deviations");
                                  app.add_option("--out", o->out, "output directory")->required();

@@ -105,3 +105,33 @@ add_test(NAME cli_error_file_key_replaced_by_flag
           --outage 15:10 --out ${_fk}/o9 --overwrite)
 set_tests_properties(cli_error_file_key_replaced_by_flag PROPERTIES FIXTURES_REQUIRED emu_rawlog
   PASS_REGULAR_EXPRESSION "6000 IMU steps at 200 Hz")
+
+# Found by the bad-input battery (README, "Errors and exit codes"): flags checked
+# against their documented ranges at the command line, NaN and sentinels
+# included ('--rate nan' said "rate must be a positive number of Hz" naming no
+# flag, '--rate 1e308' ran, '--seed -1' silently meant the configuration's seed,
+# '--durations 1e-308' ended in "outage (30, 30] is empty"); values of a file
+# beyond what navimpact reads back.
+set(_x ${CMAKE_SOURCE_DIR}/datasets/adis16405_static_excerpt.csv.gz)
+set(_r ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog)
+set(_study ${CMAKE_SOURCE_DIR}/config/paper/study_navchip_uav.yaml)
+foreach(_case
+    "rate_nan|wv|--input|${_x}|--rate|nan|^navimpact: --rate: must be in \\[1, 10000\\] Hz, got nan \\(see 'navimpact wv --help'\\)$"
+    "rate_huge|fit|--input|${_x}|--structure|WN|--rate|1e308|--rate: must be in \\[1, 10000\\] Hz, got 1e308"
+    "convert_rate|model|convert|${_m}:ref|--rate|1e308|--rate: must be in \\[1, 10000\\] Hz"
+    "eff|wv|--input|${_x}|--rate|100|--robust|--eff|1|--eff: must be in \\(0, 1\\), got 1"
+    "seed_negative|study|--config|${_study}|--seed|-1|--seed: must be an integer seed in 0..18446744073709551615, got '-1'"
+    "runs_negative|study|--config|${_study}|--runs|-1|--runs: .*not in range 1 to 1000000"
+    "propagate_zero|replay|--rawlog|${_r}|--propagate-every|0|--propagate-every: .*not in range 1 to 1000"
+    "gap_nan|replay|--rawlog|${_r}|--max-imu-gap|nan|--max-imu-gap: must be in \\[0, 60\\] s, got nan"
+    "durations_tiny|diagnose|--run|${_r}|--model|${_m}:ref|--durations|10,1e-308|--durations: must be in \\[0.0001, 604800\\] s, got 1e-308")
+  string(REPLACE "|" ";" _p "${_case}")
+  list(GET _p 0 _n)
+  list(GET _p -1 _re)
+  list(SUBLIST _p 1 -1 _args)
+  list(REMOVE_AT _args -1)
+  navimpact_cli_fail(cli_error_flag_${_n} EXIT 2 ARGS ${_args} --out ${_erd}/flag_${_n} REGEX "${_re}" NOOUT ${_erd}/flag_${_n})
+endforeach()
+# robust WV efficiency outside what the biweight reaches: the range, not the solver's exception (exit 4 before)
+navimpact_cli_fail(cli_error_eff_unreachable EXIT 1 ARGS wv --input ${_x} --rate 100 --gyro-unit deg/s --acc-unit g --robust --eff 1e-308 --out ${_erd}/eff
+  REGEX "efficiency 1e-308 is outside what the biweight reaches \\(0.01237 .. 0.999985" NOOUT ${_erd}/eff)

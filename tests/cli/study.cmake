@@ -31,7 +31,7 @@ endfunction()
 _study_bad(outage_outside "study|--config|${_sdir}/outage_late.yaml|--out|${_sdir}/out_outage_outside"
            "outage .* ends at .* s, after the end of the trajectory")
 _study_bad(zero_runs "study|--config|${_sdir}/short.yaml|--out|${_sdir}/out_zero_runs|--runs|0"
-           "--runs must be >= 1")
+           "--runs: Value 0 not in range 1 to 1000000")
 _study_bad(missing_model "study|--config|${_sdir}/bad_model.yaml|--out|${_sdir}/out_missing_model"
            "candidate 'Gyro 1'.*gyro_model9")
 _study_bad(unreadable "study|--config|${_sdir}/no_such_file.yaml|--out|${_sdir}/out_unreadable"

@@ -9,7 +9,7 @@ navimpact_cli_fail(cli_sweep_bad_no_sweep_block
   ARGS sweep --config ${CMAKE_SOURCE_DIR}/config/paper/study_navchip_uav.yaml --out ${_swdir}/bad_no_sweep_block
   REGEX "outages.: not used by a sweep" NOOUT ${_swdir}/bad_no_sweep_block)
 navimpact_cli_fail(cli_sweep_bad_one_run ARGS sweep --config ${_swcfg} --out ${_swdir}/bad_one_run --runs 1
-  REGEX "--runs must be >= 2" NOOUT ${_swdir}/bad_one_run)
+  REGEX "--runs: Value 1 not in range 2 to 1000000" NOOUT ${_swdir}/bad_one_run)
 navimpact_cli_fail(cli_sweep_bad_merge_nothing ARGS sweep-merge ${_swdir}/no_such_shard --out ${_swdir}/bad_merge
   REGEX "1 of 1 folders hold no shard.*no_such_shard" NOOUT ${_swdir}/bad_merge)
 navimpact_cli_fail(cli_sweep_bad_emit_and_out

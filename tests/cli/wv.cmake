@@ -13,6 +13,12 @@ set_tests_properties(cli_wv_excerpt PROPERTIES
 navimpact_cli_check(cli_wv_excerpt_outputs CHECK wv_json DEFINES DIR=${_wv_dir}/excerpt)
 set_tests_properties(cli_wv_excerpt_outputs PROPERTIES DEPENDS cli_wv_excerpt)
 
+# A time window (--start 0 crashed: the selection's JSON was iterated after its end of life).
+add_test(NAME cli_wv_window
+  COMMAND ${NI} wv --input ${_wv_data} --rate 100 --gyro-unit deg/s --acc-unit g --start 0 --end 1000
+          --out ${_wv_dir}/window --overwrite)
+set_tests_properties(cli_wv_window PROPERTIES PASS_REGULAR_EXPRESSION "100000 samples at 100 Hz")
+
 # Rawlog input (committed, 64 samples, label XSENS): reads with the right label.
 add_test(NAME cli_wv_rawlog
   COMMAND ${NI} wv --input ${CMAKE_SOURCE_DIR}/tests/data/imu_label_xsens.rawlog --label XSENS

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 #include "wv_internal.hpp"
 
@@ -62,6 +63,12 @@ double biweightConstant(double eff) {
   double lo = 0.05, hi = 60.0;
   boost::uintmax_t it = 200;
   auto f = [eff](double c) { return biweightEfficiency(c) - eff; };
+  // an efficiency the bracket does not reach is an input error, not the
+  // solver's exception (--eff 1e-308 ended in an internal error)
+  if (!(f(lo) <= 0.0 && f(hi) >= 0.0))
+    throw Error("robust wavelet variance: efficiency " + formatNumber(eff) + " is outside what the biweight reaches (" +
+                formatNumber(biweightEfficiency(lo), 4) + " .. " + formatNumber(biweightEfficiency(hi), 6) +
+                ", tuning constants 0.05 .. 60)");
   auto r = boost::math::tools::toms748_solve(f, lo, hi, boost::math::tools::eps_tolerance<double>(50), it);
   return 0.5 * (r.first + r.second);
 }
