@@ -120,6 +120,24 @@ TEST(CsvReader, BadInputsNameFileAndLine) {
   EXPECT_NE(errorOf("/nonexistent/file.csv", o).find("/nonexistent/file.csv"), std::string::npos);
 }
 
+// Found by the bad-input battery: a value below the smallest double was "not a
+// number" (it is that close to 0); a UTF-16 CSV was sniffed as a rawlog and a
+// file with carriage returns alone for line breaks read as its header only.
+TEST(CsvReader, TextTheLinesCannotBeReadFromIsNamedAndTinyValuesAreZero) {
+  const CsvImuOptions o = degG();
+  const ImuSeries s = readImuCsv(writeFile("tiny.csv", "gyro_x,acc_x\n1e-400,1\n-1e-400,1\n"), o);
+  EXPECT_EQ(s.channels[0].x[0], 0.0);
+  EXPECT_NE(errorOf(writeFile("huge.csv", "gyro_x,acc_x\n1e400,1\n"), o).find("huge.csv:2: column 1 ('gyro_x'): '1e400' is not a number"),
+            std::string::npos);
+  const std::string utf16("\xFF\xFEg\0y\0r\0o\0_\0x\0\n\0", 16);
+  const auto u = writeFile("utf16.csv", utf16);
+  EXPECT_EQ(errorOf(u, o), u + ":1: zero bytes or a UTF-16 byte-order mark in the first line: no UTF-8 text "
+                               "(UTF-16 or UTF-32 text: save it as UTF-8)");
+  const auto cr = writeFile("cr.csv", "gyro_x,acc_x\r1,2\r3,4\r");
+  EXPECT_EQ(errorOf(cr, o), cr + ":1: line breaks are carriage returns alone (old Mac text): save it with LF or CR LF line breaks");
+  EXPECT_EQ(readImuCsv(writeFile("crlf.csv", "gyro_x,acc_x\r\n1,2\r\n3,4\r\n"), o).size(), 2u);  // CR LF is fine
+}
+
 TEST(CsvReader, ReadsTheFullStaticRecording) {
   const ImuSeries s = readImuCsv(test::dataPath("adis16405_static_1.csv.gz"), degG());
   ASSERT_EQ(s.size(), 1000000u);

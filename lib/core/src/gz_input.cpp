@@ -193,6 +193,15 @@ bool LineReader::next(std::string_view& line) {
     if (line.size() >= 3 && static_cast<unsigned char>(line[0]) == 0xEF &&
         static_cast<unsigned char>(line[1]) == 0xBB && static_cast<unsigned char>(line[2]) == 0xBF)
       line.remove_prefix(3);
+    // text the lines cannot be read from: named rather than read as one odd line
+    if (line.find('\0') != std::string_view::npos ||
+        (line.size() >= 2 && ((line[0] == '\xFF' && line[1] == '\xFE') || (line[0] == '\xFE' && line[1] == '\xFF'))))
+      throw fileError(in_.path(), 1,
+                      "zero bytes or a UTF-16 byte-order mark in the first line: no UTF-8 text (UTF-16 or UTF-32 "
+                      "text: save it as UTF-8)");
+    if (line.find('\r') != std::string_view::npos)
+      throw fileError(in_.path(), 1,
+                      "line breaks are carriage returns alone (old Mac text): save it with LF or CR LF line breaks");
   }
   return true;
 }

@@ -5,6 +5,8 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <cstdio>
 #include <memory>
@@ -71,7 +73,17 @@ bool parseDouble(std::string_view s, double& out) {
   if (s.empty()) return false;
   if (s.front() == '+') s.remove_prefix(1);
   const auto res = std::from_chars(s.data(), s.data() + s.size(), out);
-  return res.ec == std::errc() && res.ptr == s.data() + s.size();
+  if (res.ptr != s.data() + s.size()) return false;
+  if (res.ec == std::errc::result_out_of_range) {
+    // from_chars refuses both ends; a value below the smallest double (1e-400)
+    // is that close to 0 and is read as strtod rounds it, one beyond the
+    // largest (1e400) stays no number (the program keeps the "C" locale)
+    const double v = std::strtod(std::string(s).c_str(), nullptr);
+    if (!(std::abs(v) < 1.0)) return false;
+    out = v;
+    return true;
+  }
+  return res.ec == std::errc();
 }
 
 }  // namespace navimpact

@@ -147,6 +147,8 @@ bool isRawlogFile(const std::string& path) {
   if (n == 0) return false;  // empty: not a rawlog (the CSV reader reports it)
   // A UTF-8 byte-order mark starts a text (CSV) file.
   if (n == 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF) return false;
+  // So does a UTF-16 one (the CSV reader says it is one).
+  if (n >= 2 && ((b[0] == 0xFF && b[1] == 0xFE) || (b[0] == 0xFE && b[1] == 0xFF))) return false;
   // Serialized MRPT objects start with a header byte >= 0x80; CSV starts with text.
   return b[0] >= 0x80 || (b[0] < 0x20 && b[0] != '\t' && b[0] != '\n' && b[0] != '\r');
 }

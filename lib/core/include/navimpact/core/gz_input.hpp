@@ -67,7 +67,10 @@ class GzInput {
  * Lines of a plain or gzip text file, streamed, each at most @p max_line bytes:
  * a longer line is an error naming the file and line (so a one-line 300 MB
  * file costs at most max_line bytes, not the file). A UTF-8 byte-order mark at
- * the start is skipped; "\r\n" line ends are accepted.
+ * the start is skipped; "\r\n" line ends are accepted. A first line with zero
+ * bytes or a UTF-16 byte-order mark (UTF-16/32 text, or binary) or with a
+ * carriage return inside (old Mac line breaks: the whole file one line) is an
+ * error at line 1.
  */
 class LineReader {
  public:

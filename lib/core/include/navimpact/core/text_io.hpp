@@ -34,8 +34,10 @@ std::vector<std::string_view> splitView(std::string_view s, char delim);
 std::string_view trim(std::string_view s);
 
 /**
- * Parse a whole field as a double (std::from_chars, locale independent).
- * @return false when the field is empty or has trailing garbage.
+ * Parse a whole field as a double (std::from_chars, locale independent); a
+ * value below the smallest double (1e-400) is read as it rounds (0).
+ * @return false when the field is empty, has trailing garbage or exceeds the
+ *         largest double (1e400).
  */
 bool parseDouble(std::string_view s, double& out);
 
