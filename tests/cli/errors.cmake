@@ -135,3 +135,21 @@ endforeach()
 # robust WV efficiency outside what the biweight reaches: the range, not the solver's exception (exit 4 before)
 navimpact_cli_fail(cli_error_eff_unreachable EXIT 1 ARGS wv --input ${_x} --rate 100 --gyro-unit deg/s --acc-unit g --robust --eff 1e-308 --out ${_erd}/eff
   REGEX "efficiency 1e-308 is outside what the biweight reaches \\(0.01237 .. 0.999985" NOOUT ${_erd}/eff)
+# a model amplitude beyond any IMU (model show printed an ARW of inf), and an
+# emulation whose samples no reader would take back (replay refused its rawlog)
+file(WRITE ${_erd}/huge_model.yaml "rate_hz: 100\ngyroscope: \"WN(sigma=1e308)\"\n")
+navimpact_cli_fail(cli_error_model_amplitude EXIT 1 ARGS model show ${_erd}/huge_model.yaml
+  REGEX "huge_model.yaml: key 'gyro_x': .*sigma = 1e\\+308 is beyond any IMU")
+file(WRITE ${_erd}/big_model.yaml "rate_hz: 100\ngyroscope: \"WN(sigma=1e4)\"\n")
+file(WRITE ${_erd}/big_emulation.yaml "trajectory: {file: ${_traj}, end_s: 20}\nimu: {rate_hz: 100, errors: model, model: big_model.yaml}\n")
+navimpact_cli_fail(cli_error_emulated_sample_beyond_readers EXIT 1
+  ARGS emulate --config ${_erd}/big_emulation.yaml --out ${_erd}/big.rawlog
+  REGEX "big_emulation.yaml: key 'imu.model': the emulated IMU sample gyro_. = .* rad/s at t = .* is beyond any IMU .*<= 1000 rad/s; no reader would take the rawlog"
+  NOOUT ${_erd}/big.rawlog)
+# a UTC start time read partly ('0' was the year 0) and a sensor label a navimpact rawlog ignores
+file(WRITE ${_erd}/utc.yaml "trajectory: {file: ${_traj}, end_s: 20}\nimu: {errors: none}\noutput: {start_utc: '2026-02-30T00:00:00Z'}\n")
+navimpact_cli_fail(cli_error_start_utc EXIT 1 ARGS emulate --config ${_erd}/utc.yaml --out ${_erd}/utc.rawlog
+  REGEX "utc.yaml: key 'output.start_utc': must be a UTC time YYYY-MM-DDTHH:MM:SSZ from 1970 to 2286, got '2026-02-30T00:00:00Z'$"
+  NOOUT ${_erd}/utc.rawlog)
+navimpact_cli_fail(cli_error_label_on_own_rawlog EXIT 1 ARGS replay --rawlog ${_r} --imu-label XSENS --out ${_erd}/label
+  REGEX "uav_flight_260s_ref.rawlog: a rawlog navimpact wrote: its IMU entries are labelled 'IMU', not 'XSENS'" NOOUT ${_erd}/label)

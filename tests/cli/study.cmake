@@ -29,7 +29,7 @@ function(_study_bad name args regex)
   navimpact_cli_fail(cli_study_bad_${name} ARGS ${args} REGEX "${regex}" NOOUT ${_sdir}/out_${name})
 endfunction()
 _study_bad(outage_outside "study|--config|${_sdir}/outage_late.yaml|--out|${_sdir}/out_outage_outside"
-           "outage .* ends at .* s, after the end of the trajectory")
+           "outage_late.yaml: key 'outages': outage .* ends at .* s, after the end of the trajectory")
 _study_bad(zero_runs "study|--config|${_sdir}/short.yaml|--out|${_sdir}/out_zero_runs|--runs|0"
            "--runs: Value 0 not in range 1 to 1000000")
 _study_bad(missing_model "study|--config|${_sdir}/bad_model.yaml|--out|${_sdir}/out_missing_model"

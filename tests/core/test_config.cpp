@@ -249,7 +249,7 @@ TEST(Config, AnInputFileThatCannotBeReadNamesTheConfigurationAndTheKey) {
   ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0600), 0);
   const auto f = (dir / "c.yaml").string();
   std::ofstream(f) << "imu: {file: x.csv}\nfolder: folder\nfifo: fifo\nempty: ''\nlist: [a]\n"
-                      "model: nope.yaml:ref\nmodel_folder: folder:ref\n";
+                      "model: nope.yaml:ref\nmodel_folder: folder:ref\nmodel_empty: ''\n";
   const ConfigNode c = ConfigNode::load(f);
   const std::string d = dir.string() + "/";
   EXPECT_EQ(errorOf([&] { c.map("imu").inputFile("file", "the IMU CSV"); }),
@@ -265,6 +265,8 @@ TEST(Config, AnInputFileThatCannotBeReadNamesTheConfigurationAndTheKey) {
             f + ": key 'model': cannot open '" + d + "nope.yaml' (No such file or directory)");
   EXPECT_EQ(errorOf([&] { c.modelRef("model_folder"); }),
             f + ": key 'model_folder': cannot open '" + d + "folder' (Is a directory)");
+  EXPECT_EQ(errorOf([&] { c.modelRef("model_empty"); }),  // (it meant "the default model" silently)
+            f + ": key 'model_empty': must be a model FILE[:NAME], got ''");
   // a configuration itself: a FIFO is refused before it is opened (reading it would block)
   EXPECT_EQ(errorOf([&] { ConfigNode::load(d + "fifo"); }), d + "fifo: cannot open (not a regular file)");
   EXPECT_EQ(errorOf([&] { ConfigNode::readText(d + "folder"); }), d + "folder: cannot open (Is a directory)");

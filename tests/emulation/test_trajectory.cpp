@@ -1,9 +1,11 @@
 // Trajectory CSV import: the real UAV flight, the synthetic lemniscate, units,
 // and bad input.
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/emulation/trajectory.hpp"
 #include "test_support.hpp"
@@ -86,6 +88,42 @@ TEST(Trajectory, BadInputNamesFileAndLine) {
   auto badCol = nedSpec(writeCsv("ok2.csv", rows));
   badCol.col_yaw = "heading";
   EXPECT_NE(errorOf(badCol).find("'heading' not found"), std::string::npos);
+  // positions beyond the ranges of limits.hpp (a latitude of 1e300 rad was smoothed and emulated)
+  const auto far = writeCsv("far.csv", replaceLine(8, "0.06,3e7,0,0,0,0,0"));
+  EXPECT_NE(errorOf(nedSpec(far)).find("far.csv:8: column 'n': 3e+07 is out of [-2e+07, 2e+07] m"), std::string::npos)
+      << errorOf(nedSpec(far));
+  const auto deep = writeCsv("deep.csv", replaceLine(8, "0.06,0,0,20000,0,0,0"));  // 20 km below the origin
+  EXPECT_NE(errorOf(nedSpec(deep)).find("deep.csv:8: column 'd'"), std::string::npos) << errorOf(nedSpec(deep));
+  emu::TrajectorySpec geo;
+  std::string lat = "time_s,lat_rad,lon_rad,alt_m,roll_rad,pitch_rad,yaw_rad\n";
+  for (int i = 0; i < 10; ++i) lat += std::to_string(i * 0.01) + (i == 2 ? ",1e300" : ",0.8") + ",0.1,500,0,0,0\n";
+  geo.file = writeCsv("lat.csv", lat);
+  EXPECT_EQ(errorOf(geo), geo.file + ":4: column 'lat_rad': 1e+300 (5.72958e+301 deg) is out of [-90, 90] deg");
+}
+
+// The window's keys name the configuration that gave them (the CSV alone was
+// named, with "only 1 samples in the selected window").
+TEST(Trajectory, AnEmptyWindowNamesItsKey) {
+  const auto csv = writeCsv("win.csv", nedRows(20));
+  const auto dir = std::filesystem::path(csv).parent_path();
+  auto load = [&](const std::string& keys) {
+    const std::string cfg = (dir / "t.yaml").string();
+    std::ofstream(cfg) << "trajectory: {file: win.csv, system: ned, origin: {lat_deg: 46, lon_deg: 6, height_m: 400},"
+                          " attitude_unit: deg, columns: {time: t, north: n, east: e, down: d, roll: r, pitch: p, yaw: y}"
+                       << keys << "}\n";
+    emu::TrajectorySpec s;
+    s.loadFrom(navimpact::ConfigNode::load(cfg).map("trajectory"));
+    return s;
+  };
+  const std::string cfg = (dir / "t.yaml").string();
+  EXPECT_EQ(errorOf(load(", end_s: 0.02")),
+            cfg + ": key 'trajectory.end_s': only 3 samples in the selected window (need >= 8) of " + csv + " (rows 20)");
+  try {
+    load(", start_s: 5, end_s: 5");
+    ADD_FAILURE() << "end_s = start_s accepted";
+  } catch (const navimpact::Error& e) {
+    EXPECT_EQ(std::string(e.what()), cfg + ": key 'trajectory.end_s': must be after start_s (5 s), got 5");
+  }
 }
 
 TEST(Trajectory, ReadsTheUavFlight) {

@@ -142,6 +142,22 @@ TEST(ModelText, ValidateNamesTheTerm) {
   EXPECT_THROW(validate(m), navimpact::Error);
 }
 
+// An amplitude beyond the largest sample any reader accepts (1e5 in SI) is no
+// IMU's: a WN sigma of 1e308 printed an ARW of inf with exit 0. The lower end
+// stays open (a fitted WN sigma of 1e-66 loads) and so does GM T.
+TEST(ModelText, AmplitudesBeyondAnyImuAreRefused) {
+  Model m;
+  m.rate_hz = 200.0;
+  for (const char* bad : {"WN(sigma=1e308)", "GM(sigma=2e5, T=10)", "RW(gamma=1e6)", "DR(omega=-1e300)",
+                          "QN(Q=1e6)", "SIN(amp=1e9, freq=1)"}) {
+    m.terms = parseTerms(bad, 200.0);
+    const std::string e = errorOf([&] { validate(m); });
+    EXPECT_NE(e.find("is beyond any IMU (|"), std::string::npos) << bad << ": " << e;
+  }
+  m.terms = parseTerms("WN(sigma=7.2e-66) + GM(sigma=1e5, T=1e12) + RW(gamma=1e-300) + SIN(amp=1e5, freq=1)", 200.0);
+  EXPECT_NO_THROW(validate(m));
+}
+
 TEST(ModelStructure, ParsesRepetitionAndAliases) {
   using K = ProcessKind;
   EXPECT_EQ(parseStructure("WN+GM+GM+DR"), (std::vector<K>{K::WN, K::GM, K::GM, K::DR}));

@@ -213,6 +213,8 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
   ro.smoothing = cfg.smoothing;
   ro.imu_rate_hz = rate;
   ro.outages = cfg.outages;
+  if (!cfg.config_file.empty() && !cfg.outages_key.empty())
+    ro.outage_name = keyError(cfg.config_file, cfg.outages_key, "outage").what();
   ro.record_rate_hz = cfg.record_rate_hz;
   ro.outage_record_rate_hz = cfg.outage_record_rate_hz;
   ro.gnss = cfg.gnss;

@@ -143,6 +143,7 @@ std::shared_ptr<const SweepPlan> prepareSweep(const SweepConfig& cfg, const std:
         // Contiguous windows ending at every duration: GNSS stays off from
         // start to start + the longest duration, and each end is an epoch.
         sc.outages.clear();
+        sc.outages_key.clear();  // sweep.outage, named by the cell below
         double prev = 0.0;
         for (double d : cfg.durations_s) {
           sc.outages.push_back({cfg.outage_start_s + prev, cfg.outage_start_s + d});

@@ -420,6 +420,7 @@ std::string ConfigNode::inputFile(const std::string& k, const std::string& what_
 std::string ConfigNode::modelRef(const std::string& k) const {
   std::string spec;
   read(k, spec);
+  if (spec.empty() && has(k)) throw error(k, "must be a model FILE[:NAME], got ''");
   if (spec.empty()) return spec;
   if (unreadableReason(resolve(spec)).empty()) return resolve(spec);  // the whole text names a file
   const auto colon = spec.rfind(':');

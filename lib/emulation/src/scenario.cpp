@@ -1,5 +1,6 @@
 #include "navimpact/emulation/scenario.hpp"
 
+#include <ctime>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -27,12 +28,23 @@ struct Ctx {
   std::string file;
 };
 
+/// A UTC time YYYY-MM-DDTHH:MM:SSZ between 1970 and 2286 (Unix time 0 .. 1e10 s,
+/// as an import's time_zero_unix_s). Read whole and written back identically:
+/// get_time alone took "0" for the year 0 and "2026-02-30" for March 2.
 long long parseUtc(const std::string& s, const Ctx& c) {
+  const std::string what = "must be a UTC time YYYY-MM-DDTHH:MM:SSZ from 1970 to 2286, got '" + printable(s, 40) + "'";
   std::tm tm{};
   std::istringstream in(s);
-  in >> std::get_time(&tm, "%Y-%m-%dT%H:%M:%S");
-  if (in.fail()) throw keyError(c.file, "output.start_utc", "'" + s + "' is not YYYY-MM-DDTHH:MM:SSZ");
-  return static_cast<long long>(timegm(&tm));
+  in >> std::get_time(&tm, "%Y-%m-%dT%H:%M:%SZ");
+  if (in.fail() || s.size() != 20) throw keyError(c.file, "output.start_utc", what);
+  const long long t = static_cast<long long>(timegm(&tm));
+  std::tm back{};
+  const std::time_t tt = static_cast<std::time_t>(t);
+  char buf[32] = {0};
+  if (t < 0 || t > 10000000000LL || !gmtime_r(&tt, &back) ||
+      std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &back) != 20 || s != buf)
+    throw keyError(c.file, "output.start_utc", what);
+  return t;
 }
 
 std::string quote(const std::string& s) {
@@ -205,6 +217,34 @@ EmulationBudget emulationBudget(const EmulationConfig& cfg, double duration_s) {
   return b;
 }
 
+namespace {
+
+/// An emulated IMU sample within what every reader accepts (core/imu_series.hpp,
+/// maxAbsSample): navimpact must read back the rawlogs it writes (a model with
+/// a WN sigma of 1e4 rad/s wrote one that replay refused at its fifth entry).
+/// @p perfect_B: the error-free rate and specific force, to tell the trajectory's
+/// motion from the errors added to it in the message's key.
+void checkSample(const ImuRecord& r, const Eigen::Vector3d& perfect_w, const Eigen::Vector3d& perfect_f,
+                 const EmulationConfig& cfg) {
+  for (int k = 0; k < 6; ++k) {
+    const double v = k < 3 ? r.w_IB_B[k] : r.f_B[k - 3];
+    const double p = k < 3 ? perfect_w[k] : perfect_f[k - 3];
+    const double lim = k < 3 ? kMaxAbsAngularRate : kMaxAbsSpecificForce;
+    if (std::abs(v) <= lim) continue;  // (false for NaN)
+    const bool motion = !(std::abs(p) <= lim);
+    const std::string key = motion ? "trajectory.file"
+                            : !cfg.effects.none() ? "effects"
+                            : cfg.imu_errors == "static" ? "imu.static.file" : "imu.model";
+    throw keyError(cfg.config_file, key,
+                   std::string("the emulated IMU sample ") + kChannelNames[k] + " = " + formatNumber(v) +
+                       (k < 3 ? " rad/s" : " m/s^2") + " at t = " + formatNumber(r.t, 10) + " s is beyond any IMU (|value| <= " +
+                       formatNumber(lim) + (k < 3 ? " rad/s" : " m/s^2") + "; no reader would take the rawlog): " +
+                       (motion ? "the trajectory's motion" : "the errors added to it") + " are too large");
+  }
+}
+
+}  // namespace
+
 Recording runEmulation(const EmulationConfig& cfg, const std::string& version) {
   Collect c;
   runEmulation(cfg, version, c);
@@ -256,6 +296,7 @@ void runEmulation(const EmulationConfig& cfg, const std::string& version, Record
       r.t = e.imu[k].t;
       r.w_IB_B = e.imu[k].dtheta_B / e.imu[k].dt;
       r.f_B = e.imu[k].dv_B / e.imu[k].dt;
+      checkSample(r, perfect[k].dtheta_B / perfect[k].dt, perfect[k].dv_B / perfect[k].dt, cfg);
     }
     const double t1 = perfect.back().t;
     // GNSS of the true antenna (told - lever-arm error); the rawlog states the told one
@@ -316,6 +357,7 @@ void runEmulation(const EmulationConfig& cfg, const std::string& version, Record
       r.t = s.t;
       r.w_IB_B = s.dtheta_B / s.dt + Eigen::Vector3d(e[0][k], e[1][k], e[2][k]);
       r.f_B = s.dv_B / s.dt + Eigen::Vector3d(e[3][k], e[4][k], e[5][k]);
+      checkSample(r, s.dtheta_B / s.dt, s.dv_B / s.dt, cfg);
     }
     const double until = k1 == n ? std::numeric_limits<double>::infinity() : perfect.back().t;
     gnss.next(until, blk.gnss);

@@ -7,6 +7,8 @@
 #include <Eigen/Geometry>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/gz_input.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/core/units.hpp"
@@ -32,24 +34,31 @@ double angleFactor(const std::string& unit, const std::string& key, const std::s
   throw keyError(file, key, "unit '" + unit + "' is not 'rad' or 'deg'");
 }
 
+/// North and east of a local tangent-plane trajectory [m]: within half the
+/// Earth's circumference (a tangent plane is meaningless long before).
+constexpr limits::Range kNedHorizontalM{-2.0e7, 2.0e7, false, "m"};
+
 }  // namespace
 
 SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
   InputScope scope(spec.file);
   const std::string& path = spec.file;
+  // a key of the spec: named in its configuration when it has one, else with the CSV
+  const std::string keyFile = spec.config_file.empty() ? path : spec.config_file;
+  const std::string keyPrefix = spec.config_path.empty() ? "trajectory" : spec.config_path;
   const bool geo = spec.system == "geodetic";
   if (!geo && spec.system != "ned")
-    throw keyError(path, "trajectory.system", "'" + spec.system + "' is not 'geodetic' or 'ned'");
+    throw keyError(keyFile, keyPrefix + ".system", "'" + spec.system + "' is not 'geodetic' or 'ned'");
   if (!geo && !spec.origin)
-    throw keyError(path, "trajectory.origin",
+    throw keyError(keyFile, keyPrefix + ".origin",
                    "a local NED trajectory needs a geodetic origin (lat_deg, lon_deg, height_m)");
-  const double kLL = geo ? angleFactor(spec.latlon_unit, "trajectory.latlon_unit", path) : 1.0;
-  const double kAtt = angleFactor(spec.attitude_unit, "trajectory.attitude_unit", path);
+  const double kLL = geo ? angleFactor(spec.latlon_unit, keyPrefix + ".latlon_unit", keyFile) : 1.0;
+  const double kAtt = angleFactor(spec.attitude_unit, keyPrefix + ".attitude_unit", keyFile);
   double kT = 1.0;
   if (spec.time_unit == "ms") kT = 1e-3;
   else if (spec.time_unit != "s")
-    throw keyError(path, "trajectory.time_unit", "'" + spec.time_unit + "' is not 's' or 'ms'");
-  if (!(spec.max_gap_s > 0.0)) throw keyError(path, "trajectory.max_gap_s", "must be > 0");
+    throw keyError(keyFile, keyPrefix + ".time_unit", "'" + spec.time_unit + "' is not 's' or 'ms'");
+  if (!(spec.max_gap_s > 0.0)) throw keyError(keyFile, keyPrefix + ".max_gap_s", "must be > 0");
 
   LineReader reader(path);  // streamed, lines of at most 1 MiB
   std::string_view headerView;
@@ -109,8 +118,13 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
   std::size_t first = 0, last = rows.size();
   while (first < rows.size() && spec.start_s && rows[first][0] < *spec.start_s) ++first;
   while (last > first && spec.end_s && rows[last - 1][0] > *spec.end_s) --last;
-  if (last - first < 8)
-    throw fileError(path, 0, "only " + std::to_string(last - first) + " samples in the selected window (need >= 8)");
+  if (last - first < 8) {
+    const std::string what = "only " + std::to_string(last - first) + " samples in the selected window (need >= 8)";
+    if ((spec.start_s || spec.end_s) && !spec.config_file.empty())  // the window's keys chose them
+      throw keyError(spec.config_file, keyPrefix + (spec.end_s ? ".end_s" : ".start_s"),
+                     what + " of " + printable(path, 120) + " (rows " + std::to_string(rows.size()) + ")");
+    throw fileError(path, 0, what);
+  }
 
   const auto& r0 = rows[first];
   if (geo) out.origin = spec.origin ? *spec.origin : earth::Geodetic{r0[1] * kLL, r0[2] * kLL, r0[3]};
@@ -122,8 +136,25 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
   for (std::size_t i = first; i < last; ++i) {
     const auto& r = rows[i];
     out.t.push_back(r[0]);
-    if (geo) out.p_L.push_back(earth::geodeticToNed(out.origin, earth::Geodetic{r[1] * kLL, r[2] * kLL, r[3]}));
-    else out.p_L.emplace_back(r[1], r[2], r[3]);
+    // positions within the ranges of limits.hpp (a latitude of 1e300 rad went
+    // through the smoothing and emulated a run; the filter failed at t = 0)
+    auto within = [&](int k, double v, const limits::Range& rg, double to_unit) {
+      if (!(v * to_unit >= rg.lo && v * to_unit <= rg.hi))
+        throw fileError(path, lines[i], "column '" + want[k] + "': " + formatNumber(r[k]) +
+                                            (to_unit == 1.0 ? "" : " (" + formatNumber(v * to_unit) + " " + rg.unit + ")") +
+                                            " is out of " + limits::describe(rg));
+    };
+    if (geo) {
+      within(1, r[1] * kLL, limits::kLatitudeDeg, 180.0 / units::kPi);
+      within(2, r[2] * kLL, limits::kLongitudeDeg, 180.0 / units::kPi);
+      within(3, r[3], limits::kHeightM, 1.0);
+      out.p_L.push_back(earth::geodeticToNed(out.origin, earth::Geodetic{r[1] * kLL, r[2] * kLL, r[3]}));
+    } else {
+      within(1, r[1], kNedHorizontalM, 1.0);
+      within(2, r[2], kNedHorizontalM, 1.0);
+      within(3, -r[3], limits::kHeightM, 1.0);
+      out.p_L.emplace_back(r[1], r[2], r[3]);
+    }
     Eigen::Vector3d a(r[4] * kAtt, r[5] * kAtt, r[6] * kAtt);
     if (std::abs(a[1]) > 85.0 * units::kDeg)
       throw fileError(path, lines[i], "|pitch| > 85 deg: Euler-angle smoothing is singular there");
@@ -250,6 +281,10 @@ void TrajectorySpec::loadFrom(const ConfigNode& n) {
   n.read("max_gap_s", max_gap_s, limits::kDurationS);
   n.read("start_s", start_s, limits::kFileTimeS);
   n.read("end_s", end_s, limits::kFileTimeS);
+  if (start_s && end_s && !(*end_s > *start_s))
+    throw n.error("end_s", "must be after start_s (" + formatNumber(*start_s, 10) + " s), got " + formatNumber(*end_s, 10));
+  config_file = n.file();
+  config_path = n.path();
 }
 
 void SmoothingOptions::loadFrom(const ConfigNode& n) {

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <deque>
+#include <tuple>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -320,6 +321,13 @@ RawlogReader::RawlogReader(const std::string& path, const RawlogReadOptions& opt
     m.head.notices = f.notices;
     return;
   }
+  // navimpact writes its labels (IMU, GNSS, ...): another label given for one
+  // of its rawlogs would be ignored, so it is refused
+  for (const auto& [given, own, flag] : {std::tuple{opt.imu_label, "IMU", "imu_label"}, {opt.gnss_label, "GNSS", "gnss_label"}})
+    if (!given.empty() && given != own)
+      throw Error(printable(path, 160) + ": a rawlog navimpact wrote: its " + own + " entries are labelled '" + own +
+                  "', not '" + printable(given, 40) + "' (" + flag + " / --" + (own == std::string("IMU") ? "imu" : "gnss") +
+                  "-label is for rawlogs other tools wrote)");
   if (!first) {
     m.end = true;
     return;

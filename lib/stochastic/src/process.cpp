@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
+#include "navimpact/core/imu_series.hpp"
 #include "kind.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 
@@ -113,6 +115,14 @@ void validate(const Model& m) {
       else if (!std::isfinite(v))
         throw Error("model '" + formatTerms(m.terms) + "': " + termLabel(m, i) + ": " + par.key +
                     " must be finite");
+      // An amplitude (a parameter in the signal's unit u) beyond the largest sample
+      // any reader accepts is no IMU's (a WN sigma of 1e308 printed an ARW of inf,
+      // and emulated rawlogs no reader took). Lower ends stay open: a fitted WN
+      // sigma may legitimately be 1e-66.
+      if (par.unit[0] == 'u' && std::abs(v) > kMaxAbsSpecificForce)
+        throw Error("model '" + formatTerms(m.terms) + "': " + termLabel(m, i) + ": " + par.key + " = " +
+                    formatNumber(v) + " is beyond any IMU (|" + par.key + "| <= " + formatNumber(kMaxAbsSpecificForce) +
+                    " in SI, the largest sample the readers accept)");
     }
     const std::string msg = def.check(p, m.rate_hz);
     if (!msg.empty())

@@ -96,6 +96,8 @@ struct StudyConfig {
   bool use_baro = true;                    ///< false: the filter gets no barometer at all (sweep axis)
   /// Outages relative to the first trajectory time [s] (start, end]; default (200, 260].
   std::vector<Outage> outages;
+  /// The key that gave the outages, named with config_file when one is outside the run ("" = not a key: a sweep's own axis).
+  std::string outages_key = "outages";
   std::size_t runs = 100;                  ///< Monte Carlo runs, >= 1
   std::uint64_t seed = 1;                  ///< study seed
   unsigned threads = 0;                    ///< 0 = all hardware threads

@@ -146,7 +146,8 @@ class ConfigNode {
   /// "Permission denied", "Is a directory", "not a regular file").
   std::string inputFile(const std::string& k, const std::string& what_for) const;
   /// A model reference FILE[:NAME], FILE resolved against the file's folder
-  /// when relative and checked like inputFile() ("" when absent). A colon at
+  /// when relative and checked like inputFile() ("" when absent; an empty text
+  /// is an error, not the default). A colon at
   /// position 0 or followed by a name containing '/' belongs to the path, and
   /// so does every colon when the whole text names a file.
   std::string modelRef(const std::string& k) const;

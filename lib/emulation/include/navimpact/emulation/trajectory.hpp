@@ -50,6 +50,10 @@ struct TrajectorySpec {
   double max_gap_s = 0.25;            ///< largest time step the spline may bridge [s]
   std::optional<double> start_s;      ///< keep samples with time >= start_s (file time) [s]
   std::optional<double> end_s;        ///< keep samples with time <= end_s (file time) [s]
+  /// The configuration and the dotted path of the `trajectory:` map that gave
+  /// these keys (loadFrom), so that errors about them name the configuration;
+  /// "" for a spec built in code (then the CSV is named).
+  std::string config_file, config_path;
 
   /// Read the keys of a `trajectory:` map (file, system, columns, latlon_unit,
   /// attitude_unit, time_unit, origin {lat_deg, lon_deg, height_m}, max_gap_s,
