@@ -501,8 +501,11 @@ RunnerUp runnerUp(const BlockMeans& bm, const std::vector<Extension>& ext, const
   if (bm.hasSlow(win) && bm.usable()) {
     double l_slow = kNaN, t_shift = kNaN, size_shift = kNaN;
     double aic_slow = kNaN;
-    for (const auto& r : exact.ranked)
-      if (r.second == best) aic_slow = r.first;
+    // The winner's exact AIC as ranked, unless the slow decision replaced
+    // its slow terms (then the replacement's own).
+    if (!sc.swapped)
+      for (const auto& r : exact.ranked)
+        if (r.second == best) aic_slow = r.first;
     if (!std::isfinite(aic_slow)) aic_slow = bm.exactAic(win, &l_slow);
     const double aic_shift = bm.bestShiftAic(S, &t_shift, &size_shift);
     // The shift is the runner-up when it is closer than the slow one (by
