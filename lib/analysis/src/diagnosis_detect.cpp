@@ -264,13 +264,11 @@ void removeOutliers(const ChannelContext& ctx, std::vector<double>& x, ChannelDi
   f.channel = cd.name;
   f.cause = Cause::Outliers;
   double maxz = 0, maxa = 0, longest = 0;
-  int samples = 0;
   for (const auto& e : orr.events) {
     f.times_s.push_back(t0 + static_cast<double>(e.peak) / rate);
     maxz = std::max(maxz, e.peak_z);
     maxa = std::max(maxa, std::abs(e.peak_value));
     longest = std::max(longest, static_cast<double>(e.last - e.first + 1) / rate);
-    samples += e.exceedances;
     cd.outlier_events.push_back({t0 + static_cast<double>(e.first) / rate,
                                  static_cast<double>(e.last - e.first + 1) / rate, e.peak_value});
   }

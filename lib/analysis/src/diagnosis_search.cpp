@@ -518,6 +518,7 @@ RunnerUp runnerUp(const BlockMeans& bm, const std::vector<Extension>& ext, const
     if (std::isfinite(aic_slow) && std::isfinite(aic_shift) && closer) {
       ru.p = kNaN;
       ru.draws = 0;
+      ru.larger = false;
       ru.causes = causeName(Cause::LevelShift);
       ru.detail = "a level shift of " + formatNumber(size_shift, 3) + " " + bm.ctx.unit + " at t = " + formatNumber(t_shift, 6) +
                   " s (exact likelihood of " + std::to_string(bm.y.size()) + " block means: AIC " +
