@@ -360,6 +360,23 @@ ExactRanking rankSlowExactly(const BlockMeans& bm, const std::vector<Extension>&
   return out;
 }
 
+/// A slow term as the slow decision fitted it, with its profile interval.
+Candidate exactCandidate(const slow::Term& t) {
+  Candidate c;
+  c.kind = t.proc.kind;
+  c.proc = t.proc;
+  c.params = c.kind == ProcessKind::GM ? 2 : 1;
+  if (c.kind == ProcessKind::GM) {
+    c.T_lo = t.lo;
+    c.T_hi = t.hi;
+    c.T_hi_open = c.T_top_only = t.open_top;
+  } else {
+    c.p_lo = t.lo;
+    c.p_hi = t.hi;
+  }
+  return c;
+}
+
 /// The slow decision on the exact likelihood of the block means
 /// (diagnosis_slow.hpp) for @p chosen, an extension of the terms found
 /// @p S: it may replace the WV's slow terms by the slow explanation the
@@ -386,9 +403,15 @@ slow::Choice decideSlow(const BlockMeans& bm, const std::vector<Candidate>& S, c
   sp.base = withoutSin(assemble(m0n, fast_terms));
   sp.fast_pen = penalty(fast_terms, S.size());
   sp.wv_start = withoutSin(assemble(m0n, chosen.terms));
+  bool retunes = false;
   for (std::size_t q = chosen.terms.size() - chosen.added; q < chosen.terms.size(); ++q)
-    if (bm.isSlow(chosen.terms[q]) && chosen.terms[q].kind != ProcessKind::DR)
-      sp.wv_own.push_back(assembledIndex(m0n, chosen.terms, q));
+    if (bm.isSlow(chosen.terms[q])) {
+      const int k = assembledIndex(m0n, chosen.terms, q);
+      if (chosen.terms[q].kind != ProcessKind::DR) sp.wv_own.push_back(k);
+      sp.wv_idx.push_back(k);
+      retunes = retunes || chosen.terms[q].retune;
+    }
+  if (retunes) sp.wv_idx.clear();
   sp.wv_pen = penalty(chosen.terms, chosen.terms.size() - chosen.added);
   sp.wv_text = newTermsText(chosen);
   sp.y = &bm.y;
@@ -400,26 +423,33 @@ slow::Choice decideSlow(const BlockMeans& bm, const std::vector<Candidate>& S, c
   if (sc.decided_here && sc.swapped) {
     Extension e;
     e.terms = fast_terms;
-    for (const auto& t : sc.terms) {
-      Candidate c;
-      c.kind = t.proc.kind;
-      c.proc = t.proc;
-      c.params = c.kind == ProcessKind::GM ? 2 : 1;
-      if (c.kind == ProcessKind::GM) {
-        c.T_lo = t.lo;
-        c.T_hi = t.hi;
-        c.T_hi_open = c.T_top_only = t.open_top;
-      } else {
-        c.p_lo = t.lo;
-        c.p_hi = t.hi;
-      }
-      e.terms.push_back(c);
-    }
+    for (const auto& t : sc.terms) e.terms.push_back(exactCandidate(t));
     e.added = static_cast<int>(e.terms.size() - S.size());
     e.deviance = wvDeviance(full.nu, wvOf(assemble(m0n, e.terms), full.tau), full.dof);
     e.crit = e.deviance + penalty(e.terms);
     e.valid = true;
     chosen = e;
+  } else if (sc.decided_here && sc.terms.size() == sp.wv_idx.size()) {
+    // The WV's choice kept: its random walks as the exact likelihood fits
+    // them, with the profile interval (the WV's own interval treats its
+    // scales as independent and is too narrow for a random walk, whose
+    // coarse scales are strongly correlated). A drift keeps its WV fit,
+    // a GM its WV fit of T (the block means blur a T near the block length).
+    std::size_t k = 0;
+    for (std::size_t q = chosen.terms.size() - chosen.added; q < chosen.terms.size(); ++q) {
+      Candidate& c = chosen.terms[q];
+      if (!bm.isSlow(c)) continue;
+      const slow::Term& t = sc.terms[k++];
+      if (c.kind == ProcessKind::RW && t.proc.kind == ProcessKind::RW) c = exactCandidate(t);
+    }
+    chosen.deviance = wvDeviance(full.nu, wvOf(assemble(m0n, chosen.terms), full.tau), full.dof);
+    chosen.crit = chosen.deviance + penalty(chosen.terms);
+    // The decision's words name the kept explanation as it now stands.
+    const std::string now = newTermsText(chosen);
+    for (std::string* t : {&sc.evidence, &sc.runner_up_detail})
+      for (std::size_t at = t->find(sp.wv_text); !sp.wv_text.empty() && at != std::string::npos;
+           at = t->find(sp.wv_text, at + now.size()))
+        t->replace(at, sp.wv_text.size(), now);
   }
   return sc;
 }

@@ -307,6 +307,7 @@ Choice decide(const Problem& pr) {
   wv.start = pr.wv_start;
   wv.own = pr.wv_own;
   wv.pen = pr.wv_pen;
+  wv.slow_idx = pr.wv_idx;
   wv.from_wv = true;
   fitSet(wv);
 
@@ -448,8 +449,9 @@ Choice decide(const Problem& pr) {
   ch.causes = w.causes;
   ch.swapped = !w.from_wv;
 
-  // The winner's slow terms with their 95 % profile intervals.
-  if (ch.swapped) {
+  // The winner's slow terms with their 95 % profile intervals, also when
+  // they are the WV's (the caller takes a kept random walk's from here).
+  if (w.slow_idx.size() == w.slow.size()) {
     for (int i : w.slow_idx) {
       Term t;
       t.proc = w.fit.model.terms[static_cast<std::size_t>(i)];

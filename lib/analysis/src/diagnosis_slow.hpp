@@ -37,6 +37,10 @@ struct Problem {
   std::vector<int> wv_own;
   double wv_pen = 0;
   std::vector<Cause> wv_slow;
+  /// Its slow new terms (drift included) in wv_start, in the order they
+  /// were added; empty when one of them retunes a term of the model (then
+  /// only a swap reports exact-likelihood parameters).
+  std::vector<int> wv_idx;
   std::string wv_text;                    ///< its new terms in words
   const std::vector<double>* y = nullptr; ///< block means of the cleaned record
   std::size_t block = 1;                  ///< samples per block
@@ -54,7 +58,7 @@ struct Term {
 struct Choice {
   bool decided_here = false;              ///< false: too few blocks or nothing fitted; the caller keeps its own
   bool swapped = false;                   ///< the chosen slow terms differ from the WV stage's
-  std::vector<Term> terms;                ///< the chosen slow terms (when swapped: to replace the WV's)
+  std::vector<Term> terms;                ///< the chosen slow terms as fitted on the exact likelihood (to replace the WV's)
   std::string causes;                     ///< chosen causes ('+'-joined, sorted), fast ones included
   std::string evidence;                   ///< one clause: what the exact likelihood said
   // The runner-up that leaves the choice most open (empty: none compared).
