@@ -9,6 +9,16 @@ set(_dg_u --rate 100 --gyro-unit deg/s --acc-unit g)
 # model file loads back.
 navimpact_cli_check(cli_diagnose_excerpt_wn CHECK diagnose_excerpt DEFINES DATA=${_dg_data} OUT=${_dg_out}/wn)
 
+# The whole ADIS16405 recording 1 (tests/data) with fit:auto: its models have
+# long GMs and drifts, whose retuning the slow decision decides (it crashed
+# there, reading the exact-likelihood terms of a retuned slow term it had not
+# fitted). Diagnosed to the end, every output written.
+add_test(NAME cli_diagnose_adis_recording_fit_auto
+  COMMAND ${NI} diagnose --input ${CMAKE_SOURCE_DIR}/tests/data/adis16405_static_1.csv.gz ${_dg_u} --model fit:auto
+          --out ${_dg_out}/adis1_auto --overwrite)
+set_tests_properties(cli_diagnose_adis_recording_fit_auto PROPERTIES
+  PASS_REGULAR_EXPRESSION "wrote .*diagnosis.json, report.md, model_extended.yaml")
+
 # Bad input: each fails before any work with a one-line error naming the problem.
 navimpact_cli_fail(cli_diagnose_missing_model EXIT 1 NOOUT ${_dg_out}/bad1
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model /nonexistent/model.yaml --out ${_dg_out}/bad1

@@ -429,7 +429,7 @@ slow::Choice decideSlow(const BlockMeans& bm, const std::vector<Candidate>& S, c
     e.crit = e.deviance + penalty(e.terms);
     e.valid = true;
     chosen = e;
-  } else if (sc.decided_here && sc.terms.size() == sp.wv_idx.size()) {
+  } else if (sc.decided_here && !sc.terms.empty() && sc.terms.size() == sp.wv_idx.size()) {
     // The WV's choice kept: its random walks as the exact likelihood fits
     // them, with the profile interval (the WV's own interval treats its
     // scales as independent and is too narrow for a random walk, whose
@@ -438,7 +438,7 @@ slow::Choice decideSlow(const BlockMeans& bm, const std::vector<Candidate>& S, c
     std::size_t k = 0;
     for (std::size_t q = chosen.terms.size() - chosen.added; q < chosen.terms.size(); ++q) {
       Candidate& c = chosen.terms[q];
-      if (!bm.isSlow(c)) continue;
+      if (!bm.isSlow(c) || k >= sc.terms.size()) continue;
       const slow::Term& t = sc.terms[k++];
       if (c.kind == ProcessKind::RW && t.proc.kind == ProcessKind::RW) c = exactCandidate(t);
     }
