@@ -347,11 +347,15 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   // 3. Level shifts and knocks.
   const bool outliers_or_lines = !cd.findings.empty();
   const auto wv_pre = gmwm::waveletVariance(x.data(), ctx.n, ctx.rate);
-  const bool shifts_or_knocks = removeLevelShifts(ctx, wv_pre, x, cd);
+  ShiftsLeft shifts_left;
+  const bool shifts_or_knocks = removeLevelShifts(ctx, wv_pre, x, cd, shifts_left);
   sh.tick(ctx.name + ": level shifts");
-  // 4. The WV against the model, then the cause of the broadband misfit.
+  // 4. The WV against the model, then the cause of the broadband misfit;
+  // then the shifts a random walk took up in step 3, against what it found.
   const WvCheck w = checkWv(sh, ctx, raw, x, wv_pre, outliers_or_lines, shifts_or_knocks, cd);
   const std::vector<Candidate> found = searchCauses(ctx, x, w, cd);
+  const std::vector<Finding> left = shiftsTheSearchLeft(ctx, x, shifts_left, merged(ctx.m0n, found));
+  cd.findings.insert(cd.findings.end(), left.begin(), left.end());
   // 5. The extension.
   const int added_params = extendModel(ctx, x, w, found, lines, cd);
   cd.adequate = cd.findings.empty();

@@ -168,7 +168,8 @@ void removeTransients(const ChannelContext& ctx, const std::vector<detect::Trans
 /// shifts are findings, removed from @p x; the others a note. Returns
 /// whether a shift was accepted.
 bool removeShifts(const ChannelContext& ctx, const std::vector<detect::ChangePoint>& changes,
-                  const Model& ext0_model, int p_ext0, std::vector<double>& x, ChannelDiagnosis& cd) {
+                  const Model& ext0_model, int p_ext0, std::vector<double>& x, ChannelDiagnosis& cd,
+                  ShiftsLeft& left) {
   const double rate = ctx.rate, t0 = ctx.t0;
   const std::size_t n = ctx.n;
   const Budget& B = ctx.B;
@@ -240,6 +241,12 @@ bool removeShifts(const ChannelContext& ctx, const std::vector<detect::ChangePoi
     cd.notes.push_back(std::to_string(K) + " candidate level shift(s) not tested (" + failed +
                        "): left to the wavelet-variance analysis");
   } else {
+    left.index = idx;
+    left.lr_ext0.clear();
+    for (const auto& t : st.tests) left.lr_ext0.push_back(t.lr);
+    left.ext0 = ext0;
+    left.how = how;
+    left.lr_thr = lr_thr;
     cd.notes.push_back(std::to_string(K) + " candidate level shift(s) are explained as well by " + ext0 +
                        " (likelihood ratio up to " + formatNumber([&] {
                          double v = 0;
@@ -368,7 +375,7 @@ std::vector<detect::SpectralLine> removeLines(const ChannelContext& ctx, std::ve
 }
 
 bool removeLevelShifts(const ChannelContext& ctx, const gmwm::WaveletVariance& wv_pre, std::vector<double>& x,
-                       ChannelDiagnosis& cd) {
+                       ChannelDiagnosis& cd, ShiftsLeft& left) {
   detect::ChangePointOptions cpo;
   cpo.max_transient = static_cast<std::size_t>(std::floor(ctx.rate));  // transients last at most 1 s
   auto cpr = shiftCandidates(ctx, x, cpo);
@@ -380,8 +387,58 @@ bool removeLevelShifts(const ChannelContext& ctx, const gmwm::WaveletVariance& w
     removeTransients(ctx, cpr.transients, x, cd);
     changed = true;
   }
-  if (!cpr.changes.empty() && removeShifts(ctx, cpr.changes, ext0, p_ext0, x, cd)) changed = true;
+  if (!cpr.changes.empty() && removeShifts(ctx, cpr.changes, ext0, p_ext0, x, cd, left)) changed = true;
   return changed;
+}
+
+std::vector<Finding> shiftsTheSearchLeft(const ChannelContext& ctx, const std::vector<double>& x,
+                                         const ShiftsLeft& left, const Model& found_model) {
+  if (left.index.empty()) return {};
+  detect::StepTestOptions o;
+  o.add_random_walk = false;
+  detect::StepTestResult sm;
+  try {
+    sm = detect::testLevelShifts(x, found_model, left.index, ctx.B.steps, o);
+  } catch (const Error&) {
+    return {};
+  }
+  const bool extended = found_model.terms.size() != ctx.m0n.terms.size();
+  const std::string against =
+      extended ? "the model with the terms found, " + stochastic::formatTerms(found_model.terms, 3) : std::string("the model as given");
+  std::vector<Finding> out;
+  for (std::size_t q = 0; q < sm.tests.size(); ++q) {
+    const auto& t = sm.tests[q];
+    if (!t.accepted) continue;
+    const double tt = ctx.t0 + static_cast<double>(left.index[q]) / ctx.rate;
+    const double lr_ext0 = q < left.lr_ext0.size() ? left.lr_ext0[q] : std::numeric_limits<double>::quiet_NaN();
+    Finding f;
+    f.channel = ctx.name;
+    f.cause = Cause::LevelShift;
+    f.params = {{"size", t.size}, {"t_s", tt}};
+    f.intervals.push_back({"size", {t.size - 1.96 * t.size_se, t.size + 1.96 * t.size_se}});
+    f.range_key = "t_s";
+    f.range_lo = f.range_hi = tt;
+    f.statistic = t.lr;
+    f.threshold = left.lr_thr;
+    f.p_value = t.p_value;
+    f.explanation = "a level shift of " + formatNumber(t.size, 3) + " " + ctx.unit + " at t = " + formatNumber(tt, 6) +
+                    " s (" + formatNumber(std::abs(t.size) / std::max(t.size_se, 1e-300), 3) +
+                    " standard errors), or a wandering level neither the model nor the terms found have.";
+    f.evidence = "likelihood ratio " + formatNumber(t.lr, 4) + " for a shift here against " + against +
+                 " (the same test without a random walk; p = " + formatNumber(t.p_value, 3) + "); against " + left.ext0 +
+                 ", the best explanation without shifts, a random walk allowed, only " + formatNumber(lr_ext0, 4) + " (" +
+                 left.how + ")";
+    f.runner_up = causeName(Cause::RandomWalk);
+    f.runner_up_detail = left.ext0 + " with a random walk, the best stochastic explanation without shifts (likelihood ratio of the shift " +
+                         formatNumber(lr_ext0, 4) + " below " + formatNumber(left.lr_thr, 4) + ")";
+    f.aic_margin = lr_ext0 - 4.0;  // the shift's size and time, as for an accepted shift
+    f.decided = false;
+    f.action = "look at the record around t = " + formatNumber(tt, 6) +
+               " s: segment it there if the level jumped (a stationary filter state cannot represent a one-off "
+               "jump), else add a random walk to the model";
+    out.push_back(f);
+  }
+  return out;
 }
 
 }  // namespace navimpact::analysis::detail

@@ -242,8 +242,29 @@ std::vector<detect::SpectralLine> removeLines(const ChannelContext& ctx, std::ve
 /// the block boundaries (detect/step_test.hpp); accepted shifts are removed
 /// from @p x. Transients of at most 1 s (knocks), tested at their own scale,
 /// are outlier events, interpolated out. Returns whether @p x changed.
+///
+/// When no shift beats that explanation, the candidates are left in
+/// @p left for shiftsTheSearchLeft (after the cause search).
+struct ShiftsLeft {
+  std::vector<std::size_t> index;  ///< candidate sample indices
+  std::vector<double> lr_ext0;     ///< their likelihood ratios against the explanation without shifts
+  std::string ext0, how;           ///< that explanation and its test, in words
+  double lr_thr = 0;               ///< the test's threshold (chi2_1, Bonferroni over the block boundaries)
+};
 bool removeLevelShifts(const ChannelContext& ctx, const gmwm::WaveletVariance& wv_pre, std::vector<double>& x,
-                       ChannelDiagnosis& cd);
+                       ChannelDiagnosis& cd, ShiftsLeft& left);
+
+/// The candidate shifts of step 3 that a random walk took up, tested again
+/// once the cause search is done: against the user's model with the terms
+/// it found, @p found_model (variances profiled, no random walk added; the
+/// same level and threshold). A shift significant there is something
+/// neither the model nor the terms found explain, which the explanation
+/// without shifts took up as a random walk: an undecided level-shift
+/// finding, that random walk its runner-up. Without terms found, the test
+/// is step 3's under the user's model alone, at its level.
+std::vector<Finding> shiftsTheSearchLeft(const ChannelContext& ctx, const std::vector<double>& x,
+                                         const ShiftsLeft& left, const Model& found_model);
+
 
 /// Per-scale comparison of a measured WV with a model WV @p nu_m under
 /// chi-square(@p dof), significant below @p p_thr; the simulation envelope
