@@ -102,6 +102,9 @@ set -o pipefail
 # -- run ----------------------------------------------------------------------
 LIMIT=(-max_total_time="$SECS")
 [ -n "${NAVIMPACT_FUZZ_RUNS:-}" ] && LIMIT=(-runs="$NAVIMPACT_FUZZ_RUNS")
+# wall-clock bound of one target: its time, the corpus load, one 10 s timeout
+# and its report (NAVIMPACT_FUZZ_WALL overrides; with NAVIMPACT_FUZZ_RUNS, 30 min)
+WALL=${NAVIMPACT_FUZZ_WALL:-$(( ${NAVIMPACT_FUZZ_RUNS:+1800 + }SECS * 2 + 120 ))}
 # ASan: smaller quarantine so that RSS stays a measure of the readers' memory
 export ASAN_OPTIONS=${ASAN_OPTIONS:-quarantine_size_mb=64:malloc_context_size=20}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
@@ -110,8 +113,24 @@ echo "fuzz: ${#TARGETS[@]} targets, ${LIMIT[*]} each, $JOBS at a time; corpus $B
 run_one() {
   local t=$1 log=$B/logs/$1.log rc=0
   # shellcheck disable=SC2086
-  $B/bin/fuzz_$t "${LIMIT[@]}" -rss_limit_mb=1024 -malloc_limit_mb=1024 -timeout=10 -print_final_stats=1 \
-    -artifact_prefix=$B/findings/$t/ ${NAVIMPACT_FUZZ_ARGS:-} $B/corpus/$t $S/$t > "$log" 2>&1 || rc=$?
+  # libFuzzer's own limits end a slow or large input, but its handlers can
+  # hang (an out-of-memory report stopped the process for good): the run is
+  # killed WALL seconds after it should have ended and the input it was
+  # reading kept as hang-<sha1>.
+  timeout -k 10 "$WALL" $B/bin/fuzz_$t "${LIMIT[@]}" -rss_limit_mb=1024 -malloc_limit_mb=1024 -timeout=10 \
+    -print_final_stats=1 -artifact_prefix=$B/findings/$t/ ${NAVIMPACT_FUZZ_ARGS:-} $B/corpus/$t $S/$t \
+    > "$log" 2>&1 || rc=$?
+  if [ $rc -eq 124 ] || [ $rc -eq 137 ]; then
+    local input
+    input=$(sed -n 's/^navimpact fuzz: each input is written to //p' "$log" | head -1)
+    if [ -n "$input" ] && [ -f "$input" ]; then
+      cp "$input" "$B/findings/$t/hang-$(sha1sum < "$input" | cut -c1-40)"
+      echo "Test unit written to $B/findings/$t/hang-$(sha1sum < "$input" | cut -c1-40)" >> "$log"
+      local dir=${input%%/root/config/case/*}
+      [[ $dir == */navimpact-fuzz-* ]] && rm -rf "$dir"
+    fi
+    echo "navimpact fuzz: SUMMARY: the run did not end and was killed after $WALL s" >> "$log"
+  fi
   local execs rate rss
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
@@ -121,7 +140,7 @@ run_one() {
       "${rate:-?}" "${rss:-?}" "$(ls $B/corpus/$t | wc -l)"
   else
     printf 'fuzz %-18s FAILED (exit %s) after %s executions: see %s\n' "$t" "$rc" "${execs:-?}" "$log"
-    grep -E "ERROR|navimpact fuzz|SUMMARY|Test unit written|runtime error" "$log" | head -8 | cut -c1-300
+    grep -E "ERROR|navimpact fuzz|SUMMARY|Test unit written|runtime error" "$log" | grep -v "each input is written to" | head -8 | cut -c1-300
     echo "  keep the input: cp $B/findings/$t/<file> tests/fuzz/regressions/$t/ (and fix the reader)"
   fi
   return $rc

@@ -147,6 +147,24 @@ TEST(Config, TextsYamlCppMisreadsAreRefusedNamingFileAndPlace) {
   EXPECT_NE(deep.find(": YAML syntax error: nested deeper than "), std::string::npos) << deep;
 }
 
+// Found by the libFuzzer run (tests/fuzz/regressions/covariance_config): on a
+// ',' where a document starts yaml-cpp 0.7 builds nodes without end (a 61-byte
+// configuration took 3.6 GB in 9 s, and the fuzzing harness hung in its
+// out-of-memory handler). Refused after a bounded parse, naming file and place.
+TEST(Config, TextOnWhichYamlCppDoesNotEndIsRefusedNamingFileAndPlace) {
+  const std::string e = errorOf([] { doc(","); });
+  EXPECT_EQ(e.rfind("cfg.yaml:1:1: YAML syntax error: the YAML parser (yaml-cpp) does not come to an end", 0), 0u) << e;
+  const std::string f = errorOf([] { doc("# a comment\n# another\n  , nor@th(4t\n"); });
+  EXPECT_EQ(f.rfind("cfg.yaml:3:3: YAML syntax error: the YAML parser (yaml-cpp) does not come to an end", 0), 0u) << f;
+  // what YAML allows with few bytes per node stays within the bound
+  EXPECT_EQ(errorOf([] { doc("a: [" + std::string(20000, ',') + "]\nb: " + std::string(2000, '[') + "\n"); })
+                .find("does not come to an end"),
+            std::string::npos);
+  std::string many = "a: &a 1\nb: [";
+  for (int i = 0; i < 20000; ++i) many += "*a,";
+  EXPECT_EQ(errorOf([&] { doc(many + "]\nc:\n" + std::string(100, '-') + "\n"); }), "(no error)");
+}
+
 TEST(Config, WrongTypeSaysWhatWasExpectedAndWhatCame) {
   const ConfigNode c = doc("flag: perhaps\nn: [1, 2]\nseed: -5\nv: [1, 2]\nmode: fast\nk: 2.5\n"
                            "text: {a: 1}\nsigma_m: two\nlong: " + std::string(300, 'x') + "\n");

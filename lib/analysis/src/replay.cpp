@@ -24,6 +24,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/text_io.hpp"
+#include "navimpact/core/yaml_load.hpp"
 #include "navimpact/filter/error_model.hpp"
 #include "navimpact/filter/model_entry.hpp"
 #include "navimpact/rawlog/reader.hpp"
@@ -481,7 +482,7 @@ void ReplayDriver::run() {
   origin_ = head.origin;
 
   try {
-    if (!head.metadata.empty()) scen_ = YAML::Load(head.metadata)["navimpact_scenario"];
+    if (!head.metadata.empty()) scen_ = loadYaml(head.metadata)["navimpact_scenario"];
   } catch (const YAML::Exception&) {
   }
   // IMU model of the filter.

@@ -2,6 +2,7 @@
 #include "navimpact/core/config.hpp"
 
 #include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -10,8 +11,10 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "navimpact/core/text_io.hpp"
+#include "navimpact/core/yaml_load.hpp"
 
 namespace navimpact {
 
@@ -25,6 +28,54 @@ struct ConfigNode::Doc {
   std::string file;
   fs::path dir;
 };
+
+namespace {
+
+/// Counts the parser's events and gives up beyond a bound (loadAllYaml).
+class EventBudget : public YAML::EventHandler {
+ public:
+  explicit EventBudget(std::size_t cap) : cap_(cap) {}
+  void OnDocumentStart(const YAML::Mark& m) override { tick(m); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& m, YAML::anchor_t) override { tick(m); }
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { tick(m); }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string&) override { tick(m); }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    tick(m);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    tick(m);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void tick(const YAML::Mark& m) {
+    if (++n_ > cap_)
+      throw YAML::ParserException(m, "the YAML parser (yaml-cpp) does not come to an end on this text; "
+                                     "it is malformed near here");
+  }
+  std::size_t n_ = 0;
+  std::size_t cap_;
+};
+
+}  // namespace
+
+std::vector<YAML::Node> loadAllYaml(const std::string& text) {
+  {
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    EventBudget budget(4 * text.size() + 64);
+    while (parser.HandleNextDocument(budget)) {
+    }
+  }
+  return YAML::LoadAll(text);
+}
+
+YAML::Node loadYaml(const std::string& text) {
+  std::vector<YAML::Node> docs = loadAllYaml(text);
+  return docs.empty() ? YAML::Node() : docs.front();
+}
 
 namespace {
 
@@ -147,7 +198,7 @@ ConfigNode ConfigNode::parse(const std::string& text, const std::string& file) {
   checkCharacters(text, file);
   std::vector<YAML::Node> docs;
   try {
-    docs = YAML::LoadAll(text);
+    docs = loadAllYaml(text);
   } catch (const YAML::DeepRecursion& e) {
     throw Error(file + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
                 ": YAML syntax error: nested deeper than " + std::to_string(e.depth()) + " levels");

@@ -12,6 +12,7 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/units.hpp"
+#include "navimpact/core/yaml_load.hpp"
 
 namespace navimpact::import {
 
@@ -134,7 +135,7 @@ std::vector<std::string> exportRun(const Recording& d, const fs::path& dir) {
     std::optional<double> sigma = d.baro.front().sigma_m;
     if (!sigma && !d.metadata.empty()) {  // a rawlog keeps the barometer's sigma in its scenario
       try {
-        const YAML::Node b = YAML::Load(d.metadata)["navimpact_scenario"]["baro"];
+        const YAML::Node b = loadYaml(d.metadata)["navimpact_scenario"]["baro"];
         if (b && b["sigma_m"]) sigma = b["sigma_m"].as<double>();
       } catch (const YAML::Exception&) {
       }

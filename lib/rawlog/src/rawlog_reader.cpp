@@ -21,6 +21,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
+#include "navimpact/core/yaml_load.hpp"
 
 namespace navimpact::rawlog {
 
@@ -62,7 +63,7 @@ struct RawlogReader::Impl {
   void readComment(const mrpt::obs::CObservationComment& c) {
     head.metadata = c.text;
     try {
-      const YAML::Node y = YAML::Load(c.text)["navimpact_scenario"];
+      const YAML::Node y = loadYaml(c.text)["navimpact_scenario"];
       if (y && y["origin"]) {
         origin = {y["origin"]["lat_deg"].as<double>() * M_PI / 180, y["origin"]["lon_deg"].as<double>() * M_PI / 180,
                   y["origin"]["height_m"].as<double>()};

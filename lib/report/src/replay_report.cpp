@@ -14,6 +14,7 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/yaml_load.hpp"
 #include "navimpact/plot/figure.hpp"
 #include "navimpact/report/timing.hpp"
 
@@ -405,7 +406,7 @@ std::string summaryFrom(const ReplayResult& r, const ReplayWriter::State& st) {
   j["ekf_states"] = r.run.states;
   j["ground_truth"] = r.run.has_truth;
   try {
-    const YAML::Node s = YAML::Load(r.scenario_yaml)["navimpact_scenario"];
+    const YAML::Node s = loadYaml(r.scenario_yaml)["navimpact_scenario"];
     if (s) {
       json seeds;
       for (const char* k : {"imu", "gnss", "baro"})

@@ -74,6 +74,9 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
   fs::create_directory_symlink(src / "config/models", g_dir / "root/config/models");
   fs::create_directory_symlink(src / "datasets", g_dir / "root/datasets");
   g_input = (g_dir / "root/config/case" / (std::string("input") + g_target->extension)).string();
+  // scripts/fuzz.sh keeps this file when it has to kill a run that hangs
+  // (libFuzzer writes no artifact then): it holds the input being read.
+  std::fprintf(stderr, "navimpact fuzz: each input is written to %s\n", g_input.c_str());
   return 0;
 }
 
