@@ -104,7 +104,7 @@ ImuModel modelFrom(const ConfigNode& root, std::string name) {
   ImuModel m;
   if (names.empty()) {
     if (!name.empty())
-      throw Error(file + ": holds a single model (no 'models:' map); cannot select '" + name +
+      throw Error(file + ": holds a single model (no 'models:' map); cannot select '" + printable(name) +
                   "' - use '" + file + "' alone");
     m = readModel(root, 0.0);
     m.source = file;
@@ -116,13 +116,13 @@ ImuModel modelFrom(const ConfigNode& root, std::string name) {
     if (name.empty()) {
       if (names.size() != 1)
         throw Error(file + ": holds " + std::to_string(names.size()) +
-                    " models; select one as FILE:NAME (available: " + join(names) + ")");
+                    " models; select one as FILE:NAME (available: " + printable(join(names), 200) + ")");
       name = names.front();
     }
     bool found = false;
     for (const auto& n : names) found = found || n == name;
     if (!found)
-      throw Error(file + ": no model named '" + name + "' (available: " + join(names) + ")");
+      throw Error(file + ": no model named '" + printable(name) + "' (available: " + printable(join(names), 200) + ")");
     m = readModel(root.map("models").child(name), rate);
     m.name = name;
     m.source = file + ":" + name;
