@@ -192,6 +192,20 @@ TEST(RawlogWriter, AbsoluteTimeIsKeptWithoutAScenarioTimeBase) {
   EXPECT_NEAR(b.imu.front().t, d.imu.front().t - 10.0, 1e-6);
 }
 
+// A scenario comment on which yaml-cpp 0.7 builds nodes without end (a ','
+// where the document starts) is refused naming the rawlog and its entry; it
+// used to take all memory (replay, diagnose --run, import of a rawlog).
+TEST(RawlogReader, ScenarioCommentYamlCppCannotEndIsRefusedNamingTheEntry) {
+  Recording d = sample();
+  d.metadata = ", navimpact_scenario";
+  const auto p = (navimpact::test::tempDir() / "endless_comment.rawlog").string();
+  navimpact::rawlog::writeRawlog(p, d, {false, 0});
+  const auto e = errorOf(p);
+  EXPECT_NE(e.find("endless_comment.rawlog: entry "), std::string::npos) << e;
+  EXPECT_NE(e.find("scenario comment is not valid YAML"), std::string::npos) << e;
+  EXPECT_NE(e.find("does not come to an end"), std::string::npos) << e;
+}
+
 TEST(RawlogWriter, TruncatedFileNamesTheEntry) {
   const auto dir = navimpact::test::tempDir();
   const auto p = (dir / "full.rawlog").string();
