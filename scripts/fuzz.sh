@@ -10,7 +10,8 @@
 # per input. The corpus libFuzzer grows is kept in build-fuzz/corpus/<target>
 # (a later run goes on from it). Any crash, sanitizer report, leak, timeout or
 # allocation above 1 GiB fails the script; the input is kept as
-# build-fuzz/findings/<target>/crash-* (or leak-*, timeout-*, oom-*): copy it
+# build-fuzz/findings/<target>/crash-* (or leak-*, timeout-*, oom-*, or hang-* when a
+# run had to be killed 2 x SECONDS_PER_TARGET + 120 s after it started): copy it
 # to tests/fuzz/regressions/<target>/ (read by every CTest run) and fix it.
 # Environment:
 #   NAVIMPACT_FUZZ_RUNS=N    stop each target after N executions instead of a time
