@@ -9,6 +9,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstring>
 #include <deque>
 #include <tuple>
 #include <filesystem>
@@ -27,6 +28,16 @@ namespace navimpact::rawlog {
 
 using mrpt::obs::CObservationIMU;
 namespace gnss = mrpt::obs::gnss;
+
+namespace {
+/// A bool MRPT deserialised byte for byte: any byte but 0 is true (a byte of
+/// 255 read as a bool is undefined behaviour; found by the libFuzzer run).
+bool storedTrue(const bool& b) {
+  unsigned char c = 0;
+  std::memcpy(&c, &b, 1);
+  return c != 0;
+}
+}  // namespace
 using detail::kTick;
 using detail::kUnknownAttitudeVar;
 using detail::T_FLUtoFRD;
@@ -240,7 +251,7 @@ struct RawlogReader::Impl {
       f.t = t;
       if (!head.lever_arm_B && (g->sensorPose.x() != 0 || g->sensorPose.y() != 0 || g->sensorPose.z() != 0))
         head.lever_arm_B = T_FLUtoFRD() * Eigen::Vector3d(g->sensorPose.x(), g->sensorPose.y(), g->sensorPose.z());
-      if (const auto* p = g->getMsgByClassPtr<gnss::Message_TOPCON_PZS>(); p && p->hasCartesianPosVel) {
+      if (const auto* p = g->getMsgByClassPtr<gnss::Message_TOPCON_PZS>(); p && storedTrue(p->hasCartesianPosVel)) {
         const Eigen::Vector3d r_E(p->cartesian_x, p->cartesian_y, p->cartesian_z);
         f.pos = earth::ecefToGeodetic(r_E);
         const Eigen::Matrix3d C_EtoN = earth::C_EtoN(f.pos.lat, f.pos.lon);
