@@ -104,7 +104,7 @@ set -o pipefail
 LIMIT=(-max_total_time="$SECS")
 [ -n "${NAVIMPACT_FUZZ_RUNS:-}" ] && LIMIT=(-runs="$NAVIMPACT_FUZZ_RUNS")
 # wall-clock bound of one target: its time, the corpus load, one 10 s timeout
-# and its report (NAVIMPACT_FUZZ_WALL overrides; with NAVIMPACT_FUZZ_RUNS, 30 min)
+# and its report (NAVIMPACT_FUZZ_WALL overrides; with NAVIMPACT_FUZZ_RUNS, 30 min more)
 WALL=${NAVIMPACT_FUZZ_WALL:-$(( ${NAVIMPACT_FUZZ_RUNS:+1800 + }SECS * 2 + 120 ))}
 # ASan: smaller quarantine so that RSS stays a measure of the readers' memory
 export ASAN_OPTIONS=${ASAN_OPTIONS:-quarantine_size_mb=64:malloc_context_size=20}
@@ -125,8 +125,10 @@ run_one() {
     local input
     input=$(sed -n 's/^navimpact fuzz: each input is written to //p' "$log" | head -1)
     if [ -n "$input" ] && [ -f "$input" ]; then
-      cp "$input" "$B/findings/$t/hang-$(sha1sum < "$input" | cut -c1-40)"
-      echo "Test unit written to $B/findings/$t/hang-$(sha1sum < "$input" | cut -c1-40)" >> "$log"
+      local kept
+      kept=$B/findings/$t/hang-$(sha1sum < "$input" | cut -c1-40)
+      cp "$input" "$kept"
+      echo "Test unit written to $kept" >> "$log"
       local dir=${input%%/root/config/case/*}
       [[ $dir == */navimpact-fuzz-* ]] && rm -rf "$dir"
     fi

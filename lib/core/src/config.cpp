@@ -59,26 +59,6 @@ class EventBudget : public YAML::EventHandler {
   std::size_t cap_;
 };
 
-}  // namespace
-
-std::vector<YAML::Node> loadAllYaml(const std::string& text) {
-  {
-    std::istringstream in(text);
-    YAML::Parser parser(in);
-    EventBudget budget(4 * text.size() + 64);
-    while (parser.HandleNextDocument(budget)) {
-    }
-  }
-  return YAML::LoadAll(text);
-}
-
-YAML::Node loadYaml(const std::string& text) {
-  std::vector<YAML::Node> docs = loadAllYaml(text);
-  return docs.empty() ? YAML::Node() : docs.front();
-}
-
-namespace {
-
 std::string join(const std::string& path, const std::string& k) { return path.empty() ? k : path + "." + k; }
 
 /// What a value looks like, for ", got ...": a scalar quoted and bounded, else its kind.
@@ -182,6 +162,22 @@ double numberOf(const YAML::Node& v, const limits::Range& r, const std::string& 
 }
 
 }  // namespace
+
+std::vector<YAML::Node> loadAllYaml(const std::string& text) {
+  {
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    EventBudget budget(4 * text.size() + 64);
+    while (parser.HandleNextDocument(budget)) {
+    }
+  }
+  return YAML::LoadAll(text);
+}
+
+YAML::Node loadYaml(const std::string& text) {
+  std::vector<YAML::Node> docs = loadAllYaml(text);
+  return docs.empty() ? YAML::Node() : docs.front();
+}
 
 ConfigNode::ConfigNode(std::shared_ptr<const Doc> doc, std::shared_ptr<const Node> node, std::string path)
     : doc_(std::move(doc)), node_(std::move(node)), path_(std::move(path)) {}

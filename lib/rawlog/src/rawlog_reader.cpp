@@ -28,6 +28,10 @@ namespace navimpact::rawlog {
 
 using mrpt::obs::CObservationIMU;
 namespace gnss = mrpt::obs::gnss;
+using detail::kTick;
+using detail::kUnknownAttitudeVar;
+using detail::T_FLUtoFRD;
+using detail::T_NtoENU;
 
 namespace {
 /// A bool MRPT deserialised byte for byte: any byte but 0 is true (a byte of
@@ -38,10 +42,6 @@ bool storedTrue(const bool& b) {
   return c != 0;
 }
 }  // namespace
-using detail::kTick;
-using detail::kUnknownAttitudeVar;
-using detail::T_FLUtoFRD;
-using detail::T_NtoENU;
 
 struct RawlogReader::Impl {
   std::string path;
