@@ -143,7 +143,10 @@ run_one() {
       "${rate:-?}" "${rss:-?}" "$(ls $B/corpus/$t | wc -l)"
   else
     printf 'fuzz %-18s FAILED (exit %s) after %s executions: see %s\n' "$t" "$rc" "${execs:-?}" "$log"
-    grep -E "ERROR|navimpact fuzz|SUMMARY|Test unit written|runtime error" "$log" | grep -v "each input is written to" | head -8 | cut -c1-300
+    # the seed and (for inputs up to a few KB) libFuzzer's Base64 of the input:
+    # enough to reproduce a finding from a CI log alone
+    grep -E "INFO: Seed:|ERROR|navimpact fuzz|SUMMARY|Test unit written|runtime error|^Base64:" "$log" \
+      | grep -v "each input is written to" | head -10 | cut -c1-6000
     echo "  keep the input: cp $B/findings/$t/<file> tests/fuzz/regressions/$t/ (and fix the reader)"
   fi
   return $rc

@@ -7,10 +7,17 @@ bash scripts/deps.sh
 bash scripts/build.sh
 # libFuzzer harnesses of the input readers, each for a bounded time
 # (NAVIMPACT_FUZZ_SECONDS per target, default 20; 0 skips): scripts/fuzz.sh
+# (its report is printed again after the tests, where a log's tail shows it)
 fuzz_rc=0
+fuzz_log=build-fuzz/fuzz-report.txt
 if [ "${NAVIMPACT_FUZZ_SECONDS:-20}" != 0 ]; then
-  bash scripts/fuzz.sh "${NAVIMPACT_FUZZ_SECONDS:-20}" || fuzz_rc=$?
+  mkdir -p build-fuzz
+  bash scripts/fuzz.sh "${NAVIMPACT_FUZZ_SECONDS:-20}" 2>&1 | tee "$fuzz_log" || fuzz_rc=$?
 fi
 cd build
 ctest --output-on-failure -j "${JOBS:-$(nproc)}" "$@"
-[ $fuzz_rc -eq 0 ] || { echo "test: the libFuzzer run found a failing input (see 'fuzz' lines above)"; exit 1; }
+if [ $fuzz_rc -ne 0 ]; then
+  echo "test: the libFuzzer run found a failing input; its report again:"
+  grep -v -E "^fuzz [a-z_]+ +ok:" "../$fuzz_log" | tail -40
+  exit 1
+fi

@@ -18,3 +18,7 @@ navimpact_cli_fail(cli_sweep_bad_emit_and_out
 navimpact_cli_fail(cli_sweep_bad_too_many_shards
   ARGS sweep --config ${_swcfg} --emit-slurm ${_swdir}/bad_shards --shards 9
   REGEX "--shards 9 is more than the 8 runs" NOOUT ${_swdir}/bad_shards)
+navimpact_cli_fail(cli_sweep_bad_outage_past_end
+  ARGS sweep --config ${CMAKE_SOURCE_DIR}/tests/data/bad/sweep_outage_past_end.yaml --out ${_swdir}/bad_past_end
+  REGEX "sweep_outage_past_end.yaml: [^\n]*key 'sweep.outage.durations_s.2.': the outage of 40 s from 30 s ends at 70 s, after the end of the trajectory"
+  NOOUT ${_swdir}/bad_past_end)

@@ -215,6 +215,7 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
   ro.outages = cfg.outages;
   if (!cfg.config_file.empty() && !cfg.outages_key.empty())
     ro.outage_name = keyError(cfg.config_file, cfg.outages_key, "outage").what();
+  ro.outage_names = cfg.outage_names;
   ro.record_rate_hz = cfg.record_rate_hz;
   ro.outage_record_rate_hz = cfg.outage_record_rate_hz;
   ro.gnss = cfg.gnss;

@@ -142,11 +142,16 @@ std::shared_ptr<const SweepPlan> prepareSweep(const SweepConfig& cfg, const std:
         sc.use_baro = cfg.baro[b];
         // Contiguous windows ending at every duration: GNSS stays off from
         // start to start + the longest duration, and each end is an epoch.
+        // Each window is named in messages by the duration the user wrote.
         sc.outages.clear();
-        sc.outages_key.clear();  // sweep.outage, named by the cell below
+        sc.outages_key.clear();
+        sc.outage_names.clear();
         double prev = 0.0;
-        for (double d : cfg.durations_s) {
+        for (std::size_t k = 0; k < cfg.durations_s.size(); ++k) {
+          const double d = cfg.durations_s[k];
           sc.outages.push_back({cfg.outage_start_s + prev, cfg.outage_start_s + d});
+          sc.outage_names.push_back("key 'sweep.outage.durations_s[" + std::to_string(k) + "]': the outage of " +
+                                    formatNumber(d) + " s from " + formatNumber(cfg.outage_start_s) + " s");
           prev = d;
         }
         std::shared_ptr<const StudyPlan> sp;

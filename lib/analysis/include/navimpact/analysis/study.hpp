@@ -98,6 +98,8 @@ struct StudyConfig {
   std::vector<Outage> outages;
   /// The key that gave the outages, named with config_file when one is outside the run ("" = not a key: a sweep's own axis).
   std::string outages_key = "outages";
+  /// When set, one per outage, naming it in messages in place of the key (a sweep: "key 'sweep.outage.durations_s[k]': ...").
+  std::vector<std::string> outage_names;
   std::size_t runs = 100;                  ///< Monte Carlo runs, >= 1
   std::uint64_t seed = 1;                  ///< study seed
   unsigned threads = 0;                    ///< 0 = all hardware threads

@@ -75,5 +75,9 @@ std::vector<Outage> outagesEvery(const OutagePattern& p, double aided_from_s, do
 ///         "WHAT S:D starts before the previous outage ends (outages in time order, no overlap)".
 void checkOutages(const std::vector<Outage>& outages, double span_s, const std::string& after,
                   const std::string& what = "outage");
+/// As above, with each outage named by @p names[i] in place of "WHAT S:D"
+/// (a sweep names the configuration key its window came from); names.size() == outages.size().
+void checkOutages(const std::vector<Outage>& outages, double span_s, const std::string& after,
+                  const std::vector<std::string>& names);
 
 }  // namespace navimpact
