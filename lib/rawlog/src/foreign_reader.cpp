@@ -10,6 +10,7 @@
 #include <map>
 
 #include "foreign_reader.hpp"
+#include "frames.hpp"
 #include "navimpact/core/error.hpp"
 
 namespace navimpact::rawlog::detail {
@@ -17,14 +18,8 @@ namespace navimpact::rawlog::detail {
 namespace {
 
 namespace gnss = mrpt::obs::gnss;
-constexpr double kTick = 1e-7;
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kKnot = 1852.0 / 3600.0;
-
-const Eigen::Matrix3d& T_FLUtoFRD() {
-  static const Eigen::Matrix3d T = Eigen::Vector3d(1, -1, -1).asDiagonal();
-  return T;
-}
 
 Eigen::Matrix3d rotationOf(const mrpt::poses::CPose3D& p) {
   Eigen::Matrix3d R;
@@ -91,13 +86,13 @@ Recording readForeignRawlog(EntryReader& reader, const RawlogReadOptions& opt) {
     if (auto g = std::dynamic_pointer_cast<mrpt::obs::CObservationGPS>(o)) {
       GnssFix f;
       bool pos = false;
-      if (const auto* p = g->getMsgByClassPtr<gnss::Message_TOPCON_PZS>(); p && p->hasCartesianPosVel) {
+      if (const auto* p = g->getMsgByClassPtr<gnss::Message_TOPCON_PZS>(); p && storedTrue(p->hasCartesianPosVel)) {
         f.pos = earth::ecefToGeodetic(Eigen::Vector3d(p->cartesian_x, p->cartesian_y, p->cartesian_z));
         const Eigen::Matrix3d C_EtoN = earth::C_EtoN(f.pos.lat, f.pos.lon);
         const Eigen::Vector3d v_E(p->cartesian_vx, p->cartesian_vy, p->cartesian_vz);
         if (v_E.allFinite()) f.v_N.emplace() = C_EtoN * v_E;
-        if (p->hasPosCov) f.cov_pos_N.emplace() = C_EtoN * p->pos_covariance.asEigen().topLeftCorner<3, 3>().cast<double>() * C_EtoN.transpose();
-        if (p->hasVelCov && f.v_N) f.cov_vel_N.emplace() = C_EtoN * p->vel_covariance.asEigen().topLeftCorner<3, 3>().cast<double>() * C_EtoN.transpose();
+        if (storedTrue(p->hasPosCov)) f.cov_pos_N.emplace() = C_EtoN * p->pos_covariance.asEigen().topLeftCorner<3, 3>().cast<double>() * C_EtoN.transpose();
+        if (storedTrue(p->hasVelCov) && f.v_N) f.cov_vel_N.emplace() = C_EtoN * p->vel_covariance.asEigen().topLeftCorner<3, 3>().cast<double>() * C_EtoN.transpose();
         pos = true;
       } else if (const auto* p = g->getMsgByClassPtr<gnss::Message_TOPCON_PZS>(); p && p->Fix > 0) {
         f.pos = {p->latitude_degrees * kDeg, p->longitude_degrees * kDeg, p->height_meters};

@@ -3,6 +3,8 @@
 
 #include <Eigen/Core>
 
+#include <cstring>
+
 namespace navimpact::rawlog::detail {
 
 constexpr double kTick = 1e-7;  ///< MRPT Clock resolution [s]
@@ -20,5 +22,15 @@ inline const Eigen::Matrix3d& T_FLUtoFRD() {
 }
 /// Attitude variance that stands for "no attitude known" (sigma 1e6 rad).
 constexpr double kUnknownAttitudeVar = 1e12;
+
+/// A bool MRPT deserialised byte for byte (Message_TOPCON_PZS hasCartesianPosVel,
+/// hasPosCov, hasVelCov): any byte but 0 is true. Reading a stored 255 as a bool
+/// is undefined behaviour (found twice by the libFuzzer runs of rawlog), so
+/// every such flag of a read entry goes through this.
+inline bool storedTrue(const bool& b) {
+  unsigned char c = 0;
+  std::memcpy(&c, &b, 1);
+  return c != 0;
+}
 
 }  // namespace navimpact::rawlog::detail

@@ -30,18 +30,9 @@ using mrpt::obs::CObservationIMU;
 namespace gnss = mrpt::obs::gnss;
 using detail::kTick;
 using detail::kUnknownAttitudeVar;
+using detail::storedTrue;
 using detail::T_FLUtoFRD;
 using detail::T_NtoENU;
-
-namespace {
-/// A bool MRPT deserialised byte for byte: any byte but 0 is true (a byte of
-/// 255 read as a bool is undefined behaviour; found by the libFuzzer run).
-bool storedTrue(const bool& b) {
-  unsigned char c = 0;
-  std::memcpy(&c, &b, 1);
-  return c != 0;
-}
-}  // namespace
 
 struct RawlogReader::Impl {
   std::string path;
@@ -261,11 +252,11 @@ struct RawlogReader::Impl {
         if (!(v_E.allFinite() || v_E.array().isNaN().all()))
           throw Error(where(label, t) + ": GNSS velocity is not finite");
         if (v_E.allFinite()) f.v_N.emplace() = C_EtoN * v_E;
-        if (p->hasPosCov) {
+        if (storedTrue(p->hasPosCov)) {
           const Eigen::Matrix3d c = p->pos_covariance.asEigen().topLeftCorner<3, 3>().cast<double>();
           f.cov_pos_N.emplace() = C_EtoN * c * C_EtoN.transpose();
         }
-        if (p->hasVelCov) {
+        if (storedTrue(p->hasVelCov)) {
           const Eigen::Matrix3d c = p->vel_covariance.asEigen().topLeftCorner<3, 3>().cast<double>();
           f.cov_vel_N.emplace() = C_EtoN * c * C_EtoN.transpose();
         }
