@@ -15,6 +15,9 @@ navimpact_cli_fail(cli_error_mrpt_cause_imu_reader EXIT 1
 navimpact_cli_fail(cli_error_mrpt_cause_replay_reader EXIT 1
   ARGS replay --rawlog ${_bad}/unregistered_class.rawlog --out ${_erd}/o2
   REGEX "unregistered_class.rawlog: entry 2: .*stored object has class 'mrpt::poses\\\\xC7:CPose3D'")
+navimpact_cli_fail(cli_error_mrpt_abstract_class EXIT 1
+  ARGS replay --rawlog ${_bad}/abstract_class.rawlog --out ${_erd}/o2a
+  REGEX "^navimpact: [^\n]*abstract_class.rawlog: entry 0: an object of class 'mrpt::obs::CObservation', which MRPT cannot create \\(an abstract class\\): malformed entry$")
 
 # CLI11: one line, exit 2, pointing at the command's --help.
 navimpact_cli_fail(cli_error_cli_range EXIT 2 ARGS emulate --config x.yaml --out ${_erd}/x.rawlog --gzip-level 12

@@ -48,6 +48,18 @@ TEST(RawlogBadInput, UnregisteredClassNamesTheCause) {
              {": entry 2: ", "stored object has class 'mrpt::poses\\xC7:CPose3D' which is not registered"});
 }
 
+// An entry of class mrpt::obs::CObservation (abstract: MRPT has no
+// constructor for it and printed a line to stderr before failing; found by
+// the libFuzzer corpus through the CLI): refused before MRPT sees the name,
+// nothing printed.
+TEST(RawlogBadInput, AbstractClassIsRefusedWithoutPrinting) {
+  testing::internal::CaptureStderr();
+  expectBoth(bad("abstract_class.rawlog"), "IMU",
+             {bad("abstract_class.rawlog"), ": entry 0: an object of class 'mrpt::obs::CObservation'",
+              "which MRPT cannot create (an abstract class)"});
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+}
+
 TEST(RawlogBadInput, TrailingGarbageAfterTheGzipDataIsAnError) {
   const auto src = test::sourcePath("tests/data/imu_label_xsens.rawlog");  // gzip
   const auto p = (test::tempDir() / "tail.rawlog").string();

@@ -3,6 +3,7 @@
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/obs/registerAllClasses.h>
+#include <mrpt/rtti/CObject.h>
 
 #include <algorithm>
 #include <cstring>
@@ -17,7 +18,23 @@ namespace navimpact::rawlog::detail {
 size_t GzCStream::Read(void* out, size_t n) {
   if (error) return 0;
   try {
-    return in_.read(out, n);
+    const std::size_t got = in_.read(out, n);
+    // An object header naming a class MRPT registers without a constructor
+    // (an abstract one: CObservation, CSerializable, ...): MRPT would print a
+    // line to stderr and then fail. Refused here, before MRPT sees the name.
+    if (name_len_ > 0 && got == n && n == name_len_) {
+      // (up to a NUL byte, as MRPT makes a C string of it)
+      const std::string name(static_cast<const char*>(out), strnlen(static_cast<const char*>(out), n));
+      const auto* id = mrpt::rtti::findRegisteredClass(name);
+      if (id && !id->ptrCreateObject) {
+        error = Error(in_.path() + ": an object of class '" + printable(name, 60) +
+                      "', which MRPT cannot create (an abstract class): malformed entry");
+        return 0;
+      }
+    }
+    const auto b = n == 1 && got == 1 ? *static_cast<const unsigned char*>(out) : 0;
+    name_len_ = b != 255 && (b & 0x80) ? std::size_t(b & 0x7F) : 0;
+    return got;
   } catch (const Error& e) {
     error = e;
     return 0;

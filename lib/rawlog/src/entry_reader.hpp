@@ -28,6 +28,9 @@ class GzCStream : public mrpt::io::CStream {
 
  private:
   GzInput& in_;
+  /// Length of the class name MRPT reads next (its object header is one byte
+  /// 0x80 | L, then the L bytes of the name in one read), or 0.
+  std::size_t name_len_ = 0;
 };
 
 /**
