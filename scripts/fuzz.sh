@@ -75,6 +75,10 @@ for f in config/paper/study*.yaml; do seed study_config "$(basename "$f")" < "$f
 for t in covariance_config replay_config emulation_config study_config; do  # every configuration to every loader
   for f in config/*/*.yaml; do seed $t "other_$(basename "$f")" < "$f"; done
 done
+seed import_manifest katwijk_7s.yaml < tests/fuzz/import_run/manifest.yaml
+head_gz tests/fuzz/import_run/imu.csv.gz 150 | seed import_csv katwijk_imu.csv
+seed import_csv katwijk_gnss.csv < tests/fuzz/import_run/gnss.csv
+seed import_csv katwijk_reference.csv < tests/fuzz/import_run/reference.csv
 for t in imu_rawlog rawlog; do
   plain tests/data/imu_label_xsens.rawlog | seed $t mrpt_sample_xsens.rawlog
   for f in tests/data/bad/*.rawlog; do plain "$f" | seed $t "bad_$(basename "$f")"; done

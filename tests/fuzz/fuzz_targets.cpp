@@ -11,6 +11,8 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/emulation/scenario.hpp"
 #include "navimpact/emulation/trajectory.hpp"
+#include "navimpact/import/csv_columns.hpp"
+#include "navimpact/import/manifest.hpp"
 #include "navimpact/rawlog/imu_reader.hpp"
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/core/text_io.hpp"
@@ -70,6 +72,22 @@ const std::vector<Target>& targets() {
          }
        }},
       {"rawlog", ".rawlog", [](const std::string& p) { (void)rawlog::readRawlog(p); }},
+      // navimpact import: the manifest (its streams: tests/fuzz/import_run, the
+      // first 7 s of the Katwijk run) and the CSV column reader of its streams.
+      {"import_manifest", ".yaml", [](const std::string& p) { (void)import::importManifest(p); }},
+      {"import_csv", ".csv",
+       [](const std::string& p) {
+         try {  // an IMU stream, else a GNSS stream with per-fix sigmas that may be empty
+           (void)import::readColumns(p, {{"t_s", "imu.time.column"},
+                                         {"gyro_x", "imu.gyro.columns[0]"},
+                                         {"acc_z", "imu.acc.columns[2]"}});
+         } catch (const Error& e) {
+           if (std::string(e.what()).find("no column 'gyro_x'") == std::string::npos) throw;
+           (void)import::readColumns(p, {{"t_s", "gnss.time.column"},
+                                         {"lat_deg", "gnss.position.lat"},
+                                         {"std_n_m", "gnss.sigma.columns[0]", true}});
+         }
+       }},
   };
   return t;
 }

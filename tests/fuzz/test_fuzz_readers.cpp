@@ -85,6 +85,9 @@ std::map<std::string, std::vector<std::string>> seeds(const fs::path& dir) {
   const std::vector<std::string> rl = {gunzip(emu), gunzip(test::dataPath("imu_label_xsens.rawlog"))};
   s["imu_rawlog"] = rl;
   s["rawlog"] = rl;
+  s["import_manifest"] = {slurp(src("tests/fuzz/import_run/manifest.yaml"))};
+  s["import_csv"] = {headLines(gunzip(src("tests/fuzz/import_run/imu.csv.gz")), 150),
+                     slurp(src("tests/fuzz/import_run/gnss.csv"))};
   return s;
 }
 
@@ -161,13 +164,14 @@ std::string mutate(std::string s, const std::vector<std::string>& pool, std::mt1
 }
 
 /// A fresh temporary folder mirroring the source layout (root/config/case for
-/// the input, root/config/models and root/datasets linked) so that relative
+/// the input, root/config/models, root/datasets and root/tests linked) so that relative
 /// paths in configurations resolve as in config/.
 fs::path mirror() {
   const fs::path dir = test::tempDir();
   fs::create_directories(dir / "root/config/case");
   fs::create_directory_symlink(test::sourcePath("config/models"), dir / "root/config/models");
   fs::create_directory_symlink(test::sourcePath("datasets"), dir / "root/datasets");
+  fs::create_directory_symlink(test::sourcePath("tests"), dir / "root/tests");
   return dir;
 }
 
@@ -230,6 +234,8 @@ TEST(FuzzReaders, EmulationConfig) { fuzzTarget("emulation_config"); }
 TEST(FuzzReaders, StudyConfig) { fuzzTarget("study_config"); }
 TEST(FuzzReaders, ImuRawlog) { fuzzTarget("imu_rawlog"); }
 TEST(FuzzReaders, Rawlog) { fuzzTarget("rawlog"); }
+TEST(FuzzReaders, ImportManifest) { fuzzTarget("import_manifest"); }
+TEST(FuzzReaders, ImportCsv) { fuzzTarget("import_csv"); }
 
 // Every input a fuzzing run found (tests/fuzz/regressions/<target>/...) is read
 // or refused with one error line.

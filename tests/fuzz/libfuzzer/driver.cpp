@@ -3,7 +3,7 @@
 // (build-fuzz/bin/fuzz_<target>, links made by CMake) or by the environment
 // variable NAVIMPACT_FUZZ_TARGET. Each input is written to a file in a private
 // temporary folder that mirrors the source layout (root/config/case/input.EXT,
-// with root/config/models and root/datasets linked to the source tree), so that
+// with root/config/models, root/datasets and root/tests linked to the source tree), so that
 // relative paths in configurations resolve as they do in config/, and read
 // with fuzz::runOne: read, or refused with one navimpact::Error line. Anything
 // else (another exception, an error message of more than one line, a single
@@ -73,6 +73,7 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
   fs::create_directories(g_dir / "root/config/case");
   fs::create_directory_symlink(src / "config/models", g_dir / "root/config/models");
   fs::create_directory_symlink(src / "datasets", g_dir / "root/datasets");
+  fs::create_directory_symlink(src / "tests", g_dir / "root/tests");
   g_input = (g_dir / "root/config/case" / (std::string("input") + g_target->extension)).string();
   // scripts/fuzz.sh keeps this file when it has to kill a run that hangs
   // (libFuzzer writes no artifact then): it holds the input being read.
