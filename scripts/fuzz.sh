@@ -72,7 +72,8 @@ for f in config/paper/covariance*.yaml; do seed covariance_config "$(basename "$
 for f in config/replay/*.yaml; do seed replay_config "$(basename "$f")" < "$f"; done
 for f in config/emulation/*.yaml; do seed emulation_config "$(basename "$f")" < "$f"; done
 for f in config/paper/study*.yaml; do seed study_config "$(basename "$f")" < "$f"; done
-for t in covariance_config replay_config emulation_config study_config; do  # every configuration to every loader
+for f in config/sweep/*.yaml tests/data/sweep_small.yaml; do seed sweep_config "$(basename "$f")" < "$f"; done
+for t in covariance_config replay_config emulation_config study_config sweep_config; do  # every configuration to every loader
   for f in config/*/*.yaml; do seed $t "other_$(basename "$f")" < "$f"; done
 done
 seed import_manifest katwijk_7s.yaml < tests/fuzz/import_run/manifest.yaml

@@ -6,6 +6,7 @@
 #include "navimpact/analysis/covariance_study.hpp"
 #include "navimpact/analysis/replay.hpp"
 #include "navimpact/analysis/study.hpp"
+#include "navimpact/analysis/sweep.hpp"
 #include "navimpact/core/alloc_limit.hpp"
 #include "navimpact/core/csv_reader.hpp"
 #include "navimpact/core/error.hpp"
@@ -62,6 +63,7 @@ const std::vector<Target>& targets() {
       {"replay_config", ".yaml", [](const std::string& p) { (void)analysis::loadReplayConfig(p); }},
       {"emulation_config", ".yaml", [](const std::string& p) { (void)emulation::loadEmulationConfig(p); }},
       {"study_config", ".yaml", [](const std::string& p) { (void)analysis::loadStudyConfig(p); }},
+      {"sweep_config", ".yaml", [](const std::string& p) { (void)analysis::loadSweepConfig(p); }},
       {"imu_rawlog", ".rawlog",
        [](const std::string& p) {
          try {

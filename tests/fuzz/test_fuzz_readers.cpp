@@ -85,6 +85,7 @@ std::map<std::string, std::vector<std::string>> seeds(const fs::path& dir) {
   const std::vector<std::string> rl = {gunzip(emu), gunzip(test::dataPath("imu_label_xsens.rawlog"))};
   s["imu_rawlog"] = rl;
   s["rawlog"] = rl;
+  s["sweep_config"] = {slurp(src("config/sweep/navchip_uav_sweep.yaml")), slurp(src("tests/data/sweep_small.yaml"))};
   s["import_manifest"] = {slurp(src("tests/fuzz/import_run/manifest.yaml"))};
   s["import_csv"] = {headLines(gunzip(src("tests/fuzz/import_run/imu.csv.gz")), 150),
                      slurp(src("tests/fuzz/import_run/gnss.csv"))};
@@ -232,6 +233,7 @@ TEST(FuzzReaders, CovarianceConfig) { fuzzTarget("covariance_config"); }
 TEST(FuzzReaders, ReplayConfig) { fuzzTarget("replay_config"); }
 TEST(FuzzReaders, EmulationConfig) { fuzzTarget("emulation_config"); }
 TEST(FuzzReaders, StudyConfig) { fuzzTarget("study_config"); }
+TEST(FuzzReaders, SweepConfig) { fuzzTarget("sweep_config"); }
 TEST(FuzzReaders, ImuRawlog) { fuzzTarget("imu_rawlog"); }
 TEST(FuzzReaders, Rawlog) { fuzzTarget("rawlog"); }
 TEST(FuzzReaders, ImportManifest) { fuzzTarget("import_manifest"); }
