@@ -18,7 +18,8 @@
 #   NAVIMPACT_FUZZ_JOBS=J    targets run side by side (default 2)
 #   NAVIMPACT_FUZZ_CXX=...   clang++ to build with (default clang++-14)
 #   NAVIMPACT_FUZZ_SANITIZERS=address,undefined   (e.g. "undefined" alone)
-#   NAVIMPACT_FUZZ_ARGS="..."  more libFuzzer flags (e.g. -seed=1 -dict=FILE)
+#   NAVIMPACT_FUZZ_SEED=N    libFuzzer's seed (default: a new one per run, printed as "INFO: Seed:")
+#   NAVIMPACT_FUZZ_ARGS="..."  more libFuzzer flags (e.g. -dict=FILE)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECS=${1:-20}
@@ -108,6 +109,7 @@ set -o pipefail
 # -- run ----------------------------------------------------------------------
 LIMIT=(-max_total_time="$SECS")
 [ -n "${NAVIMPACT_FUZZ_RUNS:-}" ] && LIMIT=(-runs="$NAVIMPACT_FUZZ_RUNS")
+[ -n "${NAVIMPACT_FUZZ_SEED:-}" ] && LIMIT+=(-seed="$NAVIMPACT_FUZZ_SEED")
 # wall-clock bound of one target: its time, the corpus load, one 10 s timeout
 # and its report (NAVIMPACT_FUZZ_WALL overrides; with NAVIMPACT_FUZZ_RUNS, 30 min more)
 WALL=${NAVIMPACT_FUZZ_WALL:-$(( ${NAVIMPACT_FUZZ_RUNS:+1800 + }SECS * 2 + 120 ))}
