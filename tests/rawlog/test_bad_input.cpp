@@ -57,6 +57,13 @@ TEST(RawlogBadInput, AbstractClassIsRefusedWithoutPrinting) {
   expectBoth(bad("abstract_class.rawlog"), "IMU",
              {bad("abstract_class.rawlog"), ": entry 0: an object of class 'mrpt::obs::CObservation'",
               "which MRPT cannot create (an abstract class)"});
+  // MRPT's old object header: a 4-byte little-endian name length, the name, a 4-byte version
+  const auto old = (test::tempDir() / "old_header.rawlog").string();
+  const std::string name = "mrpt::obs::CObservation";
+  std::string bytes(1, static_cast<char>(name.size()));
+  bytes += std::string(3, '\0') + name + std::string(68, '\0');
+  std::ofstream(old, std::ios::binary) << bytes;
+  expectBoth(old, "IMU", {old, ": entry 0: an object of class 'mrpt::obs::CObservation'"});
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
 }
 

@@ -32,8 +32,15 @@ size_t GzCStream::Read(void* out, size_t n) {
         return 0;
       }
     }
-    const auto b = n == 1 && got == 1 ? *static_cast<const unsigned char*>(out) : 0;
-    name_len_ = b != 255 && (b & 0x80) ? std::size_t(b & 0x7F) : 0;
+    const auto* c = static_cast<const unsigned char*>(out);
+    const std::size_t old = old_len_;
+    name_len_ = old_len_ = 0;
+    if (n == 1 && got == 1 && c[0] != 255) {
+      if (c[0] & 0x80) name_len_ = c[0] & 0x7F;
+      else old_len_ = c[0];
+    } else if (old > 0 && n == 3 && got == 3 && c[0] == 0 && c[1] == 0 && c[2] == 0) {
+      name_len_ = old;
+    }
     return got;
   } catch (const Error& e) {
     error = e;

@@ -28,9 +28,11 @@ class GzCStream : public mrpt::io::CStream {
 
  private:
   GzInput& in_;
-  /// Length of the class name MRPT reads next (its object header is one byte
-  /// 0x80 | L, then the L bytes of the name in one read), or 0.
+  /// Length of the class name MRPT reads next, or 0. Its object header is one
+  /// byte 0x80 | L, then the L bytes of the name in one read; or, in MRPT's
+  /// old format, one byte L < 0x80, three zero bytes, then the name.
   std::size_t name_len_ = 0;
+  std::size_t old_len_ = 0;  ///< an old-format L waiting for its three zero bytes, or 0
 };
 
 /**
