@@ -4,7 +4,8 @@
 // deletions, duplicated ranges and lines, truncation, extreme numbers, splices
 // of two seeds; rawlogs mutated inside the gzip stream and re-compressed, or
 // in the compressed bytes). Every input must be read or refused with one
-// navimpact::Error line: any other exception, a crash or a single allocation
+// navimpact::Error line, printing nothing: any other exception, output on
+// stderr (from the readers or the libraries they call), a crash or a single allocation
 // above 1 GiB fails the test, and the input is kept under
 // build/test_tmp/fuzz_findings/ to become a regression (tests/fuzz/regressions/).
 // Seed and iterations are logged; NAVIMPACT_FUZZ_SEED and NAVIMPACT_FUZZ_ITERS
@@ -207,14 +208,21 @@ void fuzzTarget(const std::string& name) {
       bytes = gzip(bytes);  // text readers accept gzip too
     }
     spit(input, bytes);  // stays on disk if the reader crashes: the reproducer
+    std::string failure;
+    testing::internal::CaptureStderr();  // library code (and what it calls: MRPT, yaml-cpp) prints nothing
     try {
       const std::string m = fuzz::runOne(*t, input);
       ++(m.empty() ? out.read : out.refused);
     } catch (const std::exception& e) {
+      failure = e.what();
+    }
+    if (const std::string printed = testing::internal::GetCapturedStderr(); !printed.empty() && failure.empty())
+      failure = "the reader printed to stderr: " + printed.substr(0, 300);
+    if (!failure.empty()) {
       fs::create_directories(findings);
       const auto keep = findings / (name + "_" + std::to_string(seed) + "_" + std::to_string(i) + t->extension);
       spit(keep.string(), bytes);
-      ADD_FAILURE() << name << " iteration " << i << " (seed " << seed << "): " << e.what() << "; input kept as "
+      ADD_FAILURE() << name << " iteration " << i << " (seed " << seed << "): " << failure << "; input kept as "
                     << keep.string();
       if (++failures >= 5) break;
     }
@@ -253,12 +261,17 @@ TEST(FuzzReaders, Regressions) {
       // read from the mirrored layout, as when it was found (relative paths resolve)
       const auto input = (dir / "root/config/case" / (std::string("input") + t.extension)).string();
       fs::copy_file(f.path(), input, fs::copy_options::overwrite_existing);
+      testing::internal::CaptureStderr();
+      std::string m, failure;
       try {
-        const std::string m = fuzz::runOne(t, input);
-        std::printf("%s: %s\n", f.path().filename().c_str(), m.empty() ? "read" : m.c_str());
+        m = fuzz::runOne(t, input);
       } catch (const std::exception& e) {
-        ADD_FAILURE() << f.path() << ": " << e.what();
+        failure = e.what();
       }
+      const std::string printed = testing::internal::GetCapturedStderr();
+      if (!failure.empty()) ADD_FAILURE() << f.path() << ": " << failure;
+      else if (!printed.empty()) ADD_FAILURE() << f.path() << ": the reader printed to stderr: " << printed;
+      else std::printf("%s: %s\n", f.path().filename().c_str(), m.empty() ? "read" : m.c_str());
     }
   }
   std::printf("%zu regression inputs\n", n);
