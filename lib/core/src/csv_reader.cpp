@@ -1,4 +1,5 @@
 #include "navimpact/core/csv_reader.hpp"
+#include "navimpact/core/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -198,8 +199,8 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
                                          " s (gap or jitter); resample or split the recording");
     const double rate = (n - 1) / (times[n - 1] - times[0]);
     if (opt.rate_hz && std::abs(*opt.rate_hz - rate) > 1e-3 * rate)
-      throw fileError(path, 0, "--rate " + std::to_string(*opt.rate_hz) +
-                                   " Hz disagrees with the time column (" + std::to_string(rate) + " Hz)");
+      throw fileError(path, 0, "--rate " + formatNumber(*opt.rate_hz) +
+                                   " Hz disagrees with the time column (" + formatNumber(rate) + " Hz)");
     out.rate_hz = opt.rate_hz ? *opt.rate_hz : rate;
     out.t0_s = times[0];
   } else {

@@ -1,3 +1,4 @@
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 
 #include <cmath>
@@ -44,7 +45,7 @@ void cutWindow(ImuSeries& s, double start_s, std::optional<double> end_s) {
   if (!(start_s < duration)) throw fail("--start", start_s, "is not before the end of the record");
   if (end_s) {
     if (!std::isfinite(*end_s) || !(*end_s > start_s))
-      throw fail("--end", *end_s, "must be after --start " + std::to_string(start_s) + " s");
+      throw fail("--end", *end_s, "must be after --start " + formatNumber(start_s, 10) + " s");
     if (*end_s > duration * (1.0 + 1e-12)) throw fail("--end", *end_s, "is beyond the end of the record");
   }
   // First index k with k / rate >= start, first index beyond the window (exclusive).

@@ -1,3 +1,4 @@
+#include "navimpact/core/format.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 
 #include <algorithm>
@@ -33,7 +34,7 @@ std::vector<ins::ImuSample> perfectImu(const SmoothTrajectory& tr, double rate_h
   const auto n = perfectImuCount(rate_hz, a, b);
   if (n == 0)
     throw Error("perfect IMU: the span [" + std::to_string(a) + ", " + std::to_string(b) +
-                "] s holds no whole IMU interval at " + std::to_string(rate_hz) + " Hz");
+                "] s holds no whole IMU interval at " + formatNumber(rate_hz) + " Hz");
   std::vector<ins::ImuSample> out;
   perfectImuBlock(tr, rate_hz, a, 0, n, out);
   return out;

@@ -8,8 +8,8 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
-#include "navimpact/core/limits.hpp"
 #include "navimpact/core/gz_input.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/core/units.hpp"
 
@@ -103,12 +103,12 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
     r[0] *= kT;
     if (!rows.empty()) {
       const double dt = r[0] - rows.back()[0];
-      if (dt == 0.0) throw fileError(path, reader.lineNo(), "time " + std::to_string(r[0]) + " s repeats the previous line");
-      if (dt < 0.0) throw fileError(path, reader.lineNo(), "time goes backwards (" + std::to_string(rows.back()[0]) +
-                                                      " s then " + std::to_string(r[0]) + " s)");
+      if (dt == 0.0) throw fileError(path, reader.lineNo(), "time " + formatNumber(r[0], 12) + " s repeats the previous line");
+      if (dt < 0.0) throw fileError(path, reader.lineNo(), "time goes backwards (" + formatNumber(rows.back()[0], 12) +
+                                                      " s then " + formatNumber(r[0], 12) + " s)");
       if (dt > spec.max_gap_s)
-        throw fileError(path, reader.lineNo(), "gap of " + std::to_string(dt) + " s before this line exceeds max_gap_s = " +
-                                          std::to_string(spec.max_gap_s) + " s that the smoothing spline may bridge");
+        throw fileError(path, reader.lineNo(), "gap of " + formatNumber(dt) + " s before this line exceeds max_gap_s = " +
+                                          formatNumber(spec.max_gap_s) + " s that the smoothing spline may bridge");
     }
     if (spec.start_s && r[0] < *spec.start_s) { rows.push_back(r); lines.push_back(0); continue; }
     rows.push_back(r);

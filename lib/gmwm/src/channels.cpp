@@ -1,4 +1,5 @@
 // GMWM on every channel of a recording (see channels.hpp).
+#include "navimpact/core/format.hpp"
 #include "navimpact/gmwm/channels.hpp"
 
 #include <cmath>
@@ -103,7 +104,7 @@ void checkRecordingFitOptions(const RecordingFitOptions& opt) {
   if (opt.bootstrap < 0) throw Error("--bootstrap must be >= 0, got " + std::to_string(opt.bootstrap));
   if (opt.max_gm < 0 || opt.max_gm > 3) throw Error("--max-gm must be in 0..3");
   if (!(opt.eff > 0.0 && opt.eff < 1.0))
-    throw Error("--eff must be in (0, 1), got " + std::to_string(opt.eff));
+    throw Error("--eff must be in (0, 1), got " + formatNumber(opt.eff));
   weightingOf(opt.weights);
   intervalsOf(opt.intervals);
   for (const auto& n : opt.channels)

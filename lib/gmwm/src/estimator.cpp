@@ -14,6 +14,7 @@
 // the weighted objective. The best placements of each are polished by Ceres
 // (the relative ones first on the relative criterion, as R does), then
 // minimised on the weighted objective; the lowest objective wins.
+#include "navimpact/core/format.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 
 #include <ceres/ceres.h>
@@ -1165,7 +1166,7 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
 
 std::vector<RedundantPair> redundantTerms(const Model& m, const WaveletVariance& wv, double fraction) {
   if (!(fraction > 0.0 && fraction <= 1.0))
-    throw Error("redundantTerms: fraction " + std::to_string(fraction) + " outside (0, 1]");
+    throw Error("redundantTerms: fraction " + formatNumber(fraction) + " outside (0, 1]");
   if (wv.ci_high.size() != wv.tau.size() || wv.ci_low.size() != wv.tau.size())
     throw Error("redundantTerms: the wavelet variance has no confidence interval");
   std::vector<ProcessKind> kinds;

@@ -90,7 +90,7 @@ namespace detail {
 
 double robustScale(const double* w, std::size_t m, double eff) {
   if (!(eff > 0.0 && eff < 1.0))
-    throw Error("robust wavelet variance: efficiency must be in (0, 1), got " + std::to_string(eff));
+    throw Error("robust wavelet variance: efficiency must be in (0, 1), got " + formatNumber(eff));
   const double c = biweightConstant(eff);
   return robustScale(w, m, c, consistencyA(c));
 }
@@ -170,7 +170,7 @@ double robustScale(const double* w, std::size_t m, double c, double a, bool* mad
 
 std::size_t despike(std::vector<double>& x, double alpha) {
   if (!(alpha > 0.0 && alpha < 1.0))
-    throw Error("despike: alpha must be in (0, 1), got " + std::to_string(alpha));
+    throw Error("despike: alpha must be in (0, 1), got " + formatNumber(alpha));
   const std::size_t n = x.size();
   if (n < 8) return 0;
   auto d = [&](std::size_t k) { return x[k] - 0.5 * (x[k - 1] + x[k + 1]); };
@@ -206,7 +206,7 @@ std::size_t despike(std::vector<double>& x, double alpha) {
 WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rate_hz, double eff,
                                       double alpha) {
   if (!(eff > 0.0 && eff < 1.0))
-    throw Error("robust wavelet variance: efficiency must be in (0, 1), got " + std::to_string(eff));
+    throw Error("robust wavelet variance: efficiency must be in (0, 1), got " + formatNumber(eff));
   detail::checkSeries(x, n);
   const int J = detail::maxLevel(n);
   WaveletVariance r = detail::sizedWv(J, rate_hz, n, true);

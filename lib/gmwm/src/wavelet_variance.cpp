@@ -1,6 +1,7 @@
 // Classical Haar MODWT wavelet variance with the eta3 chi-square CI
 // (Percival & Walden 2000, §8.3–8.4; R package gmwm 3.0.0, src/dwt.cpp and
 // src/wave_variance.cpp, described in shared/reference/gmwm_formulas.md §1–2).
+#include "navimpact/core/format.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 
 #include <algorithm>
@@ -286,9 +287,9 @@ Eigen::VectorXd WaveletVariance::weights() const {
 
 void wvConfidenceInterval(double wv, double eta, double alpha, double& low, double& high) {
   if (!(alpha > 0.0 && alpha < 1.0))
-    throw Error("wavelet variance CI: alpha must be in (0, 1), got " + std::to_string(alpha));
+    throw Error("wavelet variance CI: alpha must be in (0, 1), got " + formatNumber(alpha));
   if (!(eta > 0.0) || !std::isfinite(eta))
-    throw Error("wavelet variance CI: degrees of freedom must be > 0, got " + std::to_string(eta));
+    throw Error("wavelet variance CI: degrees of freedom must be > 0, got " + formatNumber(eta));
   // Percival & Walden 2000, eq. 313c: eta nu^2 / nu_hat^2 ~ chi2(eta).
   const boost::math::chi_squared chi2(eta);
   low = eta * wv / boost::math::quantile(chi2, 1.0 - alpha / 2.0);

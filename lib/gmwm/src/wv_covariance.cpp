@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 #include "navimpact/stochastic/spectrum.hpp"
 
@@ -96,7 +97,7 @@ double integrate(const Spectrum& S, double na, double nb, int p) {
 }  // namespace
 
 double spectralWv(const Model& m, double tau) {
-  if (!(tau >= 2.0)) throw Error("spectralWv: scale " + std::to_string(tau) + " below 2 samples");
+  if (!(tau >= 2.0)) throw Error("spectralWv: scale " + formatNumber(tau) + " below 2 samples");
   return integrate(Spectrum(m), 0.5 * tau, 0.0, 1);
 }
 

@@ -1,3 +1,4 @@
+#include "navimpact/core/format.hpp"
 #include "navimpact/import/export_run.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -152,7 +153,7 @@ std::vector<std::string> exportRun(const Recording& d, const fs::path& dir) {
     const bool att = r0.q_BtoN.has_value(), vel = r0.v_N.has_value(), sig = r0.sigma_p_L.has_value();
     for (const auto& r : d.reference)
       if (r.q_BtoN.has_value() != att || r.v_N.has_value() != vel || r.sigma_p_L.has_value() != sig)
-        throw Error(d.source + ": reference at t = " + std::to_string(r.t) +
+        throw Error(d.source + ": reference at t = " + formatNumber(r.t, 10) +
                     " s has other fields than the first one (attitude, velocity, sigma): cannot export it as one CSV");
     s = "t_s,lat_deg,lon_deg,height_m";
     if (att) s += ",roll_deg,pitch_deg,yaw_deg";

@@ -12,6 +12,7 @@
 #include "foreign_reader.hpp"
 #include "frames.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::rawlog::detail {
 
@@ -191,8 +192,8 @@ Recording readForeignRawlog(EntryReader& reader, const RawlogReadOptions& opt) {
     d.lever_arm_B = gs.lever_arm_B;
     if (!d.gnss.empty()) d.origin = d.gnss.front().pos;
     if (gs.rmcVelocity)
-      d.notices.push_back("GNSS velocity from NMEA RMC/VTG: horizontal only (sigma " + std::to_string(kRmcSigmaH) +
-                          " m/s assumed), vertical unknown (sigma " + std::to_string(kRmcSigmaV) + " m/s)");
+      d.notices.push_back("GNSS velocity from NMEA RMC/VTG: horizontal only (sigma " + formatNumber(kRmcSigmaH) +
+                          " m/s assumed), vertical unknown (sigma " + formatNumber(kRmcSigmaV) + " m/s)");
   }
   d.notices.push_back("rawlog not written by navimpact: IMU label '" + il + "' (sensor axes turned by its sensorPose into "
                       "the vehicle frame), GNSS label '" + (gl.empty() ? std::string("none") : gl) + "'");

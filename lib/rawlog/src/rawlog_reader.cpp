@@ -130,7 +130,7 @@ struct RawlogReader::Impl {
     const double t = haveBase ? static_cast<double>((ob.timestamp - base).count()) * kTick : 0.0;
     if (t < lastT)
       throw Error(where(label, t) + ": timestamp goes backwards (previous entry, label " + printable(lastLabel, 40) +
-                  ", at t = " + std::to_string(lastT) + " s)");
+                  ", at t = " + formatNumber(lastT, 10) + " s)");
     lastT = t;
     lastLabel = label;
     if (label == "IMU" || label == "BARO" || label == "GT" || label == "GNSS") {

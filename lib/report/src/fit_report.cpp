@@ -1,4 +1,5 @@
 // Outputs of navimpact fit: model.yaml, fit.json, WV figures, console summary.
+#include "navimpact/core/format.hpp"
 #include "navimpact/report/fit_report.hpp"
 
 #include <cmath>
@@ -250,7 +251,7 @@ std::string fitSummary(const gm::RecordingFit& f) {
        << ", per sample at " << f.rate_hz << " Hz]\n";
     os << "    objective " << c.fit.objective << " (" << (f.options.robust ? "robust WV, " : "")
        << gm::weightingName(c.fit.weighting) << " weights"
-       << (c.fit.weighting == gm::Weighting::Fast ? "" : ", R objective " + std::to_string(c.fit.objective_fast))
+       << (c.fit.weighting == gm::Weighting::Fast ? "" : ", R objective " + formatNumber(c.fit.objective_fast))
        << ")  (" << c.fit.ci_method << " 95 % intervals in fit.json)\n";
     for (std::size_t i = 0; i < c.negligible.size(); ++i)
       if (c.negligible[i])

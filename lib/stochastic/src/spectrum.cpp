@@ -1,5 +1,6 @@
 // Power spectral density of a model: each kind's density or line is in
 // processes/<name>.cpp; conventions in spectrum.hpp.
+#include "navimpact/core/format.hpp"
 #include "navimpact/stochastic/spectrum.hpp"
 
 #include <cmath>
@@ -38,8 +39,8 @@ double Spectrum::perSample(double sin2) const {
 
 double Spectrum::operator()(double f_hz) const {
   if (!(f_hz > 0.0) || !(f_hz <= 0.5 * rate_hz_))
-    throw Error("psd: frequency " + std::to_string(f_hz) + " Hz outside (0, rate/2 = " +
-                std::to_string(0.5 * rate_hz_) + " Hz]");
+    throw Error("psd: frequency " + formatNumber(f_hz) + " Hz outside (0, rate/2 = " +
+                formatNumber(0.5 * rate_hz_) + " Hz]");
   const double s = std::sin(M_PI * f_hz / rate_hz_);
   return 2.0 / rate_hz_ * perSample(s * s);  // one-sided, per Hz: 2 dt S
 }

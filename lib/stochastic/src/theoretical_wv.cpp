@@ -2,6 +2,7 @@
 // processes/<name>.cpp (Guerrier et al. 2013 / R package gmwm
 // src/process_to_wv.cpp, see shared/reference/gmwm_formulas.md §3); tau in
 // samples, n = tau/2.
+#include "navimpact/core/format.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
 #include <cmath>
@@ -15,7 +16,7 @@ namespace detail {
 
 void checkTau(double tau) {
   if (!(tau >= 2.0) || !std::isfinite(tau))
-    throw Error("Haar wavelet variance: scale tau = " + std::to_string(tau) +
+    throw Error("Haar wavelet variance: scale tau = " + formatNumber(tau) +
                 " samples is invalid (expected tau >= 2)");
 }
 

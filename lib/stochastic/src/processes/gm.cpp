@@ -8,6 +8,7 @@
 
 #include "../kind.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
 namespace navimpact::stochastic {
@@ -85,7 +86,7 @@ double haarWvAr1(double phi, double sigma2_innov, double tau) {
     return haarWvStationaryAr1(s2, L, n);
   }
   if (!(phi > -1.0 && phi <= 0.0))
-    throw Error("AR1 wavelet variance: phi = " + std::to_string(phi) +
+    throw Error("AR1 wavelet variance: phi = " + formatNumber(phi, 10) +
                 " outside the stationary range (-1, 1)");
   // phi <= 0: literal R formula (no cancellation for non-positive phi).
   const double num = n - 3.0 * phi - n * phi * phi + 4.0 * std::pow(phi, n + 1.0) -
@@ -95,7 +96,7 @@ double haarWvAr1(double phi, double sigma2_innov, double tau) {
 
 Process Process::ar1(double phi, double sigma2_innov, double rate_hz) {
   if (!(phi > 0.0 && phi < 1.0))
-    throw Error("AR1(phi=" + std::to_string(phi) +
+    throw Error("AR1(phi=" + formatNumber(phi, 10) +
                 "): phi must be in (0, 1) to be a Gauss-Markov process");
   if (!(sigma2_innov > 0.0) || !std::isfinite(sigma2_innov))
     throw Error("AR1: sigma2 must be a finite number > 0");
@@ -133,8 +134,8 @@ class GaussMarkov final : public KindDef {
     const double phi = v[0], s2 = v[1];
     if (!(phi > 0.0 && phi < 1.0))
       throw AliasValueError{0, "phi in (0, 1) (an AR1 stored as Gauss-Markov)",
-                            "phi=" + std::to_string(phi)};
-    if (!(s2 > 0.0)) throw AliasValueError{1, "sigma2 > 0", "sigma2=" + std::to_string(s2)};
+                            "phi=" + formatNumber(phi, 10)};
+    if (!(s2 > 0.0)) throw AliasValueError{1, "sigma2 > 0", "sigma2=" + formatNumber(s2)};
     if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
       throw AliasValueError{-1, "a model rate (rate_hz > 0) to convert AR1 to GM", "no rate"};
     return Process::ar1(phi, s2, rate_hz);

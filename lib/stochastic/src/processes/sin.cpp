@@ -5,6 +5,7 @@
 
 #include "../kind.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::stochastic::detail {
 
@@ -29,7 +30,7 @@ class Sinusoid final : public KindDef {
 
   std::string check(const Process& p, double rate_hz) const override {
     if (!(p.freq_hz < 0.5 * rate_hz))
-      return "freq must be below the Nyquist frequency rate_hz/2 = " + std::to_string(0.5 * rate_hz) +
+      return "freq must be below the Nyquist frequency rate_hz/2 = " + formatNumber(0.5 * rate_hz) +
              " Hz";
     return {};
   }
