@@ -67,7 +67,11 @@ navimpact::cli::Registrar reg({
         if (!o->gnss_label.empty()) cfg.gnss_label = o->gnss_label;
         if (!o->outages.empty()) {
           cfg.outages.clear();
-          for (const auto& s : o->outages) cfg.outages.push_back(navimpact::parseOutage(s));
+          cfg.outage_names.clear();
+          for (const auto& s : o->outages) {
+            cfg.outages.push_back(navimpact::parseOutage(s));
+            cfg.outage_names.push_back("--outage " + navimpact::outageText(cfg.outages.back()));
+          }
         }
         if (!o->outages_every.empty()) cfg.outages_every = navimpact::parseOutagePattern(o->outages_every);
         if (o->propagate_every) cfg.propagate_every = *o->propagate_every;

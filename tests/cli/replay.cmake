@@ -13,7 +13,11 @@ set_tests_properties(cli_replay_default_outputs PROPERTIES DEPENDS cli_replay_de
 set(_rlog ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog)
 navimpact_cli_fail(cli_replay_outage_outside_data
   ARGS replay --rawlog ${_rlog} --outage 230:60 --out ${_rdir}/late
-  REGEX "outage 230:60 ends at 290 s, after the data" NOOUT ${_rdir}/late)
+  REGEX "^navimpact: --outage 230:60 ends at 290 s, after the data" NOOUT ${_rdir}/late)
+navimpact_cli_fail(cli_replay_overlapping_outages_name_the_key
+  ARGS replay --config ${CMAKE_SOURCE_DIR}/tests/data/bad/replay_overlapping_outages.yaml --out ${_rdir}/overlap
+  REGEX "replay_overlapping_outages.yaml:[0-9:]* key 'outages.1.': outage 150:30 starts before the previous outage ends at 160 s"
+  NOOUT ${_rdir}/overlap)
 navimpact_cli_fail(cli_replay_bad_outage_text
   ARGS replay --rawlog ${_rlog} --outage 200-60 --out ${_rdir}/badtext
   REGEX "expected START:DURATION" NOOUT ${_rdir}/badtext)

@@ -58,6 +58,15 @@ Eigen::Vector3d sigma3(const ConfigNode& n, const std::string& k, const limits::
   return Eigen::Vector3d::Constant(n.number(k, r));
 }
 
+/// How each of the configuration's outages is named in messages: the key or
+/// flag that gave it (ReplayConfig::outage_names), else "outage S:D".
+std::vector<std::string> outageNames(const ReplayConfig& c) {
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < c.outages.size(); ++i)
+    names.push_back(i < c.outage_names.size() ? c.outage_names[i] : "outage " + outageText(c.outages[i]));
+  return names;
+}
+
 }  // namespace
 
 ReplayConfig loadReplayConfig(const std::string& path, const std::vector<std::string>& given_by_flags) {
@@ -82,6 +91,7 @@ void ReplayConfig::loadFrom(const ConfigNode& root, const std::vector<std::strin
     o.allowKeys({"start_s", "duration_s"});
     const double st = o.number("start_s", kOutageStartS, "seconds from time zero");
     c.outages.push_back(Outage::fromStartDuration(st, o.number("duration_s", limits::kDurationS)));
+    c.outage_names.push_back(o.error("outage " + outageText(c.outages.back())).what());
   }
   if (const auto f = root.optMap("filter")) {
     f->allowKeys({"propagate_every", "use_gnss_velocity", "gate_probability", "gate_readmit_after", "max_imu_gap_s",
@@ -517,7 +527,7 @@ void ReplayDriver::run() {
   prevT_ = r.t_zero;
 
   // Outages in rawlog time (their end against the data's end is checked when it is known).
-  checkOutages(cfg.outages, std::numeric_limits<double>::infinity(), "the data");
+  checkOutages(cfg.outages, std::numeric_limits<double>::infinity(), "the data", outageNames(cfg));
   for (const auto& o : cfg.outages) opt_.outages.push_back(o.shifted(r.t_zero));
 
   if (scen_ && scen_["baro"] && scen_["baro"]["sigma_m"]) sBaro_ = scen_["baro"]["sigma_m"].as<double>();
@@ -741,7 +751,7 @@ void ReplayDriver::run() {
 
   // What needed the end of the data.
   checkOutages(cfg.outages, t_last - r.t_zero,
-               "the data (IMU data span 0.." + formatNumber(t_last - r.t_zero, 10) + " s)");
+               "the data (IMU data span 0.." + formatNumber(t_last - r.t_zero, 10) + " s)", outageNames(cfg));
   if (hasTruth_ && truthInside_ == 0)
     throw Error(cfg.rawlog + ": the reference (GT) has no entry inside the IMU data");
   // notices in one order: the reader's, gaps, the reference, the alignment, the outages, the model

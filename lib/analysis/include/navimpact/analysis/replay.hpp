@@ -101,6 +101,9 @@ struct ReplayConfig {
   std::string imu_label, gnss_label;            ///< of a rawlog navimpact did not write; "" = the only one
   std::string model_spec;                       ///< "" = the rawlog scenario's model
   std::vector<Outage> outages;                  ///< GNSS outages from time zero [s] (navimpact::parseOutage)
+  /// How each outage is named in messages, when it came from a file or flag
+  /// ("FILE:L:C: key 'outages[1]': outage 200:60", "--outage 200:60"); one per outage or empty.
+  std::vector<std::string> outage_names;
   int propagate_every = 10;                     ///< covariance propagation every k IMU samples
   bool use_gnss_velocity = true;
   double gate_probability = 0.0;
