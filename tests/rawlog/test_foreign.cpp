@@ -3,6 +3,7 @@
 // vehicle frame x forward, y left, z up), GNSS as NMEA GGA + RMC, Novatel
 // BESTPOS or TOPCON PZS, sensory-frame or observation-only files, any labels.
 #include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationGPS.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -233,4 +234,31 @@ TEST(ForeignRawlog, NavimpactRawlogsAreNotTurned) {
   const Recording b = navimpact::rawlog::readRawlog(navimpact::test::sourcePath("datasets/uav_flight_260s_ref.rawlog"));
   ASSERT_EQ(b.imu.size(), 52000u);
   EXPECT_LT(b.imu[0].f_B[2], -3.0);  // specific force points up: negative along body down (not turned to FLU)
+}
+
+// Entries of classes navimpact does not read are decoded with stderr silenced:
+// MRPT prints warnings of its own while decoding some of them (a 3D range scan
+// whose image size disagrees with its camera: "autofixing incorrect camera
+// resolution"), and the readers print nothing. The IMU and GNSS around them
+// are read as usual, and stderr works again afterwards.
+TEST(ForeignRawlog, EntriesOfOtherClassesPrintNothing) {
+  const std::string p = navimpact::test::tempDir() / "with_3d_scan.rawlog";
+  writeForeign(p, 5, false, {"IMU"}, 0);
+  {
+    mrpt::io::CFileGZOutputStream out(p, mrpt::io::OpenMode::APPEND);  // a second gzip member
+    auto arch = mrpt::serialization::archiveFrom(out);
+    mrpt::obs::CObservation3DRangeScan scan;
+    scan.sensorLabel = "KINECT";
+    scan.timestamp = mrpt::Clock::fromDouble(1.6e9 + 1.0);
+    scan.hasRangeImage = true;
+    scan.rangeImage.setZero(4, 6);
+    scan.cameraParams.ncols = 640;  // disagrees with the 6 x 4 image
+    scan.cameraParams.nrows = 480;
+    arch << scan;
+  }
+  testing::internal::CaptureStderr();
+  const Recording r = navimpact::rawlog::readRawlog(p);
+  std::fprintf(stderr, "after");
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "after");
+  EXPECT_EQ(r.imu.size(), 200u);
 }

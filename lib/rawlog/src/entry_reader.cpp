@@ -5,7 +5,11 @@
 #include <mrpt/obs/registerAllClasses.h>
 #include <mrpt/rtti/CObject.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <new>
 #include <stdexcept>
@@ -14,6 +18,40 @@
 #include "navimpact/core/alloc_limit.hpp"
 
 namespace navimpact::rawlog::detail {
+
+StderrSilence::StderrSilence() {
+  std::fflush(stderr);
+  const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+  if (null < 0) return;
+  saved_ = ::dup(2);
+  if (saved_ >= 0 && ::dup2(null, 2) < 0) {
+    ::close(saved_);
+    saved_ = -1;
+  }
+  ::close(null);
+}
+
+StderrSilence::~StderrSilence() {
+  if (saved_ < 0) return;
+  std::fflush(stderr);
+  ::dup2(saved_, 2);
+  ::close(saved_);
+}
+
+namespace {
+/// The classes whose entries navimpact reads (and what they hold): MRPT
+/// prints nothing while it decodes them. Any other class is decoded with
+/// stderr silenced (StderrSilence), then skipped by the readers.
+bool readByNavimpact(const std::string& name) {
+  const auto at = name.rfind("::");
+  const std::string base = at == std::string::npos ? name : name.substr(at + 2);
+  static const char* const kRead[] = {"CObservationIMU", "CObservationGPS", "CObservationComment", "CSensoryFrame",
+                                      "CObservationRobotPose", "CPose3D", "CPose3DPDFGaussian", "CPoint3D"};
+  for (const char* k : kRead)
+    if (base == k) return true;
+  return false;
+}
+}  // namespace
 
 size_t GzCStream::Read(void* out, size_t n) {
   if (error) return 0;
@@ -31,6 +69,7 @@ size_t GzCStream::Read(void* out, size_t n) {
                       "', which MRPT cannot create (an abstract class): malformed entry");
         return 0;
       }
+      if (id && !quiet && !readByNavimpact(name)) quiet.emplace();
     }
     const auto* c = static_cast<const unsigned char*>(out);
     const std::size_t old = old_len_;
@@ -91,6 +130,10 @@ mrpt::serialization::CSerializable::Ptr EntryReader::next() {
     throw;
   }
   ++entry_;
+  struct EndQuiet {  // stderr back when the entry is read or refused
+    GzCStream& s;
+    ~EndQuiet() { s.quiet.reset(); }
+  } end_quiet{stream_};
   auto streamError = [this]() -> std::string {
     std::string m = stream_.error->what();
     const std::string pre = in_.path() + ": ";

@@ -14,6 +14,21 @@
 
 namespace navimpact::rawlog::detail {
 
+/// While it lives, file descriptor 2 (stderr) goes to /dev/null: MRPT prints
+/// warnings of its own while it deserialises some classes (e.g. a 3D range
+/// scan's "autofixing incorrect camera resolution"), and library code prints
+/// nothing. Used only around entries of classes navimpact does not read.
+class StderrSilence {
+ public:
+  StderrSilence();
+  ~StderrSilence();
+  StderrSilence(const StderrSilence&) = delete;
+  StderrSilence& operator=(const StderrSilence&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
 /// navimpact::GzInput as an MRPT input stream; its errors are kept, not thrown
 /// through MRPT (which would wrap them in its own multi-line text).
 class GzCStream : public mrpt::io::CStream {
@@ -25,6 +40,9 @@ class GzCStream : public mrpt::io::CStream {
   uint64_t getTotalBytesCount() const override { return in_.statedSize(); }
   uint64_t getPosition() const override { return in_.position(); }
   std::optional<Error> error;
+  /// Set while an object of a class navimpact does not read is decoded (see
+  /// StderrSilence); EntryReader::next ends it with the entry.
+  std::optional<StderrSilence> quiet;
 
  private:
   GzInput& in_;
