@@ -63,13 +63,19 @@ size_t GzCStream::Read(void* out, size_t n) {
     if (name_len_ > 0 && got == n && n == name_len_) {
       // (up to a NUL byte, as MRPT makes a C string of it)
       const std::string name(static_cast<const char*>(out), strnlen(static_cast<const char*>(out), n));
-      const auto* id = mrpt::rtti::findRegisteredClass(name);
-      if (id && !id->ptrCreateObject) {
+      if (name != last_name_) {
+        const auto* id = mrpt::rtti::findRegisteredClass(name);
+        last_name_ = name;
+        last_registered_ = id != nullptr;
+        last_abstract_ = id && !id->ptrCreateObject;
+        last_read_ = readByNavimpact(name);
+      }
+      if (last_abstract_) {
         error = Error(in_.path() + ": an object of class '" + printable(name, 60) +
                       "', which MRPT cannot create (an abstract class): malformed entry");
         return 0;
       }
-      if (id && !quiet && !readByNavimpact(name)) quiet.emplace();
+      if (last_registered_ && !last_read_ && !quiet) quiet.emplace();
     }
     const auto* c = static_cast<const unsigned char*>(out);
     const std::size_t old = old_len_;

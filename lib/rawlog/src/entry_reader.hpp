@@ -51,6 +51,9 @@ class GzCStream : public mrpt::io::CStream {
   /// old format, one byte L < 0x80, three zero bytes, then the name.
   std::size_t name_len_ = 0;
   std::size_t old_len_ = 0;  ///< an old-format L waiting for its three zero bytes, or 0
+  /// The last class name looked up and what it is (entries repeat a few classes).
+  std::string last_name_;
+  bool last_registered_ = false, last_abstract_ = false, last_read_ = false;
 };
 
 /**
