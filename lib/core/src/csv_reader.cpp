@@ -1,11 +1,11 @@
 #include "navimpact/core/csv_reader.hpp"
-#include "navimpact/core/format.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/gz_input.hpp"
 #include "navimpact/core/text_io.hpp"
 

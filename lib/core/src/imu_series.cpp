@@ -1,10 +1,10 @@
-#include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
 
 #include <cmath>
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact {
 

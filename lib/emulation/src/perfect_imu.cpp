@@ -1,4 +1,3 @@
-#include "navimpact/core/format.hpp"
 #include "navimpact/emulation/perfect_imu.hpp"
 
 #include <algorithm>
@@ -6,6 +5,7 @@
 #include <string>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::emulation {
 
@@ -33,7 +33,7 @@ std::vector<ins::ImuSample> perfectImu(const SmoothTrajectory& tr, double rate_h
   const double b = std::min(t_end, tr.tEnd());
   const auto n = perfectImuCount(rate_hz, a, b);
   if (n == 0)
-    throw Error("perfect IMU: the span [" + std::to_string(a) + ", " + std::to_string(b) +
+    throw Error("perfect IMU: the span [" + formatNumber(a, 10) + ", " + formatNumber(b, 10) +
                 "] s holds no whole IMU interval at " + formatNumber(rate_hz) + " Hz");
   std::vector<ins::ImuSample> out;
   perfectImuBlock(tr, rate_hz, a, 0, n, out);

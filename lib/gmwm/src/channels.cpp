@@ -1,11 +1,11 @@
 // GMWM on every channel of a recording (see channels.hpp).
-#include "navimpact/core/format.hpp"
 #include "navimpact/gmwm/channels.hpp"
 
 #include <cmath>
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/stochastic/datasheet.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"

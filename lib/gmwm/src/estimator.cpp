@@ -14,7 +14,6 @@
 // the weighted objective. The best placements of each are polished by Ceres
 // (the relative ones first on the relative criterion, as R does), then
 // minimised on the weighted objective; the lowest objective wins.
-#include "navimpact/core/format.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 
 #include <ceres/ceres.h>
@@ -28,6 +27,7 @@
 
 #include "fit_internal.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"

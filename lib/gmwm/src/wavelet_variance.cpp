@@ -1,7 +1,6 @@
 // Classical Haar MODWT wavelet variance with the eta3 chi-square CI
 // (Percival & Walden 2000, §8.3–8.4; R package gmwm 3.0.0, src/dwt.cpp and
 // src/wave_variance.cpp, described in shared/reference/gmwm_formulas.md §1–2).
-#include "navimpact/core/format.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 
 #include <algorithm>
@@ -20,6 +19,7 @@
 #include <vector>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/parallel.hpp"
 #include "wv_internal.hpp"
 

@@ -1,4 +1,3 @@
-#include "navimpact/core/format.hpp"
 #include "navimpact/import/export_run.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -12,6 +11,7 @@
 #include <sstream>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/core/yaml_load.hpp"
 

@@ -1,5 +1,4 @@
 // Outputs of navimpact fit: model.yaml, fit.json, WV figures, console summary.
-#include "navimpact/core/format.hpp"
 #include "navimpact/report/fit_report.hpp"
 
 #include <cmath>
@@ -9,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/plot/figure.hpp"
 #include "navimpact/stochastic/datasheet.hpp"

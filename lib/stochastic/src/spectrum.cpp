@@ -1,6 +1,5 @@
 // Power spectral density of a model: each kind's density or line is in
 // processes/<name>.cpp; conventions in spectrum.hpp.
-#include "navimpact/core/format.hpp"
 #include "navimpact/stochastic/spectrum.hpp"
 
 #include <cmath>
@@ -8,6 +7,7 @@
 
 #include "kind.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::stochastic {
 

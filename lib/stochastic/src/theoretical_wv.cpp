@@ -2,13 +2,13 @@
 // processes/<name>.cpp (Guerrier et al. 2013 / R package gmwm
 // src/process_to_wv.cpp, see shared/reference/gmwm_formulas.md §3); tau in
 // samples, n = tau/2.
-#include "navimpact/core/format.hpp"
 #include "navimpact/stochastic/theoretical_wv.hpp"
 
 #include <cmath>
 
 #include "kind.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 
 namespace navimpact::stochastic {
 
