@@ -42,6 +42,25 @@ TEST(Outage, CoversTheHalfOpenInterval) {
   EXPECT_FALSE(navimpact::inOutage(100.0, {Outage{0.0, 10.0}, o}));
 }
 
+// An outage is named in a message by the key or flag that gave it where the
+// caller has one, else "WHAT S:D"; more names than outages is a caller's error.
+TEST(Outage, CheckNamesEachOutageByWhatGaveIt) {
+  const std::vector<Outage> w = {{10.0, 20.0}, {15.0, 30.0}, {40.0, 50.0}};
+  auto message = [&](const std::vector<std::string>& names, double span) {
+    try {
+      navimpact::checkOutages(w, span, "the data", "--outage", names);
+    } catch (const navimpact::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message({"key 'a[0]'", "key 'a[1]'"}, 100.0),
+            "key 'a[1]' starts before the previous outage ends at 20 s (outages in time order, no overlap)");
+  EXPECT_EQ(message({"key 'a[0]'"}, 100.0),
+            "--outage 15:15 starts before the previous outage ends at 20 s (outages in time order, no overlap)");
+  EXPECT_EQ(message({"n0", "n1", "n2", "n3"}, 100.0), "checkOutages: 4 names for 3 outages");
+}
+
 TEST(Outage, ParsesStartColonDuration) {
   const Outage o = navimpact::parseOutage(" 200 : 60 ");
   EXPECT_DOUBLE_EQ(o.start_s, 200.0);

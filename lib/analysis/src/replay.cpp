@@ -58,15 +58,6 @@ Eigen::Vector3d sigma3(const ConfigNode& n, const std::string& k, const limits::
   return Eigen::Vector3d::Constant(n.number(k, r));
 }
 
-/// How each of the configuration's outages is named in messages: the key or
-/// flag that gave it (ReplayConfig::outage_names), else "outage S:D".
-std::vector<std::string> outageNames(const ReplayConfig& c) {
-  std::vector<std::string> names;
-  for (std::size_t i = 0; i < c.outages.size(); ++i)
-    names.push_back(i < c.outage_names.size() ? c.outage_names[i] : "outage " + outageText(c.outages[i]));
-  return names;
-}
-
 }  // namespace
 
 ReplayConfig loadReplayConfig(const std::string& path, const std::vector<std::string>& given_by_flags) {
@@ -527,7 +518,7 @@ void ReplayDriver::run() {
   prevT_ = r.t_zero;
 
   // Outages in rawlog time (their end against the data's end is checked when it is known).
-  checkOutages(cfg.outages, std::numeric_limits<double>::infinity(), "the data", outageNames(cfg));
+  checkOutages(cfg.outages, std::numeric_limits<double>::infinity(), "the data", "outage", cfg.outage_names);
   for (const auto& o : cfg.outages) opt_.outages.push_back(o.shifted(r.t_zero));
 
   if (scen_ && scen_["baro"] && scen_["baro"]["sigma_m"]) sBaro_ = scen_["baro"]["sigma_m"].as<double>();
@@ -751,7 +742,7 @@ void ReplayDriver::run() {
 
   // What needed the end of the data.
   checkOutages(cfg.outages, t_last - r.t_zero,
-               "the data (IMU data span 0.." + formatNumber(t_last - r.t_zero, 10) + " s)", outageNames(cfg));
+               "the data (IMU data span 0.." + formatNumber(t_last - r.t_zero, 10) + " s)", "outage", cfg.outage_names);
   if (hasTruth_ && truthInside_ == 0)
     throw Error(cfg.rawlog + ": the reference (GT) has no entry inside the IMU data");
   // notices in one order: the reader's, gaps, the reference, the alignment, the outages, the model

@@ -42,13 +42,10 @@ RunPlan planRuns(const RunPlanOptions& opt) {
   const double duration = plan.duration_s();
 
   // Outages inside the run.
-  const std::string traj_end = "the end of the trajectory " +
-                               (opt.smoothed ? std::string() : opt.trajectory.file + " ") + "(" +
-                               formatNumber(duration) + " s)";
-  if (opt.outage_names.empty())
-    checkOutages(opt.outages, duration, traj_end, opt.outage_name);
-  else
-    checkOutages(opt.outages, duration, traj_end, opt.outage_names);
+  checkOutages(opt.outages, duration,
+               "the end of the trajectory " + (opt.smoothed ? std::string() : opt.trajectory.file + " ") + "(" +
+                   formatNumber(duration) + " s)",
+               opt.outage_name, opt.outage_names);
 
   // Perfect IMU.
   plan.perfect = emulation::perfectImu(tr, rate, plan.t0, plan.t1);

@@ -55,25 +55,19 @@ std::vector<Outage> outagesEvery(const OutagePattern& p, double aided_from, doub
 }
 
 void checkOutages(const std::vector<Outage>& outages, double span_s, const std::string& after,
-                  const std::string& what) {
-  std::vector<std::string> names;
-  for (const Outage& o : outages) names.push_back(what + " " + outageText(o));
-  checkOutages(outages, span_s, after, names);
-}
-
-void checkOutages(const std::vector<Outage>& outages, double span_s, const std::string& after,
-                  const std::vector<std::string>& names) {
-  if (names.size() != outages.size())
+                  const std::string& what, const std::vector<std::string>& names) {
+  if (names.size() > outages.size())
     throw Error("checkOutages: " + std::to_string(names.size()) + " names for " + std::to_string(outages.size()) + " outages");
   for (std::size_t i = 0; i < outages.size(); ++i) {
     const Outage& o = outages[i];
+    const std::string name = i < names.size() ? names[i] : what + " " + outageText(o);
     if (!(o.start_s >= 0.0) || !(o.end_s > o.start_s) || !std::isfinite(o.end_s))
-      throw Error(names[i] + ": START must be >= 0 s and DURATION > 0 s");
+      throw Error(name + ": START must be >= 0 s and DURATION > 0 s");
     if (i > 0 && o.start_s < outages[i - 1].end_s)
-      throw Error(names[i] + " starts before the previous outage ends at " + formatNumber(outages[i - 1].end_s) +
+      throw Error(name + " starts before the previous outage ends at " + formatNumber(outages[i - 1].end_s) +
                   " s (outages in time order, no overlap)");
     if (o.end_s > span_s + 1e-6)
-      throw Error(names[i] + " ends at " + formatNumber(o.end_s) + " s, after " + after);
+      throw Error(name + " ends at " + formatNumber(o.end_s) + " s, after " + after);
   }
 }
 

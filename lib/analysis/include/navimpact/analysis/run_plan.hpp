@@ -50,7 +50,7 @@ struct RunPlanOptions {
   double imu_rate_hz = 0.0;               ///< emulated IMU rate [Hz], > 0
   std::vector<Outage> outages;            ///< GNSS outages in run time (from the trajectory start) [s]
   std::string outage_name = "outage";     ///< how an outage is named in messages ("--outage" on the command line)
-  std::vector<std::string> outage_names;  ///< when set, one per outage, naming it in place of "outage_name S:D"
+  std::vector<std::string> outage_names;  ///< where set, outage i is named outage_names[i] in place of "outage_name S:D"
   double record_rate_hz = 1.0;            ///< error epochs over the whole run [Hz]; 0 = none
   double outage_record_rate_hz = 5.0;     ///< error epochs inside outages [Hz]; 0 = their ends only
   emulation::GnssOptions gnss;            ///< GNSS of every run (its seed is replaced per run); lever arm for the filter

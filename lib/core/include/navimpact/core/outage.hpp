@@ -69,15 +69,14 @@ std::vector<Outage> outagesEvery(const OutagePattern& p, double aided_from_s, do
 /// finite time >= 0 and lasts a finite time > 0, they are in time order
 /// without overlap, and each ends at most 1 microsecond after @p span_s, the
 /// length of the run. @p after names the end of the data in the message
-/// ("the data (IMU data span 0..260 s)").
-/// @throws navimpact::Error "WHAT S:D ends at E s, after AFTER",
-///         "WHAT S:D: START must be >= 0 s and DURATION > 0 s",
-///         "WHAT S:D starts before the previous outage ends (outages in time order, no overlap)".
+/// ("the data (IMU data span 0..260 s)"). Outage i is named @p names[i]
+/// where given (the configuration key or flag it came from: "FILE: key
+/// 'outages[1]': outage 150:30", "--outage 150:30"), else "WHAT S:D";
+/// @p names holds at most one name per outage.
+/// @throws navimpact::Error "NAME ends at E s, after AFTER",
+///         "NAME: START must be >= 0 s and DURATION > 0 s",
+///         "NAME starts before the previous outage ends (outages in time order, no overlap)".
 void checkOutages(const std::vector<Outage>& outages, double span_s, const std::string& after,
-                  const std::string& what = "outage");
-/// As above, with each outage named by @p names[i] in place of "WHAT S:D"
-/// (a sweep names the configuration key its window came from); names.size() == outages.size().
-void checkOutages(const std::vector<Outage>& outages, double span_s, const std::string& after,
-                  const std::vector<std::string>& names);
+                  const std::string& what = "outage", const std::vector<std::string>& names = {});
 
 }  // namespace navimpact
