@@ -14,6 +14,7 @@
 #include <new>
 #include <stdexcept>
 
+#include "frames.hpp"
 #include "mrpt_errors.hpp"
 #include "navimpact/core/alloc_limit.hpp"
 
@@ -114,8 +115,7 @@ std::string badImuFlags(const mrpt::serialization::CSerializable* obj) {
   const auto* m = dynamic_cast<const mrpt::obs::CObservationIMU*>(obj);
   if (!m) return {};
   for (std::size_t i = 0; i < m->dataIsPresent.size(); ++i) {
-    unsigned char b = 0;
-    std::memcpy(&b, &m->dataIsPresent[i], 1);
+    const unsigned char b = storedByte(m->dataIsPresent[i]);
     if (b > 1)
       return "CObservationIMU presence flag " + std::to_string(i) + " is byte " + std::to_string(b) +
              ", not 0 or 1 (malformed entry)";

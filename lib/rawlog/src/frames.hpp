@@ -23,14 +23,17 @@ inline const Eigen::Matrix3d& T_FLUtoFRD() {
 /// Attitude variance that stands for "no attitude known" (sigma 1e6 rad).
 constexpr double kUnknownAttitudeVar = 1e12;
 
-/// A bool MRPT deserialised byte for byte (Message_TOPCON_PZS hasCartesianPosVel,
-/// hasPosCov, hasVelCov): any byte but 0 is true. Reading a stored 255 as a bool
-/// is undefined behaviour (found twice by the libFuzzer runs of rawlog), so
-/// every such flag of a read entry goes through this.
-inline bool storedTrue(const bool& b) {
+/// The byte MRPT stored in a bool it deserialises byte for byte (the presence
+/// flags of CObservationIMU; Message_TOPCON_PZS hasCartesianPosVel, hasPosCov,
+/// hasVelCov). Reading a stored 255 as a bool is undefined behaviour (found by
+/// the libFuzzer runs of rawlog), so every such flag of a read entry goes
+/// through this.
+inline unsigned char storedByte(const bool& b) {
   unsigned char c = 0;
   std::memcpy(&c, &b, 1);
-  return c != 0;
+  return c;
 }
+/// Such a flag as a bool: any byte but 0 is true.
+inline bool storedTrue(const bool& b) { return storedByte(b) != 0; }
 
 }  // namespace navimpact::rawlog::detail

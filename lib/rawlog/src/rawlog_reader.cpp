@@ -9,7 +9,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <cstring>
 #include <deque>
 #include <tuple>
 #include <filesystem>
@@ -58,7 +57,7 @@ struct RawlogReader::Impl {
   std::string where(const std::string& label, double t) const {
     std::string s = path + ": entry " + std::to_string(entry);
     if (!label.empty())
-      s += " (label " + printable(label, 40) + (std::isfinite(t) ? ", t = " + std::to_string(t) + " s" : "") + ")";
+      s += " (label " + printable(label, 40) + (std::isfinite(t) ? ", t = " + formatNumber(t, 10) + " s" : "") + ")";
     return s;
   }
 
