@@ -94,6 +94,15 @@ const std::vector<Target>& targets() {
   return t;
 }
 
+std::filesystem::path mirrorSourceLayout(const std::filesystem::path& dir, const std::filesystem::path& src) {
+  const std::filesystem::path root = dir / "root";
+  std::filesystem::create_directories(root / "config/case");
+  std::filesystem::create_directory_symlink(src / "config/models", root / "config/models");
+  std::filesystem::create_directory_symlink(src / "datasets", root / "datasets");
+  std::filesystem::create_directory_symlink(src / "tests", root / "tests");
+  return root / "config/case";
+}
+
 std::string runOne(const Target& t, const std::string& path) {
   constexpr std::size_t kCap = std::size_t(1) << 30;  // no single allocation above 1 GiB
   AllocationLimit::takeRefused();

@@ -2,6 +2,7 @@
 // mutation CTest and by libFuzzer-style drivers).
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -15,8 +16,18 @@ struct Target {
 
 /// Every reader: IMU CSV, trajectory CSV, model text (structure and model
 /// strings, which must round-trip), model file, covariance / replay /
-/// emulation / study configurations, IMU rawlog and full rawlog readers.
+/// emulation / study / sweep configurations, IMU rawlog and full rawlog
+/// readers, the import manifest and the CSV column reader of its streams.
 const std::vector<Target>& targets();
+
+/**
+ * Lay out @p dir as the source tree @p src is seen from a configuration:
+ * dir/root/config/case (where an input is written), with root/config/models,
+ * root/datasets and root/tests linked to @p src, so that relative paths in an
+ * input resolve as they do from config/.
+ * @return the folder inputs go to, dir/root/config/case.
+ */
+std::filesystem::path mirrorSourceLayout(const std::filesystem::path& dir, const std::filesystem::path& src);
 
 /**
  * Run @p t on @p path under a 1 GiB single-allocation cap.

@@ -170,10 +170,7 @@ std::string mutate(std::string s, const std::vector<std::string>& pool, std::mt1
 /// paths in configurations resolve as in config/.
 fs::path mirror() {
   const fs::path dir = test::tempDir();
-  fs::create_directories(dir / "root/config/case");
-  fs::create_directory_symlink(test::sourcePath("config/models"), dir / "root/config/models");
-  fs::create_directory_symlink(test::sourcePath("datasets"), dir / "root/datasets");
-  fs::create_directory_symlink(test::sourcePath("tests"), dir / "root/tests");
+  fuzz::mirrorSourceLayout(dir, test::sourcePath(""));
   return dir;
 }
 

@@ -69,12 +69,8 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
   if (!mkdtemp(templ.data())) die("cannot create a temporary folder under " + base.string());
   g_dir = templ;
   std::atexit(removeDir);
-  const fs::path src = NAVIMPACT_SOURCE_DIR;
-  fs::create_directories(g_dir / "root/config/case");
-  fs::create_directory_symlink(src / "config/models", g_dir / "root/config/models");
-  fs::create_directory_symlink(src / "datasets", g_dir / "root/datasets");
-  fs::create_directory_symlink(src / "tests", g_dir / "root/tests");
-  g_input = (g_dir / "root/config/case" / (std::string("input") + g_target->extension)).string();
+  const fs::path case_dir = navimpact::fuzz::mirrorSourceLayout(g_dir, NAVIMPACT_SOURCE_DIR);
+  g_input = (case_dir / (std::string("input") + g_target->extension)).string();
   // scripts/fuzz.sh keeps this file when it has to kill a run that hangs
   // (libFuzzer writes no artifact then): it holds the input being read.
   std::fprintf(stderr, "navimpact fuzz: each input is written to %s\n", g_input.c_str());
