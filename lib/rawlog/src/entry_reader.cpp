@@ -13,6 +13,7 @@
 #include <cstring>
 #include <new>
 #include <stdexcept>
+#include <string_view>
 
 #include "frames.hpp"
 #include "mrpt_errors.hpp"
@@ -63,16 +64,16 @@ size_t GzCStream::Read(void* out, size_t n) {
     // line to stderr and then fail. Refused here, before MRPT sees the name.
     if (name_len_ > 0 && got == n && n == name_len_) {
       // (up to a NUL byte, as MRPT makes a C string of it)
-      const std::string name(static_cast<const char*>(out), strnlen(static_cast<const char*>(out), n));
+      const std::string_view name(static_cast<const char*>(out), strnlen(static_cast<const char*>(out), n));
       if (name != last_name_) {
-        const auto* id = mrpt::rtti::findRegisteredClass(name);
         last_name_ = name;
+        const auto* id = mrpt::rtti::findRegisteredClass(last_name_);
         last_registered_ = id != nullptr;
         last_abstract_ = id && !id->ptrCreateObject;
-        last_read_ = readByNavimpact(name);
+        last_read_ = readByNavimpact(last_name_);
       }
       if (last_abstract_) {
-        error = Error(in_.path() + ": an object of class '" + printable(name, 60) +
+        error = Error(in_.path() + ": an object of class '" + printable(last_name_, 60) +
                       "', which MRPT cannot create (an abstract class): malformed entry");
         return 0;
       }
