@@ -559,6 +559,30 @@ RunnerUp runnerUp(const BlockMeans& bm, const std::vector<Extension>& ext, const
   return ru;
 }
 
+/// The runner-up of one fast term @p q of a winner that also has slow terms:
+/// the slow decision and the level shift contest only the slow terms (the
+/// block means see nothing of a white noise or a short GM, which every slow
+/// explanation keeps), so this term's rival is the best extension the WV
+/// ranks that does without it, by the WV AIC.
+RunnerUp fastTermRunnerUp(const std::vector<Extension>& ext, const WvRanking& wv, int best, const Extension& win,
+                          std::size_t q) {
+  RunnerUp ru;
+  const Candidate& t = win.terms[q];
+  for (int i : wv.order) {
+    if (i == best) continue;
+    const Extension& e = ext[static_cast<std::size_t>(i)];
+    bool has = false;
+    for (std::size_t k = e.terms.size() - e.added; k < e.terms.size(); ++k)
+      has = has || (e.terms[k].kind == t.kind && e.terms[k].retune == t.retune && e.terms[k].term == t.term);
+    if (has) continue;
+    ru.causes = causesOf(e);
+    ru.detail = newTermsText(e) + " (WV deviance)";
+    ru.margin = e.crit - win.crit;
+    break;
+  }
+  return ru;
+}
+
 /// Each term found as it stands in the joint fit of @p S: its parameters,
 /// intervals and the misfit it explains given the other terms found, in
 /// place of its finding at cd.findings[found_at[i]] (which keeps the test,
@@ -636,18 +660,19 @@ std::vector<Candidate> searchCauses(const ChannelContext& ctx, const std::vector
     for (const auto& s : chk) pmin = std::min(pmin, s.p_value);
     // One finding per new term, restated below as it stands in the joint fit.
     for (std::size_t q = win.terms.size() - win.added; q < win.terms.size(); ++q) {
+      const RunnerUp& r = bm.hasSlow(win) && !bm.isSlow(win.terms[q]) ? fastTermRunnerUp(ext, wv, best, win, q) : ru;
       Finding nf;
       nf.channel = cd.name;
       nf.statistic = pmin;
       nf.threshold = w.p_thr;
       nf.p_value = std::min(1.0, pmin * J * ctx.channels / 0.4);  // Bonferroni over scales and channels (WV share)
       nf.evidence = evidence;
-      nf.runner_up = ru.causes;
-      nf.runner_up_detail = ru.detail;
-      nf.aic_margin = ru.margin;
-      nf.runner_up_p = ru.p;
-      nf.runner_up_draws = ru.draws;
-      nf.decided = ru.decided();
+      nf.runner_up = r.causes;
+      nf.runner_up_detail = r.detail;
+      nf.aic_margin = r.margin;
+      nf.runner_up_p = r.p;
+      nf.runner_up_draws = r.draws;
+      nf.decided = r.decided();
       cd.findings.push_back(nf);
       found_at.push_back(cd.findings.size() - 1);
     }
