@@ -66,12 +66,13 @@ navimpact::cli::Registrar reg({
         if (!o->imu_label.empty()) cfg.imu_label = o->imu_label;
         if (!o->gnss_label.empty()) cfg.gnss_label = o->gnss_label;
         if (!o->outages.empty()) {
-          cfg.outages.clear();
-          cfg.outage_names.clear();
+          std::vector<navimpact::Outage> outages;
+          std::vector<std::string> names;
           for (const auto& s : o->outages) {
-            cfg.outages.push_back(navimpact::parseOutage(s));
-            cfg.outage_names.push_back("--outage " + navimpact::outageText(cfg.outages.back()));
+            outages.push_back(navimpact::parseOutage(s));
+            names.push_back("--outage " + navimpact::outageText(outages.back()));
           }
+          cfg.setOutages(std::move(outages), std::move(names));
         }
         if (!o->outages_every.empty()) cfg.outages_every = navimpact::parseOutagePattern(o->outages_every);
         if (o->propagate_every) cfg.propagate_every = *o->propagate_every;

@@ -372,7 +372,7 @@ TEST(Replay, ConfigLoadsScoringAlignmentAndAids) {
   EXPECT_EQ(c.aids.zupt_detector.window_s, 0.4);
   EXPECT_TRUE(c.aids.nhc);
   EXPECT_EQ(c.aids.nhc_point_B.x(), -1.0);
-  for (const std::string& bad : {"outages_every: {period_s: 10, duration_s: 30}\n", "aids: {zupt: {sigma_mps: -1}}\n",
+  for (const char* bad : {"outages_every: {period_s: 10, duration_s: 30}\n", "aids: {zupt: {sigma_mps: -1}}\n",
                                  "aids: {nhc: {speed: 1}}\n", "imu_at_rest: {false_alarm: 0.7}\n"}) {
     std::ofstream(path) << bad;
     EXPECT_THROW(an::loadReplayConfig(path), navimpact::Error) << bad;

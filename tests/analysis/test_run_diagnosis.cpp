@@ -255,7 +255,9 @@ TEST(RunDiagnosis, AnExtensionThatAlignsLaterIsScoredOnTheMeasuredOutageWindows)
   for (std::size_t k = 0; k < cut.outages.size(); ++k) {
     const auto& m = measured.score->outages[k];
     ASSERT_EQ(cut.outages[k].has_value(), p.outages[k].has_value() && m.start_s + m.duration_s <= stop);
-    if (cut.outages[k]) EXPECT_EQ(cut.outages[k]->err_N, p.outages[k]->err_N);
+    if (cut.outages[k]) {
+      EXPECT_EQ(cut.outages[k]->err_N, p.outages[k]->err_N);
+    }
   }
 }
 

@@ -64,7 +64,9 @@ TEST(RunPlan, EpochsOnTheImuGridDenserInOutagesEachOutageEndAnEpoch) {
     for (std::size_t e = 0; e < p.truth.t.size(); ++e) {
       const double k = (p.truth.t[e] - p.t0) * rate;
       EXPECT_NEAR(k, std::round(k), 1e-6) << e;
-      if (e > 0) EXPECT_GT(p.truth.t[e], p.truth.t[e - 1]);
+      if (e > 0) {
+        EXPECT_GT(p.truth.t[e], p.truth.t[e - 1]);
+      }
     }
     const double step_out = std::max(1.0, std::round(rate / o.record_rate_hz)) / rate;
     const double step_in = std::max(1.0, std::round(rate / o.outage_record_rate_hz)) / rate;
@@ -78,8 +80,9 @@ TEST(RunPlan, EpochsOnTheImuGridDenserInOutagesEachOutageEndAnEpoch) {
       EXPECT_LE(std::abs(p.truth.t[p.outage_end_epoch[q]] - (p.t0 + w.end_s)), 0.5 / rate + 1e-9);
       // inside the outage no gap longer than the outage record step
       for (std::size_t e = 1; e < p.truth.t.size(); ++e)
-        if (p.truth.t[e - 1] >= p.t0 + w.start_s - 0.5 / rate && p.truth.t[e] <= p.t0 + w.end_s + 0.5 / rate)
+        if (p.truth.t[e - 1] >= p.t0 + w.start_s - 0.5 / rate && p.truth.t[e] <= p.t0 + w.end_s + 0.5 / rate) {
           EXPECT_LE(p.truth.t[e] - p.truth.t[e - 1], step_in + 1e-9);
+        }
     }
     // outside: no gap longer than the record step
     for (std::size_t e = 1; e < p.truth.t.size(); ++e) EXPECT_LE(p.truth.t[e] - p.truth.t[e - 1], step_out + 1e-9);

@@ -66,8 +66,7 @@ emulation::SmoothTrajectory buildTrajectory(const ReplayResult& scored, const Ru
              " s apart), smoothed by P-splines";
   } else {
     ReplayConfig c = opt.replay;
-    c.outages.clear();
-    c.outage_names.clear();
+    c.setOutages({});
     c.outages_every.reset();
     c.use_reference = false;
     c.record_interval_s = 0.1;
@@ -446,8 +445,7 @@ PairedOutageScores replayOnMeasuredOutages(const ReplayConfig& extension, const 
                                            const rawlog::RawlogRecords& data, double stop_after_s) {
   if (!measured.score) throw Error(measured.cfg.rawlog + ": the measured replay has no reference (GT) to score against");
   ReplayConfig c = extension;
-  c.outages = measured.cfg.outages;  // every window of the measured replay, from time zero
-  c.outage_names.clear();
+  c.setOutages(measured.cfg.outages);  // every window of the measured replay, from time zero
   c.outages_every.reset();
   const ReplayResult r = runReplay(c, data, stop_after_s);
   if (!r.score) throw Error(c.rawlog + ": the extended replay has no reference (GT) to score against");
@@ -734,8 +732,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
   auto fitExtra = [&](ExtraCause kind) -> Fit {
     return [&, kind](const ReplayConfig& base, const Exclusion& ex, std::vector<RunFinding>* fnd, CauseResult* cr) {
       ReplayConfig c = base;
-      c.outages.clear();
-      c.outage_names.clear();
+      c.setOutages({});
       c.outages_every.reset();
       if (ex.b >= ex.a) {
         const double a = std::max(0.0, ex.a - tz), b = std::min(ex.b - tz, out.run_end_s);
@@ -952,8 +949,7 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   std::vector<ReplayResult> measured;
   for (std::size_t i = 0; i < D; ++i) {
     ReplayConfig c = opt.replay;
-    c.outages.clear();
-    c.outage_names.clear();
+    c.setOutages({});
     c.outages_every = OutagePattern{opt.durations_s[i] + opt.reconverge_s, opt.durations_s[i]};
     progress(0.10 * double(i) / double(D), "replay");
     measured.push_back(runReplay(c, data));

@@ -42,6 +42,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -134,8 +135,10 @@ struct GnssInnovation {
 struct NavEpoch {
   double t = 0.0;                   ///< [s]
   ins::NavState est;                ///< the filter's estimate at t (after the updates of t)
-  filter::Vector9d err;             ///< estimate minus truth: dp NED [m], dv NED [m/s], psi [rad]; NaN without truth
-  filter::Vector9d sigma;           ///< predicted 1-sigma of the same nine errors
+  /// estimate minus truth: dp NED [m], dv NED [m/s], psi [rad]; NaN without truth
+  filter::Vector9d err = filter::Vector9d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// predicted 1-sigma of the same nine errors (NaN until set)
+  filter::Vector9d sigma = filter::Vector9d::Constant(std::numeric_limits<double>::quiet_NaN());
   Eigen::Matrix3d P_pos = Eigen::Matrix3d::Zero();  ///< predicted position covariance N, E, D [m^2]
   std::array<double, 4> nees{};     ///< position (3 dof), velocity (3), attitude (3), all (9); NaN if P singular or no truth
 };

@@ -69,6 +69,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "navimpact/analysis/nav_run.hpp"
@@ -104,6 +105,11 @@ struct ReplayConfig {
   /// How each outage is named in messages, when it came from a file or flag
   /// ("FILE:L:C: key 'outages[1]': outage 200:60", "--outage 200:60"); one per outage or empty.
   std::vector<std::string> outage_names;
+  /// Replace the outages and their names together (none: each named "outage S:D").
+  void setOutages(std::vector<Outage> o, std::vector<std::string> names = {}) {
+    outages = std::move(o);
+    outage_names = std::move(names);
+  }
   int propagate_every = 10;                     ///< covariance propagation every k IMU samples
   bool use_gnss_velocity = true;
   double gate_probability = 0.0;
