@@ -18,6 +18,7 @@
 #include "navimpact/rawlog/writer.hpp"
 #include "navimpact/report/run_diagnosis_report.hpp"
 #include "navimpact/stochastic/model_file.hpp"
+#include "navimpact/stochastic/simulate.hpp"
 #include "test_support.hpp"
 
 namespace emu = navimpact::emulation;
@@ -304,6 +305,15 @@ struct Hidden {
   std::vector<Truth> truth;              // true values of the cause's parameters
 };
 
+/// The seeds of a hidden-effect test: @p a and @p b, or with
+/// NAVIMPACT_RUN_DIAGNOSIS_SEED=S (S > 0), two others derived from S: draws
+/// the suite has never seen, printed with the draw.
+std::vector<std::uint64_t> seeds(std::uint64_t a, std::uint64_t b) {
+  const std::uint64_t root = navimpact::test::envOr("NAVIMPACT_RUN_DIAGNOSIS_SEED", 0);
+  if (root == 0) return {a, b};
+  return {st::deriveSeed(root, a), st::deriveSeed(root, b)};
+}
+
 /// Magnitude log-uniform over [hi / 10^decades, hi] with a random sign.
 double drawSigned(std::mt19937_64& rng, double hi, double decades) {
   const double m = hi * std::pow(10.0, -decades * std::uniform_real_distribution<double>(0.0, 1.0)(rng));
@@ -394,7 +404,7 @@ void checkHiddenTriad(const TriadEffect& e, std::uint64_t seed) {
 // documented [1, 100]; gyro or accelerometers drawn): the factor's 99 %
 // interval covers k on the affected channels and stays near 1 on the others.
 TEST(RunDiagnosisHidden, InMotionNoise) {
-  for (std::uint64_t seed : {41003u, 41004u}) {
+  for (std::uint64_t seed : seeds(41003u, 41004u)) {
     std::mt19937_64 rng(seed);
     const bool gyro = (rng() & 1u) != 0;
     const double k = std::pow(10.0, 2.0 * std::uniform_real_distribution<double>(0.0, 1.0)(rng));
@@ -419,7 +429,7 @@ TEST(RunDiagnosisHidden, InMotionNoise) {
 TEST(RunDiagnosisHidden, ScaleFactor) {
   const TriadEffect e{"scale_factor", "scale", "scale factor", "", limits::kScaleFactor.hi,
                       kLimitGyroScale, kLimitAccScale, &emu::SensorEffects::gyro_scale, &emu::SensorEffects::acc_scale};
-  for (std::uint64_t seed : {41101u, 41102u}) checkHiddenTriad(e, seed);
+  for (std::uint64_t seed : seeds(41101u, 41102u)) checkHiddenTriad(e, seed);
 }
 
 // Misalignment of one triad (drawn), one magnitude log-uniform over [5e-5, 0.05] rad.
@@ -427,12 +437,12 @@ TEST(RunDiagnosisHidden, Misalignment) {
   const TriadEffect e{"misalignment", "angle", "misalignment", " rad", limits::kMisalignmentRad.hi,
                       kLimitGyroMisalignment, kLimitAccMisalignment, &emu::SensorEffects::gyro_misalignment_rad,
                       &emu::SensorEffects::acc_misalignment_rad};
-  for (std::uint64_t seed : {41201u, 41202u}) checkHiddenTriad(e, seed);
+  for (std::uint64_t seed : seeds(41201u, 41202u)) checkHiddenTriad(e, seed);
 }
 
 // IMU-GNSS time offset, magnitude log-uniform over [1e-4, 0.1] s, random sign.
 TEST(RunDiagnosisHidden, TimeOffset) {
-  for (std::uint64_t seed : {41301u, 41302u}) {
+  for (std::uint64_t seed : seeds(41301u, 41302u)) {
     std::mt19937_64 rng(seed);
     const double d = drawSigned(rng, limits::kTimeOffsetS.hi, 3.0);
     emu::SensorEffects fx;
@@ -445,7 +455,7 @@ TEST(RunDiagnosisHidden, TimeOffset) {
 
 // Antenna lever-arm error, one magnitude log-uniform over [0.01, 10] m, random sign per axis.
 TEST(RunDiagnosisHidden, LeverArm) {
-  for (std::uint64_t seed : {41401u, 41402u}) {
+  for (std::uint64_t seed : seeds(41401u, 41402u)) {
     std::mt19937_64 rng(seed);
     const double m = std::abs(drawSigned(rng, limits::kLeverArmErrorM.hi, 3.0));
     emu::SensorEffects fx;
@@ -461,12 +471,13 @@ TEST(RunDiagnosisHidden, LeverArm) {
 }
 
 // An accelerometer bias random walk the model lacks (all three axes), density
-// log-uniform over [1e-5, 1e-2] m/s^2/sqrt(s): bias_instability. Its vertical
-// (acc_z) interval covers the truth; the horizontal estimate is not checked (the
-// horizontal outage errors also carry the attitude errors the random walk
-// causes, so it reads high: 0.076 for a true 0.01).
+// log-uniform over [1e-5, 1e-2] m/s^2/sqrt(s): bias_instability. The horizontal
+// (acc_x, acc_y: one estimate) and vertical (acc_z) intervals cover the truth,
+// at most one miss. (Scaled as q T^5/20, a bias known at the outage start, they
+// read 2-6x high and missed at most seeds: the filter that lacks the random walk
+// starts each outage with a bias that has wandered since it last estimated it.)
 TEST(RunDiagnosisHidden, BiasInstability) {
-  for (std::uint64_t seed : {41501u, 41502u}) {
+  for (std::uint64_t seed : seeds(41501u, 41502u)) {
     std::mt19937_64 rng(seed);
     const double q = std::abs(drawSigned(rng, 1e-2, 3.0));
     st::ImuModel m = st::loadImuModel(navimpact::test::sourcePath(kModel));
@@ -477,6 +488,7 @@ TEST(RunDiagnosisHidden, BiasInstability) {
     std::cout << "hidden accelerometer bias random walk: seed " << seed << ", " << q << " m/s^2/sqrt(s)\n";
     const auto path = emulateRun("bias_" + std::to_string(seed), mfile, seed);
     checkHidden(an::diagnoseRun(hiddenOptions(path, seed + 1)),
-                Hidden{"bias_instability", q, kLimitBiasRandomWalk, {{"acc_z", "rw_density", q}}});
+                Hidden{"bias_instability", q, kLimitBiasRandomWalk,
+                       {{"acc_x", "rw_density", q}, {"acc_y", "rw_density", q}, {"acc_z", "rw_density", q}}});
   }
 }

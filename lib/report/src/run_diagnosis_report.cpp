@@ -64,7 +64,11 @@ std::string runDiagnosisJson(const RunDiagnosis& d, const std::string& input_jso
     j["gain"] = gainJson(d.causes[static_cast<std::size_t>(d.best)]);
   } else if (!d.causes.empty()) {
     j["gain"] = gainJson(d.causes.front());
-    j["gain"]["note"] = "no cause has a significant held-out gain: the best-ranked one is shown, no extension written";
+    const auto& b = d.causes.front();
+    j["gain"]["note"] = b.significant && !b.given.empty()
+                            ? "undecided between " + b.cause + " and " + b.given + ": the best-ranked cause gains nothing "
+                              "significant on top of the runner-up's extension; no extension written"
+                            : "no cause has a significant held-out gain: the best-ranked one is shown, no extension written";
   } else {
     j["gain"] = {{"outage_error_before_m", nullptr}, {"outage_error_after_m", nullptr}, {"anees_before", nullptr},
                  {"anees_after", nullptr}, {"significant", false}, {"note", "causes not analysed"}};
@@ -203,7 +207,7 @@ std::string runDiagnosisMarkdown(const RunDiagnosis& d) {
       if (!c.given.empty())
         s << "\n" << c.cause << " added to the extension of " << c.given << ": held-out gain " << r3(c.gain_given)
           << ", p = " << formatReadable(c.p_given, 2) << " -> "
-          << (c.adds ? "it explains more than " + c.given + ": named too"
+          << (c.adds ? "it explains more than " + c.given + ": named"
                      : "nothing beyond " + c.given + " (it shares its signature): not named")
           << ".\n";
     s << "\n### Fitted parameters (whole run)\n\n| cause | channel | parameter | value | interval |\n|---|---|---|---|---|\n";
@@ -222,6 +226,13 @@ std::string runDiagnosisMarkdown(const RunDiagnosis& d) {
         << r3(b.error_before_m) << " -> " << r3(b.error_after_m) << " m, mean NEES " << r3(b.anees_before) << " -> "
         << r3(b.anees_after) << ", p = " << formatReadable(b.p_value, 2)
         << ". The extension: model_extended.yaml and filter_extended.yaml.\n";
+    } else if (d.causes.front().significant && !d.causes.front().given.empty()) {
+      const auto& b = d.causes.front();
+      s << "\n**Undecided between " << b.cause << " and " << b.given << "**: " << b.cause
+        << " has the larger held-out gain, but nothing beyond " << b.given << "'s extension (gain "
+        << r3(b.gain_given) << ", p = " << formatReadable(b.p_given, 2)
+        << "): the held-out outages do not tell the two apart. No extension is proposed; a run with other "
+           "motion (turns, speed changes, longer outages) may separate them.\n";
     } else {
       s << "\nNo cause has a significant held-out gain: no extension is proposed.\n";
     }

@@ -135,9 +135,11 @@ struct CauseResult {
   /// A significant cause other than the top-ranked one, added to the top cause's
   /// extension (fitted per fold on top of it) and scored against it on the
   /// same held-out outages: named (findings) only if that gain is significant too.
-  std::string given;                     ///< the top-ranked cause it was added to ("" = not tested)
+  /// The top-ranked cause, when significant, is added to the runner-up's
+  /// extension the same way: not adding there, the two are undecided.
+  std::string given;                     ///< the cause it was added to ("" = not tested)
   double gain_given = NAN, p_given = NAN;  ///< its held-out gain and p on top of that cause
-  bool adds = false;                     ///< gain_given > 0 and p_given < alpha / (number of causes)
+  bool adds = false;                     ///< gain_given > 0 and p_given < alpha / (number of causes) (the top cause: < alpha)
   std::string extension;                 ///< what the extension changes, in words
   stochastic::ImuModel model_after;      ///< the extended model (whole-run fit; = today's for GNSS causes)
   std::optional<double> gnss_sigma_h_m, gnss_sigma_v_m;  ///< the extended filter's GNSS sigmas (gnss_noise)
