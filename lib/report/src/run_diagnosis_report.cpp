@@ -74,9 +74,17 @@ std::string runDiagnosisJson(const RunDiagnosis& d, const std::string& input_jso
                  {"anees_after", nullptr}, {"significant", false}, {"note", "causes not analysed"}};
   }
   nlohmann::json cs = nlohmann::json::array();
-  for (const auto& c : d.causes) {
+  for (std::size_t k = 0; k < d.causes.size(); ++k) {
+    const auto& c = d.causes[k];
     nlohmann::json cj = gainJson(c);
-    if (!c.given.empty())
+    // the top-ranked cause was added to the runner-up's extension, every
+    // other one to the top cause's
+    if (!c.given.empty() && k == 0)
+      cj["on_top_of_runner_up"] = {{"runner_up_cause", c.given},
+                                   {"nll_gain", num(c.gain_given)},
+                                   {"p_value", num(c.p_given)},
+                                   {"named", c.adds}};
+    else if (!c.given.empty())
       cj["on_top_of_best"] = {{"best_cause", c.given},
                               {"nll_gain", num(c.gain_given)},
                               {"p_value", num(c.p_given)},
