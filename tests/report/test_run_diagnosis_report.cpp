@@ -71,3 +71,20 @@ TEST(RunDiagnosisReport, ATopCauseThatExplainsMoreThanTheRunnerUpIsNamed) {
   EXPECT_EQ(js["findings"][0]["cause"], "bias_instability");
   EXPECT_EQ(js["causes"][0]["on_top_of_runner_up"]["named"], true);
 }
+
+TEST(RunDiagnosisReport, ATopCauseTheRunnerUpAddsNothingToIsNamedAndSaysWhy) {
+  // bias_instability adds 0.5 (not significant) on top of misalignment,
+  // misalignment adds nothing (-1) on top of bias_instability
+  an::RunDiagnosis d = twoCauses(0.5, 0.3, true);
+  d.causes[1].given = "bias_instability";
+  d.causes[1].gain_given = -1.0;
+  d.causes[1].p_given = 0.99;
+  const std::string md = rp::runDiagnosisMarkdown(d);
+  EXPECT_NE(md.find("not significant, but misalignment adds nothing on top of bias_instability (below): "
+                    "bias_instability named"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("misalignment added to the extension of bias_instability: held-out gain -1"), std::string::npos)
+      << md;
+  EXPECT_NE(md.find("**Cause: bias_instability**"), std::string::npos) << md;
+}

@@ -211,13 +211,22 @@ std::string runDiagnosisMarkdown(const RunDiagnosis& d) {
         << r3(c.anees_before) << " / " << r3(c.anees_after) << " | " << r3(c.gain) << " | "
         << formatReadable(c.p_value, 2) << " | " << (c.significant ? "yes" : "no") << " |\n";
     }
-    for (const auto& c : d.causes)
-      if (!c.given.empty())
-        s << "\n" << c.cause << " added to the extension of " << c.given << ": held-out gain " << r3(c.gain_given)
-          << ", p = " << formatReadable(c.p_given, 2) << " -> "
-          << (c.adds ? "it explains more than " + c.given + ": named"
-                     : "nothing beyond " + c.given + " (it shares its signature): not named")
-          << ".\n";
+    for (std::size_t k = 0; k < d.causes.size(); ++k) {
+      const auto& c = d.causes[k];
+      if (c.given.empty()) continue;
+      s << "\n" << c.cause << " added to the extension of " << c.given << ": held-out gain " << r3(c.gain_given)
+        << ", p = " << formatReadable(c.p_given, 2) << " -> ";
+      if (k == 0 && c.adds && !(c.gain_given > 0 && c.p_given < d.alpha))
+        s << "not significant, but " << c.given << " adds nothing on top of " << c.cause << " (below): " << c.cause
+          << " named";
+      else if (k == 0 && !c.adds)
+        s << "the held-out outages do not tell " << c.cause << " from " << c.given << ": undecided";
+      else if (c.adds)
+        s << "it explains more than " << c.given << (k == 0 ? "" : ": named");
+      else
+        s << "nothing beyond " << c.given << " (it shares its signature): not named";
+      s << ".\n";
+    }
     s << "\n### Fitted parameters (whole run)\n\n| cause | channel | parameter | value | interval |\n|---|---|---|---|---|\n";
     for (const auto& c : d.causes)
       for (const auto& f : c.findings)
