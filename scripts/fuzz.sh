@@ -128,18 +128,22 @@ run_one() {
   timeout -k 10 "$WALL" $B/bin/fuzz_$t "${LIMIT[@]}" -rss_limit_mb=1024 -malloc_limit_mb=1024 -timeout=10 \
     -print_final_stats=1 -artifact_prefix=$B/findings/$t/ ${NAVIMPACT_FUZZ_ARGS:-} $B/corpus/$t $S/$t \
     > "$log" 2>&1 || rc=$?
+  local input
+  input=$(sed -n 's/^navimpact fuzz: each input is written to //p' "$log" | head -1)
   if [ $rc -eq 124 ] || [ $rc -eq 137 ]; then
-    local input
-    input=$(sed -n 's/^navimpact fuzz: each input is written to //p' "$log" | head -1)
     if [ -n "$input" ] && [ -f "$input" ]; then
       local kept
       kept=$B/findings/$t/hang-$(sha1sum < "$input" | cut -c1-40)
       cp "$input" "$kept"
       echo "Test unit written to $kept" >> "$log"
-      local dir=${input%%/root/config/case/*}
-      [[ $dir == */navimpact-fuzz-* ]] && rm -rf "$dir"
     fi
     echo "navimpact fuzz: SUMMARY: the run did not end and was killed after $WALL s" >> "$log"
+  fi
+  # the driver's folder of inputs (its exit handler does not run when
+  # libFuzzer ends a run or aborts on a finding: one was left per run)
+  if [ -n "$input" ]; then
+    local dir=${input%%/root/config/case/*}
+    if [[ $dir == */navimpact-fuzz-* ]]; then rm -rf "$dir"; fi
   fi
   local execs rate rss
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
