@@ -261,15 +261,17 @@ std::string causesOf(const Extension& e) {
   return j;
 }
 
-/// Every new term of @p small is one of @p big's (same kind, same retuned term).
+/// @p t is one of the new terms of @p e (same kind, same retuned term).
+bool hasNewTerm(const Extension& e, const Candidate& t) {
+  for (std::size_t k = e.terms.size() - e.added; k < e.terms.size(); ++k)
+    if (e.terms[k].kind == t.kind && e.terms[k].retune == t.retune && e.terms[k].term == t.term) return true;
+  return false;
+}
+
+/// Every new term of @p small is one of @p big's.
 bool containsNewTerms(const Extension& big, const Extension& small) {
-  for (std::size_t q = small.terms.size() - small.added; q < small.terms.size(); ++q) {
-    bool in = false;
-    for (std::size_t k = big.terms.size() - big.added; k < big.terms.size(); ++k)
-      in = in || (big.terms[k].kind == small.terms[q].kind && big.terms[k].retune == small.terms[q].retune &&
-                  big.terms[k].term == small.terms[q].term);
-    if (!in) return false;
-  }
+  for (std::size_t q = small.terms.size() - small.added; q < small.terms.size(); ++q)
+    if (!hasNewTerm(big, small.terms[q])) return false;
   return true;
 }
 
@@ -567,14 +569,9 @@ RunnerUp runnerUp(const BlockMeans& bm, const std::vector<Extension>& ext, const
 RunnerUp fastTermRunnerUp(const std::vector<Extension>& ext, const WvRanking& wv, int best, const Extension& win,
                           std::size_t q) {
   RunnerUp ru;
-  const Candidate& t = win.terms[q];
   for (int i : wv.order) {
-    if (i == best) continue;
     const Extension& e = ext[static_cast<std::size_t>(i)];
-    bool has = false;
-    for (std::size_t k = e.terms.size() - e.added; k < e.terms.size(); ++k)
-      has = has || (e.terms[k].kind == t.kind && e.terms[k].retune == t.retune && e.terms[k].term == t.term);
-    if (has) continue;
+    if (i == best || hasNewTerm(e, win.terms[q])) continue;
     ru.causes = causesOf(e);
     ru.detail = newTermsText(e) + " (WV deviance)";
     ru.margin = e.crit - win.crit;

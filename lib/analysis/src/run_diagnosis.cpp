@@ -492,8 +492,9 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
     double a, b;     // window
     double T;        // coasting time at the scored end [s]
     double pred_h2, pred_v2;  // simulated mean squares at this outage end
-    double g_h, g_v;          // their paired excess per unit random-walk density q [m^2 / (m^2/s^3)]
-    std::vector<double> d_h, d_v;  // the same per realisation (g_h, g_v their mean)
+    // per realisation: its paired excess with the calibration random walk,
+    // per unit density q [m^2 / (m^2/s^3)]
+    std::vector<double> d_h, d_v;
   };
   std::vector<Item> items;
   for (std::size_t i = 0; i < D; ++i) {
@@ -501,7 +502,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
     const double tz = measured[i].t_zero;
     for (std::size_t j = 0; j < simOut[i].size(); ++j) {
       const auto& o = sc.outages[simOut[i][j].score_index];
-      Item it{i, j, 0, o.start_s + tz, o.start_s + tz + o.duration_s, o.end_s - o.start_s, 0.0, 0.0, 0.0, 0.0, {}, {}};
+      Item it{i, j, 0, o.start_s + tz, o.start_s + tz + o.duration_s, o.end_s - o.start_s, 0.0, 0.0, {}, {}};
       const double mid = 0.5 * (it.a + it.b);
       it.fold = std::min(K - 1, std::max(0, static_cast<int>(std::floor((mid - t0) / L))));
       double h2 = 0.0, v2 = 0.0;
@@ -514,15 +515,10 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
       it.pred_v2 = v2 / double(sims.size());
       const double q0 = kCalibrationRwDensity * kCalibrationRwDensity;
       for (const auto& s : sims) {
-        if (s.err_rw.empty()) break;
         const auto &e = s.err_rw[i][j], &e0 = s.err[i][j];
         it.d_h.push_back((e(0) * e(0) + e(1) * e(1) - e0(0) * e0(0) - e0(1) * e0(1)) / q0);
         it.d_v.push_back((e(2) * e(2) - e0(2) * e0(2)) / q0);
-        it.g_h += it.d_h.back() / double(sims.size());
-        it.g_v += it.d_v.back() / double(sims.size());
       }
-      it.g_h = std::max(0.0, it.g_h);
-      it.g_v = std::max(0.0, it.g_v);
       items.push_back(it);
     }
   }
@@ -691,25 +687,26 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
     for (const auto& it : items)
       if (!ex.overlaps(it.a, it.b)) tr_items.push_back(&it);
     if (tr_items.empty()) throw Error("diagnose --run: no training outage outside the held-out block");
-    // rs: the realisations whose calibration counts (nullptr: all)
+    // What density 1 adds at an outage end through this filter: the mean
+    // paired excess over the realisations @p rs (nullptr: all), >= 0. The
+    // bias the filter lacks has wandered since it last estimated it, so this
+    // is far above q T^5/20 per axis of a bias known at the outage start.
+    auto perUnit = [](const std::vector<double>& d, const std::vector<std::size_t>* rs) {
+      const double n = static_cast<double>(rs ? rs->size() : d.size());
+      double x = 0.0;
+      if (rs) {
+        for (std::size_t r : *rs) x += d[r] / n;
+      } else {
+        for (double v : d) x += v / n;
+      }
+      return std::max(0.0, x);
+    };
     auto lsq = [&](const std::vector<const Item*>& v, double& qh, double& qv, const std::vector<std::size_t>* rs) {
       double nh = 0, dh = 0, nv = 0, dv = 0;
       for (const Item* it : v) {
         const auto& o = measured[it->i].score->outages[simOut[it->i][it->j].score_index];
         const double eh2 = o.err_N(0) * o.err_N(0) + o.err_N(1) * o.err_N(1), ev2 = o.err_N(2) * o.err_N(2);
-        // what density 1 adds at this outage end through this filter: the
-        // bias the filter lacks has wandered since it last estimated it, so
-        // this is far above q T^5/20 per axis of a bias known at the start
-        double xh = it->g_h, xv = it->g_v;
-        if (rs) {
-          xh = xv = 0.0;
-          for (std::size_t r : *rs) {
-            xh += it->d_h[r] / double(rs->size());
-            xv += it->d_v[r] / double(rs->size());
-          }
-          xh = std::max(0.0, xh);
-          xv = std::max(0.0, xv);
-        }
+        const double xh = perUnit(it->d_h, rs), xv = perUnit(it->d_v, rs);
         nh += (eh2 - it->pred_h2 - 2 * ref.sigma_h_m * ref.sigma_h_m) * xh;
         dh += xh * xh;
         nv += (ev2 - it->pred_v2 - ref.sigma_v_m * ref.sigma_v_m) * xv;
@@ -1147,19 +1144,24 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
       o.h = tr.at(b.t).pos.h + *b.sigma_m * zb[k];
       run.baro.push_back(o);
     }
+    // The filter of every duration over @p er: its outage ends, one per
+    // simulated outage, each passed to keep(duration, epoch).
+    auto filterEnds = [&](const EmulatedRun& er, const std::string& with, auto&& keep) {
+      for (std::size_t i = 0; i < D; ++i) {
+        const NavRunResult res = runNav(er.input(truths[i]), model, navs[i]);
+        if (res.epochs.size() != simOut[i].size())
+          throw Error("diagnose --run: realisation " + std::to_string(r) + with + " recorded " +
+                      std::to_string(res.epochs.size()) + " outage ends, expected " + std::to_string(simOut[i].size()));
+        for (const auto& e : res.epochs) keep(i, e);
+      }
+    };
     RealisationOut& ro = sims[r];
     ro.err.resize(D);
     ro.nees.resize(D);
-    for (std::size_t i = 0; i < D; ++i) {
-      const NavRunResult res = runNav(run.input(truths[i]), model, navs[i]);
-      if (res.epochs.size() != simOut[i].size())
-        throw Error("diagnose --run: realisation " + std::to_string(r) + " recorded " +
-                    std::to_string(res.epochs.size()) + " outage ends, expected " + std::to_string(simOut[i].size()));
-      for (const auto& e : res.epochs) {
-        ro.err[i].push_back(e.err);
-        ro.nees[i].push_back(e.nees[0]);
-      }
-    }
+    filterEnds(run, "", [&](std::size_t i, const NavEpoch& e) {
+      ro.err[i].push_back(e.err);
+      ro.nees[i].push_back(e.nees[0]);
+    });
     if (opt.causes) {
       // The same realisation with an accelerometer bias random walk of
       // density kCalibrationRwDensity on the three axes (its own stream).
@@ -1176,13 +1178,8 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
       rw.gnss = run.gnss;
       rw.baro = run.baro;
       ro.err_rw.resize(D);
-      for (std::size_t i = 0; i < D; ++i) {
-        const NavRunResult res = runNav(rw.input(truths[i]), model, navs[i]);
-        if (res.epochs.size() != simOut[i].size())
-          throw Error("diagnose --run: realisation " + std::to_string(r) + " with the calibration random walk recorded " +
-                      std::to_string(res.epochs.size()) + " outage ends, expected " + std::to_string(simOut[i].size()));
-        for (const auto& e : res.epochs) ro.err_rw[i].push_back(e.err);
-      }
+      filterEnds(rw, " with the calibration random walk",
+                 [&](std::size_t i, const NavEpoch& e) { ro.err_rw[i].push_back(e.err); });
     }
   }, [&](std::size_t done, std::size_t count) {
     progress(0.15 + (opt.causes ? 0.65 : 0.85) * double(done) / double(count), "simulation");

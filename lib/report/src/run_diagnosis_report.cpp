@@ -79,16 +79,13 @@ std::string runDiagnosisJson(const RunDiagnosis& d, const std::string& input_jso
     nlohmann::json cj = gainJson(c);
     // the top-ranked cause was added to the runner-up's extension, every
     // other one to the top cause's
-    if (!c.given.empty() && k == 0)
-      cj["on_top_of_runner_up"] = {{"runner_up_cause", c.given},
-                                   {"nll_gain", num(c.gain_given)},
-                                   {"p_value", num(c.p_given)},
-                                   {"named", c.adds}};
-    else if (!c.given.empty())
-      cj["on_top_of_best"] = {{"best_cause", c.given},
-                              {"nll_gain", num(c.gain_given)},
-                              {"p_value", num(c.p_given)},
-                              {"named", c.adds}};
+    if (!c.given.empty()) {
+      const bool top = k == 0;
+      cj[top ? "on_top_of_runner_up" : "on_top_of_best"] = {{top ? "runner_up_cause" : "best_cause", c.given},
+                                                            {"nll_gain", num(c.gain_given)},
+                                                            {"p_value", num(c.p_given)},
+                                                            {"named", c.adds}};
+    }
     cj["findings"] = nlohmann::json::array();
     for (const auto& f : c.findings) cj["findings"].push_back(findingJson(f));
     cs.push_back(cj);
