@@ -230,8 +230,8 @@ TEST(ImuSeriesWindow, KeepsTheSamplesInsideTheWindow) {
       EXPECT_EQ(ch.x.back(), static_cast<double>(k1 - 1));
       // every kept sample's time lies in the window, its neighbours outside
       EXPECT_GE(ch.x.front() / s.rate_hz, a - 1e-6 / s.rate_hz);
-      if (k0 > 0) EXPECT_LT((k0 - 1) / s.rate_hz, a);
-      if (!open_end) EXPECT_LT(ch.x.back() / s.rate_hz, b);
+      if (k0 > 0) { EXPECT_LT((k0 - 1) / s.rate_hz, a); }
+      if (!open_end) { EXPECT_LT(ch.x.back() / s.rate_hz, b); }
     }
     EXPECT_NEAR(w.t0_s, s.t0_s + k0 / s.rate_hz, 1e-9);
   }

@@ -291,7 +291,7 @@ TEST(ExtraStates, GnssMeasurementColumnsMatchNonlinearResiduals) {
     ref.predictCovariance(truth, w, f, 0.005);
     MatrixXd H(6, N);
     H << ref.H_gnssPosition(told, dt_meas), ref.H_gnssVelocity(told, dt_meas);
-    if (dt_meas == 0.0) EXPECT_LT(residuals(VectorXd::Zero(N)).norm(), 1e-6);  // the truth predicts z
+    if (dt_meas == 0.0) { EXPECT_LT(residuals(VectorXd::Zero(N)).norm(), 1e-6); }  // the truth predicts z
     for (int j = ref.layout().extraIndex(Extra::GyroScale); j < N; ++j) {
       const double eps = j >= kl && j < kl + 3 ? 1e-2 : 1e-4;
       VectorXd d = VectorXd::Zero(N);

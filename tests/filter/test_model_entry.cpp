@@ -53,10 +53,11 @@ TEST(ModelEntry, ConvertsToTheFilterRateAndAgreesWithTheFilter) {
     for (int i = 0; i < 6; ++i) EXPECT_EQ(e.model.axis[i].terms, c.axis[i].terms);
     const bool converted = model_rate != imu_rate;
     ASSERT_EQ(e.notes.size(), (converted ? 1u : 0u) + e.layout.notes().size());
-    if (converted)
+    if (converted) {
       EXPECT_NE(e.notes[0].find("converted exactly to " + std::to_string(static_cast<int>(imu_rate)) + " Hz"),
                 std::string::npos)
           << e.notes[0];
+    }
     // the GM is a state exactly when its T exceeds the propagation interval
     const bool white = T <= cfg.propagate_every / imu_rate;
     whites += white;

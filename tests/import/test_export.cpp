@@ -55,9 +55,9 @@ TEST(ExportRun, ImportOfTheExportIsTheRecording) {
       EXPECT_EQ(b.gnss[k].t, d.gnss[k].t);
       EXPECT_LT(earth::geodeticToNed(d.gnss[k].pos, b.gnss[k].pos).norm(), 1e-8);
       ASSERT_EQ(b.gnss[k].v_N.has_value(), d.gnss[k].v_N.has_value());
-      if (d.gnss[k].v_N) EXPECT_EQ(*b.gnss[k].v_N, *d.gnss[k].v_N);
+      if (d.gnss[k].v_N) { EXPECT_EQ(*b.gnss[k].v_N, *d.gnss[k].v_N); }
       ASSERT_EQ(b.gnss[k].cov_pos_N.has_value(), withCov);
-      if (withCov) EXPECT_LT((*b.gnss[k].cov_pos_N - *d.gnss[k].cov_pos_N).norm(), 1e-14);
+      if (withCov) { EXPECT_LT((*b.gnss[k].cov_pos_N - *d.gnss[k].cov_pos_N).norm(), 1e-14); }
       ASSERT_EQ(b.gnss[k].cov_vel_N.has_value(), d.gnss[k].cov_vel_N.has_value());
     }
     ASSERT_EQ(b.baro.size(), d.baro.size());

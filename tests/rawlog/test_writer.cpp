@@ -367,7 +367,7 @@ TEST(RawlogReader, ReturnsTheRecordsOfReadRawlogInTimeOrder) {
       EXPECT_EQ(d.reference[i].t, whole.reference[i].t);
       EXPECT_EQ(d.reference[i].p_L, whole.reference[i].p_L);
       ASSERT_EQ(d.reference[i].v_N.has_value(), whole.reference[i].v_N.has_value());
-      if (d.reference[i].v_N) EXPECT_EQ(*d.reference[i].v_N, *whole.reference[i].v_N);
+      if (d.reference[i].v_N) { EXPECT_EQ(*d.reference[i].v_N, *whole.reference[i].v_N); }
     }
   }
 }
@@ -406,7 +406,7 @@ TEST(RawlogReader, RecordsInMemoryComeBackInTheReadersOrder) {
         EXPECT_EQ(a.reference.p_L, b.reference.p_L);
         EXPECT_EQ(a.reference.v_N, b.reference.v_N);
         EXPECT_EQ(a.reference.q_BtoN.has_value(), b.reference.q_BtoN.has_value());
-        if (a.reference.q_BtoN) EXPECT_EQ(a.reference.q_BtoN->coeffs(), b.reference.q_BtoN->coeffs());
+        if (a.reference.q_BtoN) { EXPECT_EQ(a.reference.q_BtoN->coeffs(), b.reference.q_BtoN->coeffs()); }
         EXPECT_EQ(a.reference.sigma_p_L, b.reference.sigma_p_L);
       }
     }

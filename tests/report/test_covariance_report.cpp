@@ -68,7 +68,7 @@ TEST(CovarianceReport, WritesAllOutputsOrNothing) {
     EXPECT_EQ(j["runs"][k]["filter_states"].get<int>(), run.states);
     // how the model entered the filter, where it was changed
     EXPECT_EQ(j["runs"][k].contains("notes"), !run.notes.empty());
-    if (!run.notes.empty()) EXPECT_EQ(j["runs"][k]["notes"].get<std::vector<std::string>>(), run.notes);
+    if (!run.notes.empty()) { EXPECT_EQ(j["runs"][k]["notes"].get<std::vector<std::string>>(), run.notes); }
     ASSERT_EQ(j["runs"][k]["at"].size(), cfg.summary_times_s.size());
     for (std::size_t q = 0; q < cfg.summary_times_s.size(); ++q) {
       const double ts = cfg.summary_times_s[q];
