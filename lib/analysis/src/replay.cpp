@@ -722,7 +722,10 @@ void ReplayDriver::run() {
   if (obs_) obs_->begin(r);
   decideWindows(x0.t + dt0);
   fillTo(x0.t + 0.5 * dt0);
-  run.start();
+  run.start(samples_.front());  // peekSample() above: the first sample is there
+  // a negative time-offset estimate applies a fix before its own time stamp
+  // (NavRunner): the records are read that far ahead
+  const double fixLookahead = opt_.ekf.imu.extra.time_offset_sigma_s > 0.0 ? -limits::kTimeOffsetS.lo : 0.0;
   ins::ImuSample s;
   while (nextSample(s)) {
     if (s.t - r.t_zero > stopAfter_) {
@@ -730,7 +733,7 @@ void ReplayDriver::run() {
       break;
     }
     decideWindows(s.t + s.dt);
-    fillTo(s.t + 0.5 * s.dt);
+    fillTo(s.t + 0.5 * s.dt + fixLookahead);
     run.step(s);
   }
   const double t_last = lastImuT_;

@@ -212,17 +212,20 @@ SensorParams ErrorStateEkf::extraSigmas() const {
   return paramsFrom(layout_, [&](int k) { return std::sqrt(std::max(P_(k, k), 0.0)); });
 }
 
-Vector9d ErrorStateEkf::timeOffsetCarry() const {
-  Vector9d c = Vector9d::Zero();
-  const int k = layout_.extraIndex(Extra::TimeOffset);
-  if (k < 0) return c;
-  const double d = x_imu_(k - kNav);
+Vector9d ErrorStateEkf::stateRate() const {
   const ins::NavState& x = state();
   const Vector3d w_IN_N = earth::w_IE_N(x.lat) + earth::w_EN_N(x.lat, x.h, x.v_N);
-  c.segment<3>(0) = x.v_N * d;
-  c.segment<3>(3) = accelerationN() * d;
-  c.segment<3>(6) = (x.C_BtoN() * w_IB_B_ - w_IN_N) * d;  // C w_NB_B
-  return c;
+  Vector9d r;
+  r << x.v_N, accelerationN(), x.C_BtoN() * w_IB_B_ - w_IN_N;  // C w_NB_B
+  return r;
+}
+
+double ErrorStateEkf::timeOffsetEstimate() const { return extra(Extra::TimeOffset); }
+
+Vector9d ErrorStateEkf::timeOffsetCarry() const {
+  const int k = layout_.extraIndex(Extra::TimeOffset);
+  if (k < 0) return Vector9d::Zero();
+  return stateRate() * x_imu_(k - kNav);
 }
 
 void ErrorStateEkf::addExtraCouplings(const Lin& L, Eigen::Ref<MatrixXd> X, int col0) const {
@@ -646,10 +649,7 @@ void ErrorStateEkf::checkPositiveDefinite(const char* where) {
   pd_worst_ = std::min(pd_worst_, lambda);
 }
 
-void ErrorStateEkf::predict(const ins::ImuSample& raw) {
-  if (!(raw.dt > 0.0) || !std::isfinite(raw.dt))
-    throw Error("IMU sample at t = " + formatNumber(raw.t, 9) + " s has non-positive interval dt");
-  if (pending_ > 0) applyTransition();  // left over from predictCovariance()
+ins::ImuSample ErrorStateEkf::corrected(const ins::ImuSample& raw) const {
   // Corrected output = raw - estimated error (closed loop, Groves 14.? feedback).
   const Eigen::Matrix<double, 6, 1> e = sensorErrors();
   ins::ImuSample s = raw;
@@ -668,7 +668,54 @@ void ErrorStateEkf::predict(const ins::ImuSample& raw) {
       s.dv_B = M.inverse() * s.dv_B;
     }
   }
+  return s;
+}
+
+void ErrorStateEkf::primeRates(const ins::ImuSample& first) {
+  if (!(first.dt > 0.0) || !std::isfinite(first.dt))
+    throw Error("IMU sample at t = " + formatNumber(first.t, 9) + " s has non-positive interval dt");
+  const ins::ImuSample s = corrected(first);
   w_IB_B_ = s.w_IB_B();
+  f_B_ = s.f_B();
+  ring_count_ = 0;
+  pushRate(w_IB_B_, first.dt);
+}
+
+void ErrorStateEkf::pushRate(const Vector3d& w, double dt) {
+  const int K = std::clamp(static_cast<int>(std::lround(kRateSpanS / dt)), 1, kRateRing - 1);
+  if (ring_count_ >= K) {
+    const Vector3d& old = rate_ring_[static_cast<std::size_t>((ring_next_ - K + kRateRing) % kRateRing)];
+    dw_IB_B_ = (w - old) / (K * dt);
+  } else {
+    dw_IB_B_.setZero();
+  }
+  rate_ring_[static_cast<std::size_t>(ring_next_)] = w;
+  ring_next_ = (ring_next_ + 1) % kRateRing;
+  ring_count_ = std::min(ring_count_ + 1, kRateRing);
+  w_end_IB_B_ = w + (0.5 * dt) * dw_IB_B_;
+}
+
+void ErrorStateEkf::carryInitialStateToImuClock() {
+  const int k = layout_.extraIndex(Extra::TimeOffset);
+  if (k < 0) return;
+  flushPropagation();
+  const Vector9d J = stateRate();
+  const double d0 = extra(Extra::TimeOffset);
+  if (d0 != 0.0) mech_.setState(applyNavError(state(), -d0 * J));  // the truth at t0 - d0
+  MatrixXd T = MatrixXd::Identity(size(), size());
+  T.block(0, k, 9, 1) = -J;  // dx_nav = J (d - d0) = -J dd
+  P_ = (T * P_ * T.transpose()).eval();
+  P_ = (0.5 * (P_ + P_.transpose())).eval();
+  cache_->nominal_valid = false;
+}
+
+void ErrorStateEkf::predict(const ins::ImuSample& raw) {
+  if (!(raw.dt > 0.0) || !std::isfinite(raw.dt))
+    throw Error("IMU sample at t = " + formatNumber(raw.t, 9) + " s has non-positive interval dt");
+  if (pending_ > 0) applyTransition();  // left over from predictCovariance()
+  const ins::ImuSample s = corrected(raw);
+  w_IB_B_ = s.w_IB_B();
+  pushRate(w_IB_B_, raw.dt);
   f_B_ = s.f_B();
   mech_.step(s);
   cache_->nominal_valid = false;
@@ -746,6 +793,8 @@ void ErrorStateEkf::predictCovariance(const ins::NavState& nominal, const Vector
   mech_.setState(nominal);
   w_IB_B_ = w_IB_B;
   f_B_ = f_B;
+  w_end_IB_B_ = w_IB_B;  // the nominal rate at the interval's end
+  dw_IB_B_.setZero();
   if (!same) {
     buildTransition(currentLin(), dt, c.T);
     c.nominal = nominal;
@@ -777,7 +826,7 @@ Vector3d ErrorStateEkf::antennaVelocity(const Vector3d& l) const {
   const ins::NavState& x = state();
   const Eigen::Matrix3d C = x.C_BtoN();
   const Vector3d w_ie = earth::w_IE_N(x.lat);
-  return x.v_N + C * w_IB_B_.cross(l) - w_ie.cross(C * l);
+  return x.v_N + C * w_end_IB_B_.cross(l) - w_ie.cross(C * l);
 }
 
 Vector3d ErrorStateEkf::accelerationN() const {
@@ -788,13 +837,22 @@ Vector3d ErrorStateEkf::accelerationN() const {
          (2.0 * w_ie + earth::w_EN_N(x.lat, x.h, x.v_N)).cross(x.v_N);
 }
 
+Vector3d ErrorStateEkf::antennaAcceleration(const Vector3d& l) const {
+  // d/dt [v_N + C (w x l)] = a_N + C (w x (w x l)) + C (dw/dt x l), w the body
+  // rate w.r.t. the Earth (Earth rate and transport rate in C's derivative left out)
+  const ins::NavState& x = state();
+  const Eigen::Matrix3d C = x.C_BtoN();
+  const Vector3d w = w_end_IB_B_ - C.transpose() * earth::w_IE_N(x.lat);
+  return accelerationN() + C * (w.cross(w.cross(l)) + dw_IB_B_.cross(l));
+}
+
 MatrixXd ErrorStateEkf::H_antennaVelocity(const Vector3d& lever_B) const {
   MatrixXd H = MatrixXd::Zero(3, size());
   const Eigen::Matrix3d C = state().C_BtoN();
   const Vector3d w_ie = earth::w_IE_N(state().lat);
   H.block<3, 3>(0, kVel).setIdentity();
   // v_ant = v + C (w_IB_B x l) - w_IE_N x (C l)  (Groves 14.111)
-  H.block<3, 3>(0, kAtt) = -skew(C * w_IB_B_.cross(lever_B)) + skew(w_ie) * skew(C * lever_B);
+  H.block<3, 3>(0, kAtt) = -skew(C * w_end_IB_B_.cross(lever_B)) + skew(w_ie) * skew(C * lever_B);
   // gyro error: d(w) = -h_c dx_imu -> C (dw x l) = C [l x] Hg dx
   if (layout_.imuSize() > 0 && lever_B.squaredNorm() > 0.0) {
     MatrixXd Hg(3, layout_.imuSize());
@@ -804,12 +862,39 @@ MatrixXd ErrorStateEkf::H_antennaVelocity(const Vector3d& lever_B) const {
   if (layout_.hasExtra()) {
     // dw = -diag(w) ds_g + [w x] dm_g enters as C (dw x l) = -C [l x] dw
     if (const int k = layout_.extraIndex(Extra::GyroScale); k >= 0)
-      H.block<3, 3>(0, k) = C * skew(lever_B) * w_IB_B_.asDiagonal();
+      H.block<3, 3>(0, k) = C * skew(lever_B) * w_end_IB_B_.asDiagonal();
     if (const int k = layout_.extraIndex(Extra::GyroMisalignment); k >= 0)
-      H.block<3, 3>(0, k) = -C * skew(lever_B) * skew(w_IB_B_);
+      H.block<3, 3>(0, k) = -C * skew(lever_B) * skew(w_end_IB_B_);
     // lever-arm error: l_used - l_true = -de, d v_ant / d l = C [w x] - [w_IE x] C
     if (const int k = layout_.extraIndex(Extra::LeverArm); k >= 0)
-      H.block<3, 3>(0, k) = -(C * skew(w_IB_B_) - skew(w_ie) * C);
+      H.block<3, 3>(0, k) = -(C * skew(w_end_IB_B_) - skew(w_ie) * C);
+  }
+  return H;
+}
+
+MatrixXd ErrorStateEkf::H_antennaRotationAcceleration(const Vector3d& l) const {
+  // C u, u = w x (w x l) + dw/dt x l (antennaAcceleration): with C_est = (I + [psi x]) C,
+  // d(C u) = -[(C u) x] psi + C du; du = M dw + ([w x][w x] + [dw/dt x]) dl with
+  // M = -[(w x l) x] - [w x][l x]; dw = -Hg dx_imu (- diag(w) ds_g + [w x] dm_g); dl = -de
+  MatrixXd H = MatrixXd::Zero(3, size());
+  const ins::NavState& x = state();
+  const Eigen::Matrix3d C = x.C_BtoN();
+  const Vector3d w = w_end_IB_B_ - C.transpose() * earth::w_IE_N(x.lat);
+  const Vector3d u = w.cross(w.cross(l)) + dw_IB_B_.cross(l);
+  H.block<3, 3>(0, kAtt) = -skew(C * u);
+  const Eigen::Matrix3d CM = C * (-skew(w.cross(l)) - skew(w) * skew(l));
+  if (layout_.imuSize() > 0) {
+    MatrixXd Hg(3, layout_.imuSize());
+    for (int c = 0; c < 3; ++c) Hg.row(c) = layout_.sensorRow(c);
+    H.rightCols(layout_.imuSize()) = -CM * Hg;
+  }
+  if (layout_.hasExtra()) {
+    if (const int k = layout_.extraIndex(Extra::GyroScale); k >= 0)
+      H.block<3, 3>(0, k) = -CM * w_end_IB_B_.asDiagonal();
+    if (const int k = layout_.extraIndex(Extra::GyroMisalignment); k >= 0)
+      H.block<3, 3>(0, k) = CM * skew(w_end_IB_B_);
+    if (const int k = layout_.extraIndex(Extra::LeverArm); k >= 0)
+      H.block<3, 3>(0, k) = -C * (skew(w) * skew(w) + skew(dw_IB_B_));
   }
   return H;
 }
@@ -818,11 +903,15 @@ MatrixXd ErrorStateEkf::H_gnssVelocity(const Vector3d& lever_B, double dt_meas) 
   const Vector3d l = lever_B - extra3(Extra::LeverArm);
   const double tau = dt_meas + extra(Extra::TimeOffset);
   MatrixXd H = H_antennaVelocity(l);
-  // carried to the measurement epoch with dv/dt, whose linearisation is the
-  // velocity rows of F (Groves 14.65-14.69 and the accelerometer coupling)
-  if (tau != 0.0) H += tau * F().middleRows(kVel, 3);
+  // carried to the measurement epoch with the antenna's acceleration: dv/dt,
+  // whose linearisation is the velocity rows of F (Groves 14.65-14.69 and the
+  // accelerometer coupling), and the lever arm's rotation terms
+  if (tau != 0.0) {
+    H += tau * F().middleRows(kVel, 3);
+    if (l.squaredNorm() > 0.0) H += tau * H_antennaRotationAcceleration(l);
+  }
   // time offset: d(v_ant + a_N tau)/d(d_est) = a_N
-  if (const int k = layout_.extraIndex(Extra::TimeOffset); k >= 0) H.col(k) = accelerationN();
+  if (const int k = layout_.extraIndex(Extra::TimeOffset); k >= 0) H.col(k) = antennaAcceleration(l);
   return H;
 }
 
@@ -855,9 +944,13 @@ MatrixXd ErrorStateEkf::H_nonHolonomic(const Vector3d& point_B) const {
   return H3.bottomRows(2);
 }
 
-MatrixXd ErrorStateEkf::H_baro() const {
+MatrixXd ErrorStateEkf::H_baro(double dt_meas) const {
   MatrixXd H = MatrixXd::Zero(1, size());
   H(0, kPos + 2) = -1.0;  // h_est - h = -dp_D
+  // carried to the measurement epoch: h - v_D tau; the offset's column -v_D
+  const double tau = dt_meas + extra(Extra::TimeOffset);
+  if (tau != 0.0) H(0, kVel + 2) = -tau;
+  if (const int k = layout_.extraIndex(Extra::TimeOffset); k >= 0) H(0, k) = -state().v_N.z();
   return H;
 }
 
@@ -960,7 +1053,7 @@ VectorXd ErrorStateEkf::residualGnssVelocity(const Vector3d& z_N, const Vector3d
   const Vector3d l = lever_B - extra3(Extra::LeverArm);
   const double tau = dt_meas + extra(Extra::TimeOffset);
   Vector3d v_ant = antennaVelocity(l);
-  if (tau != 0.0) v_ant += accelerationN() * tau;
+  if (tau != 0.0) v_ant += antennaAcceleration(l) * tau;
   return v_ant - z_N;
 }
 
@@ -997,11 +1090,13 @@ UpdateResult ErrorStateEkf::updateNonHolonomic(double sigma_lat, double sigma_ve
   return update(dz, H_nonHolonomic(point_B), R);
 }
 
-UpdateResult ErrorStateEkf::updateBaro(double h_meas, double sigma) {
+UpdateResult ErrorStateEkf::updateBaro(double h_meas, double sigma, double dt_meas) {
   requirePositiveSigma(sigma, "barometer sigma", state().t);
+  const double tau = dt_meas + extra(Extra::TimeOffset);
   VectorXd dz(1);
   dz(0) = state().h - h_meas;
-  return update(dz, H_baro(), MatrixXd::Constant(1, 1, sigma * sigma));
+  if (tau != 0.0) dz(0) -= state().v_N.z() * tau;
+  return update(dz, H_baro(dt_meas), MatrixXd::Constant(1, 1, sigma * sigma));
 }
 
 void ErrorStateEkf::discretize(double dt, MatrixXd& Phi, MatrixXd& Qd) const {

@@ -216,7 +216,9 @@ class NavRunner {
   /// A GNSS outage (absolute filter time), appended to NavRunResult::outages.
   void addOutage(const Outage& o);
   /// The measurements at x0.t and the first epoch; once, before step().
-  void start();
+  /// @p first: the first IMU sample (its interval starts at x0.t), whose
+  /// rates the measurements at x0.t use (ErrorStateEkf::primeRates).
+  void start(const ins::ImuSample& first);
   /// One IMU sample (contiguous with the previous one).
   void step(const ins::ImuSample& s);
   /// The result; the runner is done.

@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <limits>
 #include <memory>
+#include <array>
 #include <optional>
 #include <string>
 
@@ -172,6 +173,29 @@ class ErrorStateEkf {
   void predict(const ins::ImuSample& raw);
 
   /**
+   * The body rates the measurement models use (antenna velocity, carrying a
+   * fix to its epoch, the time-offset column) before the first predict(): the
+   * corrected output of @p first, the sample whose interval starts at the
+   * initial state. Without it they would use zero rates: a GNSS velocity at
+   * the initial epoch with a lever arm set the velocity off by w x l (1.8 m/s
+   * for a 3 m lever arm at 0.6 rad/s), a transient the lever-arm and
+   * time-offset states kept ~2 % of for good. The state and P are unchanged.
+   */
+  void primeRates(const ins::ImuSample& first);
+
+  /**
+   * With a time-offset state d = t_IMU - t_true: the initial state came from
+   * data on the true clock (a reference, GNSS), while the state at the IMU's
+   * stamp t0 is the truth at t0 - d. Carries the initial state by the offset's
+   * initial estimate d0 (x0 - xdot d0) and couples its errors to the offset's:
+   * dx_nav -> dx_nav - J dd with J = xdot = (v_N, a_N, w_NB_N) (P -> T P T').
+   * Without it a reference start with an 84 ms offset began with an attitude
+   * error of w d (up to 3 deg) outside P0, a transient the offset kept 2 % of.
+   * After primeRates(); nothing without a time-offset state.
+   */
+  void carryInitialStateToImuClock();
+
+  /**
    * Covariance-only propagation over @p dt along a given nominal state (the
    * navigation state is set to @p nominal and not integrated).
    * @param[in] nominal  linearisation point at the end of the interval.
@@ -234,11 +258,14 @@ class ErrorStateEkf {
   UpdateResult updateNonHolonomic(double sigma_lateral_mps, double sigma_vertical_mps,
                                   const Eigen::Vector3d& point_B = Eigen::Vector3d::Zero());
   /**
-   * Barometric altitude, taken as ellipsoidal height of the IMU.
-   * @param[in] h_meas  measured height [m].
-   * @param[in] sigma   1-sigma noise [m], > 0.
+   * Barometric altitude, taken as ellipsoidal height of the IMU, on the true
+   * clock as GNSS (with a time-offset state it is the height at IMU time
+   * t + d); carried to its epoch h - v_D tau, tau = dt_meas + d.
+   * @param[in] h_meas   measured height [m].
+   * @param[in] sigma    1-sigma noise [m], > 0.
+   * @param[in] dt_meas  its epoch minus the filter time [s] (0 on a sample).
    */
-  UpdateResult updateBaro(double h_meas, double sigma);
+  UpdateResult updateBaro(double h_meas, double sigma, double dt_meas = 0.0);
 
   /**
    * Generic linear update dz = H dx - noise with the caller's residual (used
@@ -265,7 +292,7 @@ class ErrorStateEkf {
   // ---- Jacobians (public for tests and covariance-only analysis) --------
   Eigen::MatrixXd H_gnssPosition(const Eigen::Vector3d& lever_B, double dt_meas = 0.0) const;  ///< 3 x size()
   Eigen::MatrixXd H_gnssVelocity(const Eigen::Vector3d& lever_B, double dt_meas = 0.0) const;  ///< 3 x size()
-  Eigen::MatrixXd H_baro() const;                                        ///< 1 x size()
+  Eigen::MatrixXd H_baro(double dt_meas = 0.0) const;                    ///< 1 x size()
   Eigen::MatrixXd H_zeroVelocity() const;                                ///< 3 x size()
   Eigen::MatrixXd H_nonHolonomic(const Eigen::Vector3d& point_B) const;  ///< 2 x size()
   /// Continuous F (size() square) at the current state and last f_B.
@@ -293,6 +320,8 @@ class ErrorStateEkf {
   /// (dp NED [m], dv NED [m/s], psi [rad]): (v_N, a_N, C_BtoN w_NB_B) d_est
   /// (Groves 2013 eq. 5.54 for a_N); zero when the state is off.
   Vector9d timeOffsetCarry() const;
+  /// The time-offset state's estimate d = t_IMU - t_true [s]; 0 when it is off.
+  double timeOffsetEstimate() const;
   const StateLayout& layout() const { return layout_; }
   int size() const { return layout_.size(); }
   const UpdateResult& lastUpdate() const { return last_; }
@@ -358,6 +387,28 @@ class ErrorStateEkf {
   Eigen::MatrixXd P_;
   Eigen::VectorXd x_imu_;
   Eigen::Vector3d w_IB_B_ = Eigen::Vector3d::Zero(), f_B_ = Eigen::Vector3d::Zero();
+  // The body rate at the end of the last sample's interval and the angular
+  // acceleration, for the antenna's velocity and acceleration: the sample's
+  // rate is its interval's mean (dt/2 late, which a time-offset state took
+  // for part of the offset, 3 ms at 100 Hz with a 10 m lever arm). The
+  // acceleration from the rates kRateSpanS apart (noise / (span/dt) of a
+  // difference of consecutive samples), the end rate the sample's plus it dt/2.
+  static constexpr double kRateSpanS = 0.05;
+  static constexpr int kRateRing = 64;
+  std::array<Eigen::Vector3d, kRateRing> rate_ring_{};
+  int ring_next_ = 0, ring_count_ = 0;
+  Eigen::Vector3d w_end_IB_B_ = Eigen::Vector3d::Zero();  ///< [rad/s]
+  Eigen::Vector3d dw_IB_B_ = Eigen::Vector3d::Zero();     ///< [rad/s^2]
+  void pushRate(const Eigen::Vector3d& w, double dt);
+  /// The antenna's acceleration in N for lever arm @p l [m/s^2].
+  Eigen::Vector3d antennaAcceleration(const Eigen::Vector3d& l) const;
+  /// Jacobian of the lever arm's rotation terms of antennaAcceleration (3 x size()).
+  Eigen::MatrixXd H_antennaRotationAcceleration(const Eigen::Vector3d& l) const;
+  /// @p raw corrected by the estimated sensor errors (closed loop).
+  ins::ImuSample corrected(const ins::ImuSample& raw) const;
+  /// Time derivative of (position NED [m], velocity [m/s], attitude [rad]) at
+  /// the state: v_N, a_N (Groves 2013 eq. 5.54) and C_BtoN w_NB_B.
+  Vector9d stateRate() const;
   // accumulated transition
   Eigen::Matrix<double, 9, 9> A_acc_;
   Eigen::MatrixXd B_acc_, D_acc_, Q_acc_;
