@@ -142,7 +142,8 @@ struct NavRunner::Impl {
     if (*keep_epochs) res.epochs.push_back(std::move(e));
   }
 
-  void record(double t_now, double half_dt) {
+  /// @p last: the data end, where the truth epochs up to t_now are recorded whatever the offset.
+  void record(double t_now, double half_dt, bool last = false) {
     constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     if (!hasTruth) {
       if (t_now + half_dt < next_record) return;
@@ -159,11 +160,17 @@ struct NavRunner::Impl {
       emit(std::move(e), nullptr);
       return;
     }
-    while (!truth.empty() && truth.front().first <= t_now + half_dt) {
+    // With a time-offset state the truth of true time t is compared with the
+    // state at the IMU epoch of t + d_est carried the rest (half a sample at
+    // most): a first-order carry over the whole offset left errors of order
+    // (dw/dt) d^2 / 2 in the scored attitude (1.8 mrad for 84 ms at 0.5 rad/s^2).
+    const bool offset = ekf.layout().extraIndex(filter::Extra::TimeOffset) >= 0;
+    const double d = offset ? ekf.timeOffsetEstimate() : 0.0;
+    while (!truth.empty() && truth.front().first + (last ? std::min(d, 0.0) : d) <= t_now + half_dt) {
       const double tt = truth.front().first;
       const ins::NavState& xt = truth.front().second;
       // nearest sample; an epoch exactly between two samples may land on either
-      if (std::abs(tt - t_now) > half_dt * (1.0 + 1e-6) + 1e-9)
+      if (!offset && std::abs(tt - t_now) > half_dt * (1.0 + 1e-6) + 1e-9)
         throw Error("navigation run: truth epoch " + formatNumber(tt, 10) +
                     " s does not fall on an IMU sample (nearest " + formatNumber(t_now, 10) + " s)");
       ekf.flushPropagation();
@@ -172,7 +179,7 @@ struct NavRunner::Impl {
       e.est = ekf.state();
       e.err = filter::navError(ekf.state(), xt);
       // with a time-offset state the solution at true time t is the state carried forward by d_est
-      if (ekf.layout().extraIndex(filter::Extra::TimeOffset) >= 0) e.err += ekf.timeOffsetCarry();
+      if (offset) e.err += ekf.carry(tt + d - t_now);
       if (opt.reference_lever_B.squaredNorm() > 0.0) e.err.head<3>() += ekf.state().C_BtoN() * opt.reference_lever_B;
       const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
@@ -263,6 +270,8 @@ void NavRunner::step(const ins::ImuSample& s) {
 
 NavRunResult NavRunner::finish() {
   Impl& m = *impl_;
+  // truth epochs a positive time-offset estimate left for IMU epochs past the data
+  if (m.started && m.ekf.layout().extraIndex(filter::Extra::TimeOffset) >= 0) m.record(m.t_prev, 0.5 * m.dt0, true);
   m.res.rejections = m.ekf.rejections();
   m.res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - m.t_start).count();
   if (m.ekf.layout().hasExtra()) {

@@ -222,11 +222,7 @@ Vector9d ErrorStateEkf::stateRate() const {
 
 double ErrorStateEkf::timeOffsetEstimate() const { return extra(Extra::TimeOffset); }
 
-Vector9d ErrorStateEkf::timeOffsetCarry() const {
-  const int k = layout_.extraIndex(Extra::TimeOffset);
-  if (k < 0) return Vector9d::Zero();
-  return stateRate() * x_imu_(k - kNav);
-}
+Vector9d ErrorStateEkf::carry(double tau) const { return stateRate() * tau; }
 
 void ErrorStateEkf::addExtraCouplings(const Lin& L, Eigen::Ref<MatrixXd> X, int col0) const {
   // corrected - true = -diag(true) ds + [true x] dm (state_layout.hpp), entering

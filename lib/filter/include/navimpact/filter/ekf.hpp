@@ -316,10 +316,10 @@ class ErrorStateEkf {
   SensorParams extraSigmas() const;
   /// With the time-offset state on, the state at IMU time t is the truth at
   /// t - d_est (state_layout.hpp); the navigation solution at true time t is
-  /// the state carried forward by d_est. Returns that first-order change of
-  /// (dp NED [m], dv NED [m/s], psi [rad]): (v_N, a_N, C_BtoN w_NB_B) d_est
-  /// (Groves 2013 eq. 5.54 for a_N); zero when the state is off.
-  Vector9d timeOffsetCarry() const;
+  /// the state carried forward to IMU time t + d_est. Returns the first-order
+  /// change over @p tau of (dp NED [m], dv NED [m/s], psi [rad]): (v_N, a_N,
+  /// C_BtoN w_NB_B) tau (Groves 2013 eq. 5.54 for a_N).
+  Vector9d carry(double tau) const;
   /// The time-offset state's estimate d = t_IMU - t_true [s]; 0 when it is off.
   double timeOffsetEstimate() const;
   const StateLayout& layout() const { return layout_; }
