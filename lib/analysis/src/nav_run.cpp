@@ -165,7 +165,7 @@ struct NavRunner::Impl {
     // most): a first-order carry over the whole offset left errors of order
     // (dw/dt) d^2 / 2 in the scored attitude (1.8 mrad for 84 ms at 0.5 rad/s^2).
     const bool offset = ekf.layout().extraIndex(filter::Extra::TimeOffset) >= 0;
-    const double d = offset ? ekf.timeOffsetEstimate() : 0.0;
+    const double d = ekf.timeOffsetEstimate();  // 0 without the state
     while (!truth.empty() && truth.front().first + (last ? std::min(d, 0.0) : d) <= t_now + half_dt) {
       const double tt = truth.front().first;
       const ins::NavState& xt = truth.front().second;
@@ -178,7 +178,7 @@ struct NavRunner::Impl {
       e.t = tt;
       e.est = ekf.state();
       e.err = filter::navError(ekf.state(), xt);
-      // with a time-offset state the solution at true time t is the state carried forward by d_est
+      // with a time-offset state: the state at IMU time t_now carried to the IMU epoch of tt + d_est
       if (offset) e.err += ekf.carry(tt + d - t_now);
       if (opt.reference_lever_B.squaredNorm() > 0.0) e.err.head<3>() += ekf.state().C_BtoN() * opt.reference_lever_B;
       const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
