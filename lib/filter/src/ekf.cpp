@@ -851,9 +851,7 @@ MatrixXd ErrorStateEkf::H_antennaVelocity(const Vector3d& lever_B) const {
   H.block<3, 3>(0, kAtt) = -skew(C * w_end_IB_B_.cross(lever_B)) + skew(w_ie) * skew(C * lever_B);
   // gyro error: d(w) = -h_c dx_imu -> C (dw x l) = C [l x] Hg dx
   if (layout_.imuSize() > 0 && lever_B.squaredNorm() > 0.0) {
-    MatrixXd Hg(3, layout_.imuSize());
-    for (int c = 0; c < 3; ++c) Hg.row(c) = layout_.sensorRow(c);
-    H.rightCols(layout_.imuSize()) = C * skew(lever_B) * Hg;
+    H.rightCols(layout_.imuSize()) = C * skew(lever_B) * layout_.gyroRows();
   }
   if (layout_.hasExtra()) {
     // dw = -diag(w) ds_g + [w x] dm_g enters as C (dw x l) = -C [l x] dw
@@ -880,9 +878,7 @@ MatrixXd ErrorStateEkf::H_antennaRotationAcceleration(const Vector3d& l) const {
   H.block<3, 3>(0, kAtt) = -skew(C * u);
   const Eigen::Matrix3d CM = C * (-skew(w.cross(l)) - skew(w) * skew(l));
   if (layout_.imuSize() > 0) {
-    MatrixXd Hg(3, layout_.imuSize());
-    for (int c = 0; c < 3; ++c) Hg.row(c) = layout_.sensorRow(c);
-    H.rightCols(layout_.imuSize()) = -CM * Hg;
+    H.rightCols(layout_.imuSize()) = -CM * layout_.gyroRows();
   }
   if (layout_.hasExtra()) {
     if (const int k = layout_.extraIndex(Extra::GyroScale); k >= 0)
@@ -928,9 +924,7 @@ MatrixXd ErrorStateEkf::H_nonHolonomic(const Vector3d& point_B) const {
   H3.block<3, 3>(0, kVel) = Ct;
   H3.block<3, 3>(0, kAtt) = Ct * skew(state().v_N) + skew(point_B) * Ct * skew(w_ie);
   if (layout_.imuSize() > 0 && point_B.squaredNorm() > 0.0) {
-    MatrixXd Hg(3, layout_.imuSize());
-    for (int c = 0; c < 3; ++c) Hg.row(c) = layout_.sensorRow(c);
-    H3.rightCols(layout_.imuSize()) = skew(point_B) * Hg;
+    H3.rightCols(layout_.imuSize()) = skew(point_B) * layout_.gyroRows();
     // extra gyro states: dw = -diag(w) ds_g + [w x] dm_g enters as dw x l = -[l x] dw
     if (const int k = layout_.extraIndex(Extra::GyroScale); k >= 0)
       H3.block<3, 3>(0, k) = skew(point_B) * w_IB_B_.asDiagonal();

@@ -169,6 +169,12 @@ StateLayout StateLayout::build(const stochastic::ImuModel& model, const ImuError
   return L;
 }
 
+Eigen::MatrixXd StateLayout::gyroRows() const {
+  Eigen::MatrixXd Hg(3, imuSize());
+  for (int c = 0; c < 3; ++c) Hg.row(c) = h_[static_cast<std::size_t>(c)];
+  return Hg;
+}
+
 Eigen::MatrixXd StateLayout::imuP0() const {
   Eigen::MatrixXd P = Eigen::MatrixXd::Zero(imuSize(), imuSize());
   for (const ProcessBlock& b : blocks_)

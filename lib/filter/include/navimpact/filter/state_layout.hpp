@@ -163,6 +163,8 @@ class StateLayout {
   const std::array<double, 6>& whitePsd() const { return white_psd_; }
   /// Row vector h_c (size imuSize()) with sensor error of channel c = h_c x_imu.
   const Eigen::RowVectorXd& sensorRow(int channel) const { return h_[channel]; }
+  /// The gyro rows h_0..h_2 stacked (3 x imuSize()): gyro error e_w = Hg x_imu [rad/s].
+  Eigen::MatrixXd gyroRows() const;
   /// Initial covariance of the IMU error states (imuSize() square).
   Eigen::MatrixXd imuP0() const;
   /// One line per state: "index name".
