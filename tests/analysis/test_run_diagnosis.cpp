@@ -269,7 +269,12 @@ TEST(RunDiagnosis, AnExtensionThatAlignsLaterIsScoredOnTheMeasuredOutageWindows)
 // magnitude over the range's top three decades (two for the motion-noise
 // factor, [1, 100]), random signs per axis; far below the detection limit
 // the same holds a fortiori. Each draw:
-//  - a named cause (findings) is never another cause than the hidden one;
+//  - a named cause (findings) other than the hidden one is a false alarm, an
+//    event of probability <= alpha = 0.05 per run (the family-wise level; the
+//    limits script measured 1 in 100 null and below-limit runs, 2 in 40 at
+//    0.5 and 1 ms time offsets, the same noise seed both times): a test allows it in one of its two runs, not both
+//    (probability <= alpha^2 = 0.25 % at the nominal level), so a cause that
+//    is named in place of the hidden one systematically still fails;
 //  - above the detection limit of this run length (README) the hidden cause
 //    is named (the best significant one) with a positive held-out gain;
 //  - its 95 % intervals cover the truth on the affected components (at most
@@ -329,18 +334,27 @@ an::RunDiagnosisOptions hiddenOptions(const std::string& rawlog, std::uint64_t s
   return o;
 }
 
-void checkHidden(const an::RunDiagnosis& d, const Hidden& h) {
+/// Checks one run; returns whether another cause than the hidden one was named (a false alarm).
+bool checkHidden(const an::RunDiagnosis& d, const Hidden& h) {
   std::cout << navimpact::report::runDiagnosisSummary(d);
-  for (const auto& f : d.findings) EXPECT_EQ(f.cause, h.cause) << "a wrong cause is named: " << f.cause << " " << f.channel;
+  bool wrong = false;
+  for (const auto& f : d.findings)
+    if (f.cause != h.cause) {
+      std::cout << "false alarm: " << f.cause << " " << f.channel << " named (hidden: " << h.cause << ")\n";
+      wrong = true;
+    }
   const an::CauseResult* c = nullptr;
   for (const auto& x : d.causes)
     if (x.cause == h.cause) c = &x;
-  ASSERT_NE(c, nullptr);
+  EXPECT_NE(c, nullptr);
+  if (c == nullptr) return wrong;
   std::cout << h.cause << ": size " << h.size << " (detection limit " << h.limit << "), held-out gain " << c->gain
             << ", p = " << c->p_value << (c->significant ? ", significant" : "") << "\n";
   if (h.size >= h.limit) {
-    ASSERT_GE(d.best, 0) << "above the detection limit but nothing named";
-    EXPECT_EQ(d.causes[static_cast<std::size_t>(d.best)].cause, h.cause);
+    EXPECT_GE(d.best, 0) << "above the detection limit but nothing named";
+    if (d.best >= 0) {
+      EXPECT_EQ(d.causes[static_cast<std::size_t>(d.best)].cause, h.cause);
+    }
     EXPECT_GT(c->gain, 0.0);
     EXPECT_TRUE(c->significant);
     // the finding and the gain reach the output contract
@@ -367,6 +381,13 @@ void checkHidden(const an::RunDiagnosis& d, const Hidden& h) {
     }
   EXPECT_EQ(checked, static_cast<int>(h.truth.size()));
   EXPECT_LE(misses, 1);
+  return wrong;
+}
+
+/// At most one of a test's runs may name a wrong cause (see above).
+void expectAtMostOneFalseAlarm(int runs_with_wrong_cause) {
+  EXPECT_LE(runs_with_wrong_cause, 1) << "both runs named a cause other than the hidden one: probability <= alpha^2 "
+                                         "= 0.25 % if each is a false alarm at the family-wise level";
 }
 
 /// The triad of one sensor that an effect acts on: the gyro's or the accelerometer's vector.
@@ -384,7 +405,7 @@ struct TriadEffect {
 /// The effect on one triad (drawn: gyro or accelerometer), one magnitude
 /// log-uniform over three decades below its range's end with a random sign
 /// per axis, emulated, diagnosed and checked.
-void checkHiddenTriad(const TriadEffect& e, std::uint64_t seed) {
+bool checkHiddenTriad(const TriadEffect& e, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   const bool gyro = (rng() & 1u) != 0;
   const double m = std::abs(drawSigned(rng, e.range_hi, 3.0));
@@ -396,7 +417,7 @@ void checkHiddenTriad(const TriadEffect& e, std::uint64_t seed) {
     h.truth.push_back({navimpact::kChannelNames[(gyro ? 0 : 3) + i], e.param, v});
   }
   std::cout << "hidden " << e.what << ": seed " << seed << ", " << (gyro ? "gyro" : "acc") << " " << m << e.unit << "\n";
-  checkHidden(an::diagnoseRun(hiddenOptions(emulateWithEffects(e.cause, seed, fx), seed + 1)), h);
+  return checkHidden(an::diagnoseRun(hiddenOptions(emulateWithEffects(e.cause, seed, fx), seed + 1)), h);
 }
 
 }  // namespace
@@ -405,6 +426,7 @@ void checkHiddenTriad(const TriadEffect& e, std::uint64_t seed) {
 // documented [1, 100]; gyro or accelerometers drawn): the factor's 99 %
 // interval covers k on the affected channels and stays near 1 on the others.
 TEST(RunDiagnosisHidden, InMotionNoise) {
+  int wrong = 0;
   for (std::uint64_t seed : seeds(41003u, 41004u)) {
     std::mt19937_64 rng(seed);
     const bool gyro = (rng() & 1u) != 0;
@@ -415,7 +437,7 @@ TEST(RunDiagnosisHidden, InMotionNoise) {
     Hidden h{"in_motion_noise", k, gyro ? kLimitGyroMotionNoise : kLimitAccMotionNoise, {}};
     for (int i = 0; i < 3; ++i) h.truth.push_back({navimpact::kChannelNames[(gyro ? 0 : 3) + i], "factor", k});
     const an::RunDiagnosis d = an::diagnoseRun(hiddenOptions(emulateWithEffects("motion", seed, fx), seed + 1));
-    checkHidden(d, h);
+    wrong += checkHidden(d, h) ? 1 : 0;
     for (const auto& c : d.causes)
       if (c.cause == "in_motion_noise")
         for (const auto& f : c.findings)
@@ -423,6 +445,7 @@ TEST(RunDiagnosisHidden, InMotionNoise) {
             EXPECT_LT(f.interval.front().second.first, 1.5) << f.channel;  // unaffected channels near 1
           }
   }
+  expectAtMostOneFalseAlarm(wrong);
 }
 
 // Scale factors of one triad (drawn: gyro or accelerometer), one magnitude
@@ -430,7 +453,9 @@ TEST(RunDiagnosisHidden, InMotionNoise) {
 TEST(RunDiagnosisHidden, ScaleFactor) {
   const TriadEffect e{"scale_factor", "scale", "scale factor", "", limits::kScaleFactor.hi,
                       kLimitGyroScale, kLimitAccScale, &emu::SensorEffects::gyro_scale, &emu::SensorEffects::acc_scale};
-  for (std::uint64_t seed : seeds(41101u, 41102u)) checkHiddenTriad(e, seed);
+  int wrong = 0;
+  for (std::uint64_t seed : seeds(41101u, 41102u)) wrong += checkHiddenTriad(e, seed) ? 1 : 0;
+  expectAtMostOneFalseAlarm(wrong);
 }
 
 // Misalignment of one triad (drawn), one magnitude log-uniform over [5e-5, 0.05] rad.
@@ -438,24 +463,29 @@ TEST(RunDiagnosisHidden, Misalignment) {
   const TriadEffect e{"misalignment", "angle", "misalignment", " rad", limits::kMisalignmentRad.hi,
                       kLimitGyroMisalignment, kLimitAccMisalignment, &emu::SensorEffects::gyro_misalignment_rad,
                       &emu::SensorEffects::acc_misalignment_rad};
-  for (std::uint64_t seed : seeds(41201u, 41202u)) checkHiddenTriad(e, seed);
+  int wrong = 0;
+  for (std::uint64_t seed : seeds(41201u, 41202u)) wrong += checkHiddenTriad(e, seed) ? 1 : 0;
+  expectAtMostOneFalseAlarm(wrong);
 }
 
 // IMU-GNSS time offset, magnitude log-uniform over [1e-4, 0.1] s, random sign.
 TEST(RunDiagnosisHidden, TimeOffset) {
+  int wrong = 0;
   for (std::uint64_t seed : seeds(41301u, 41302u)) {
     std::mt19937_64 rng(seed);
     const double d = drawSigned(rng, limits::kTimeOffsetS.hi, 3.0);
     emu::SensorEffects fx;
     fx.time_offset_s = d;
     std::cout << "hidden time offset: seed " << seed << ", " << d << " s\n";
-    checkHidden(an::diagnoseRun(hiddenOptions(emulateWithEffects("offset", seed, fx), seed + 1)),
-                Hidden{"time_offset", std::abs(d), kLimitTimeOffset, {{"all", "time_offset", d}}});
+    const Hidden h{"time_offset", std::abs(d), kLimitTimeOffset, {{"all", "time_offset", d}}};
+    wrong += checkHidden(an::diagnoseRun(hiddenOptions(emulateWithEffects("offset", seed, fx), seed + 1)), h) ? 1 : 0;
   }
+  expectAtMostOneFalseAlarm(wrong);
 }
 
 // Antenna lever-arm error, one magnitude log-uniform over [0.01, 10] m, random sign per axis.
 TEST(RunDiagnosisHidden, LeverArm) {
+  int wrong = 0;
   for (std::uint64_t seed : seeds(41401u, 41402u)) {
     std::mt19937_64 rng(seed);
     const double m = std::abs(drawSigned(rng, limits::kLeverArmErrorM.hi, 3.0));
@@ -467,8 +497,9 @@ TEST(RunDiagnosisHidden, LeverArm) {
       h.truth.push_back({"gnss", ax[i], fx.lever_arm_error_B_m(i)});
     }
     std::cout << "hidden lever-arm error: seed " << seed << ", " << m << " m per axis\n";
-    checkHidden(an::diagnoseRun(hiddenOptions(emulateWithEffects("lever", seed, fx), seed + 1)), h);
+    wrong += checkHidden(an::diagnoseRun(hiddenOptions(emulateWithEffects("lever", seed, fx), seed + 1)), h) ? 1 : 0;
   }
+  expectAtMostOneFalseAlarm(wrong);
 }
 
 // An accelerometer bias random walk the model lacks (all three axes), density
@@ -478,6 +509,7 @@ TEST(RunDiagnosisHidden, LeverArm) {
 // read 2-6x high and missed at most seeds: the filter that lacks the random walk
 // starts each outage with a bias that has wandered since it last estimated it.)
 TEST(RunDiagnosisHidden, BiasInstability) {
+  int wrong = 0;
   for (std::uint64_t seed : seeds(41501u, 41502u)) {
     std::mt19937_64 rng(seed);
     const double q = std::abs(drawSigned(rng, 1e-2, 3.0));
@@ -488,8 +520,9 @@ TEST(RunDiagnosisHidden, BiasInstability) {
     std::ofstream(mfile) << st::toYaml(m);
     std::cout << "hidden accelerometer bias random walk: seed " << seed << ", " << q << " m/s^2/sqrt(s)\n";
     const auto path = emulateRun("bias_" + std::to_string(seed), mfile, seed);
-    checkHidden(an::diagnoseRun(hiddenOptions(path, seed + 1)),
-                Hidden{"bias_instability", q, kLimitBiasRandomWalk,
-                       {{"acc_x", "rw_density", q}, {"acc_y", "rw_density", q}, {"acc_z", "rw_density", q}}});
+    const Hidden h{"bias_instability", q, kLimitBiasRandomWalk,
+                   {{"acc_x", "rw_density", q}, {"acc_y", "rw_density", q}, {"acc_z", "rw_density", q}}};
+    wrong += checkHidden(an::diagnoseRun(hiddenOptions(path, seed + 1)), h) ? 1 : 0;
   }
+  expectAtMostOneFalseAlarm(wrong);
 }
