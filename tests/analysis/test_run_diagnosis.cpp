@@ -504,8 +504,8 @@ TEST(RunDiagnosisHidden, LeverArm) {
 
 // An accelerometer bias random walk the model lacks (all three axes), density
 // log-uniform over [1e-5, 1e-2] m/s^2/sqrt(s): bias_instability. The horizontal
-// (acc_x, acc_y: one estimate) and vertical (acc_z) intervals cover the truth,
-// at most one miss. (Scaled as q T^5/20, a bias known at the outage start, they
+// (acc_x, acc_y: one estimate, so its miss counts twice) and vertical (acc_z)
+// intervals cover the truth, at most one miss. (Scaled as q T^5/20, a bias known at the outage start, they
 // read 2-6x high and missed at most seeds: the filter that lacks the random walk
 // starts each outage with a bias that has wandered since it last estimated it.)
 TEST(RunDiagnosisHidden, BiasInstability) {

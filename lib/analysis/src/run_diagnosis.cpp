@@ -9,6 +9,7 @@
 
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/fisher_f.hpp>
+#include <boost/math/distributions/gamma.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
 #include "navimpact/core/error.hpp"
@@ -738,19 +739,76 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
         bh.push_back(a1);
         bv.push_back(a2);
       }
+      // The outages of one run share its bias path (consecutive outage ends are
+      // far from independent: the filter's bias error wanders slowly), which
+      // the bootstrap over outages cannot see. Each calibrating realisation r,
+      // its random walk scaled to density sqrt(q) (errors are linear in the
+      // walk: e = e0 + sqrt(q / q0) (e_rw - e0)), is a run whose truth is q;
+      // the estimator applied to it (r left out of the calibration) shows its
+      // spread at q. q is kept where the estimate lies inside the 99 % range
+      // of a gamma law with that mean and variance (test inversion on a grid);
+      // the interval is the union with the bootstrap's.
+      const double q0 = kCalibrationRwDensity * kCalibrationRwDensity;
+      auto pseudoEstimate = [&](std::size_t r, double q, bool vertical) {
+        const double sc = std::sqrt(q / q0), R = static_cast<double>(nr);
+        double num = 0.0, den = 0.0;
+        for (const Item* it : tr_items) {
+          const auto &e0 = sims[r].err[it->i][it->j], &e1 = sims[r].err_rw[it->i][it->j];
+          const Eigen::Vector3d e = e0.head(3) + sc * (e1.head(3) - e0.head(3));  // position error N, E, D [m]
+          const double e2 = vertical ? e(2) * e(2) : e(0) * e(0) + e(1) * e(1);
+          const double e02 = vertical ? e0(2) * e0(2) : e0(0) * e0(0) + e0(1) * e0(1);
+          const auto& d = vertical ? it->d_v : it->d_h;
+          const double pred = ((vertical ? it->pred_v2 : it->pred_h2) * R - e02) / (R - 1.0);
+          const double x = std::max(0.0, (perUnit(d, nullptr) * R - d[r]) / (R - 1.0));
+          num += (e2 - pred) * x;
+          den += x * x;
+        }
+        return den > 0 ? std::max(0.0, num / den) : 0.0;
+      };
+      auto parametric = [&](double obs, double boot_hi, bool vertical) -> std::optional<std::pair<double, double>> {
+        if (nr < 3 || !(obs > 0.0)) return std::nullopt;
+        const double top = std::max(obs, boot_hi);
+        std::optional<std::pair<double, double>> kept;
+        for (int g = -1; g <= 270; ++g) {
+          const double q = g < 0 ? 0.0 : top * std::pow(10.0, -6.0 + g / 30.0);  // 0, then 1e-6 .. 1e3 x top
+          double m = 0.0, m2 = 0.0;
+          for (std::size_t r = 0; r < nr; ++r) {
+            const double v = pseudoEstimate(r, q, vertical);
+            m += v;
+            m2 += v * v;
+          }
+          m /= double(nr);
+          const double var = std::max(0.0, (m2 - double(nr) * m * m) / double(nr - 1));
+          if (!(m > 0.0) || !(var > 0.0)) continue;
+          const boost::math::gamma_distribution<double> law(m * m / var, var / m);
+          if (obs < boost::math::quantile(law, 0.005) || obs > boost::math::quantile(law, 0.995)) continue;
+          if (!kept) kept = std::pair{q, q};
+          kept->first = std::min(kept->first, q);
+          kept->second = std::max(kept->second, q);
+        }
+        return kept;
+      };
       for (int c = 3; c < 6; ++c) {
         const double q = c < 5 ? qh : qv;
         const auto& bb = c < 5 ? bh : bv;
+        double lo = percentile(bb, 0.005), hi = percentile(bb, 0.995);
+        const auto par = parametric(q, hi, c == 5);
+        if (par) {
+          lo = std::min(lo, par->first);
+          hi = std::max(hi, par->second);
+        }
         RunFinding f;
         f.cause = "bias_instability";
         f.channel = kChannelNames[c];
         f.params = {{"rw_density", std::sqrt(q)}};
-        f.interval = {{"rw_density", {std::sqrt(percentile(bb, 0.005)), std::sqrt(percentile(bb, 0.995))}}};
+        f.interval = {{"rw_density", {std::sqrt(lo), std::sqrt(hi)}}};
         f.note = std::string("accelerometer bias random walk density [m/s^2/sqrt(s)] from the ") +
                  (c < 5 ? "horizontal" : "vertical") + " outage-end errors' excess over the simulation, against what a random walk "
-                 "of known density adds to the same simulated runs (least squares over the outages), "
-                 "99 % interval by a seeded bootstrap over " + std::to_string(tr_items.size()) + " outages and the " +
-                 std::to_string(nr) + " calibrating realisations";
+                 "of known density adds to the same simulated runs (least squares over the outages); "
+                 "99 % interval: a seeded bootstrap over " + std::to_string(tr_items.size()) + " outages and the " +
+                 std::to_string(nr) + " calibrating realisations, joined with the densities whose simulated runs "
+                 "(the realisations with their random walk scaled) give this estimate inside their 99 % range, "
+                 "as the outages of one run share its bias path";
         fnd->push_back(f);
       }
     }
