@@ -54,6 +54,7 @@ struct Opts {
   double reconverge = 30.0;
   int realisations = 50;
   int folds = 5;
+  bool allow_large = false;
 };
 
 /// `diagnose --run`: predicted against measured outage errors of a real run.
@@ -66,6 +67,7 @@ int runOnRun(const Opts& o) {
   ro.reconverge_s = o.reconverge;
   ro.realisations = o.realisations;
   ro.folds = o.folds;
+  ro.allow_large = o.allow_large;
   ro.seed = o.seed;
   ro.alpha = o.alpha;
   ro.threads = o.threads;
@@ -115,15 +117,12 @@ std::vector<navimpact::Outage> checkOutages(const Opts& o) {
   for (const auto& spec : o.outages) w.push_back(navimpact::parseOutage(spec, "--outage"));
   if (!o.trajectory.empty() && !std::filesystem::exists(o.trajectory))
     throw navimpact::Error("--trajectory " + o.trajectory + ": no such file");
-  if (o.nav_runs < 2) throw navimpact::Error("--nav-runs must be >= 2");
   return w;
 }
 
 int run(const Opts& o) {
   if (!o.run_rawlog.empty()) return runOnRun(o);
   if (o.in.input.empty()) throw navimpact::Error("diagnose needs --input STATIC (a static recording) or --run RUN.rawlog");
-  if (o.simulations < 0 || o.simulations == 1)
-    throw navimpact::Error("--simulations must be 0 or >= 2");
   if (!(o.alpha > 0 && o.alpha < 0.5)) throw navimpact::Error("--alpha must be in (0, 0.5)");
   const auto windows = checkOutages(o);
   // Model file problems are reported before the (long) data read.
@@ -146,19 +145,22 @@ int run(const Opts& o) {
     nopt.runs = o.nav_runs;
     nopt.seed = o.seed;
     nopt.threads = o.threads;
+    nopt.allow_large = o.allow_large;
     plan = na::prepareNavGain(nopt, data.rate_hz, data.size());
   }
+  na::DiagnoseOptions dopt;
+  dopt.simulations = o.simulations;
+  dopt.seed = o.seed;
+  dopt.alpha = o.alpha;
+  dopt.threads = o.threads;
+  dopt.allow_large = o.allow_large;
+  na::checkDiagnoseOptions(dopt, data.channels.size(), data.size());  // before a fit
   if (fit) {
     model = navimpact::gmwm::fitRecording(data, fitOptions(o.model.substr(4), o)).model;
     model.source = o.model;
   }
 
   navimpact::cli::Progress bar("diagnose", 1000);
-  na::DiagnoseOptions dopt;
-  dopt.simulations = o.simulations;
-  dopt.seed = o.seed;
-  dopt.alpha = o.alpha;
-  dopt.threads = o.threads;
   dopt.progress = [&bar](double f, const std::string&) {
     bar.update(static_cast<std::size_t>(f * 1000));
   };
@@ -237,8 +239,12 @@ navimpact::cli::Registrar reg(
            ->check(navimpact::cli::within(navimpact::limits::kDurationS));
        app.add_option("--realisations", o->realisations, "--run: simulated realisations (seeded by --seed)")
            ->capture_default_str();
-       app.add_option("--folds", o->folds, "--run: cross-validation folds (time blocks of the run) for the causes")
+       app.add_option("--folds", o->folds,
+                      "--run: cross-validation folds (time blocks of the run) for the causes; at most one per outage")
            ->capture_default_str();
+       app.add_flag("--allow-large", o->allow_large,
+                    "run even when the estimated work or memory of the simulations or navigation runs is above the "
+                    "documented budget");
        app.add_option("--model", o->model,
                       "model simulated today: FILE[:NAME], or fit:SPEC (e.g. fit:WN+GM) to fit "
                       "that structure to the data first, or fit:auto (the structure chosen by the WIC "

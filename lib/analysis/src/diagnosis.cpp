@@ -19,6 +19,8 @@
 
 #include "diagnosis_internal.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/parallel.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
@@ -427,13 +429,25 @@ void groupEvents(Diagnosis& d) {
 
 }  // namespace
 
-Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
-                   const DiagnoseOptions& opt) {
+void checkDiagnoseOptions(const DiagnoseOptions& opt, std::size_t channels, std::size_t samples) {
   if (!(opt.alpha > 0 && opt.alpha < 0.5))
     throw Error("diagnose: alpha must be in (0, 0.5), got " + std::to_string(opt.alpha));
-  if (opt.simulations < 0 || opt.simulations == 1)
-    throw Error("diagnose: simulations must be 0 or >= 2, got " +
-                std::to_string(opt.simulations));
+  if (opt.simulations < 0 || opt.simulations == 1 || opt.simulations > limits::kMaxMonteCarloRuns)
+    throw Error("diagnose: --simulations must be 0 or in [2, " + std::to_string(limits::kMaxMonteCarloRuns) +
+                "], got " + std::to_string(opt.simulations));
+  // Work of the model's simulations, estimated before they start (README
+  // "Ranges and budgets"): simulated samples over channels and simulations.
+  const double work = double(opt.simulations) * double(channels) * double(samples);
+  if (!opt.allow_large && work > limits::kDefaultSimulatedSampleBudget)
+    throw Error("diagnose: --simulations " + std::to_string(opt.simulations) + ": about " + formatNumber(work, 3) +
+                " simulated samples (simulations x " + std::to_string(channels) + " channels x " +
+                std::to_string(samples) + " samples), above the budget of " +
+                formatNumber(limits::kDefaultSimulatedSampleBudget, 3) +
+                ": lower --simulations or pass --allow-large");
+}
+
+Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
+                   const DiagnoseOptions& opt) {
   if (data.channels.empty()) throw Error(data.source + ": no IMU channel to diagnose");
   const std::size_t n = data.size();
   if (n < 4096)
@@ -441,6 +455,7 @@ Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
                 " samples; diagnose needs at least 4096 (two halves of 2048) for its "
                 "held-out comparison and spectrum");
   if (!(data.rate_hz > 0)) throw Error(data.source + ": sampling rate must be > 0");
+  checkDiagnoseOptions(opt, data.channels.size(), n);
   for (const auto& c : data.channels) {
     if (c.x.size() != n) throw Error(data.source + ": channel " + c.name + " has a different length");
     for (std::size_t k = 0; k < c.x.size(); ++k)

@@ -16,6 +16,7 @@
 #include "navimpact/analysis/run_plan.hpp"
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/parallel.hpp"
 #include "navimpact/core/units.hpp"
@@ -33,7 +34,9 @@ struct NavGainPlan {
 
 std::shared_ptr<const NavGainPlan> prepareNavGain(const NavGainOptions& opt, double rate,
                                                   std::size_t samples) {
-  if (opt.runs < 2) throw Error("navigation gain: runs must be >= 2, got " + std::to_string(opt.runs));
+  if (opt.runs < 2 || opt.runs > limits::kMaxMonteCarloRuns)
+    throw Error("navigation gain: --nav-runs must be in [2, " + std::to_string(limits::kMaxMonteCarloRuns) + "], got " +
+                std::to_string(opt.runs));
   if (opt.outages.empty()) throw Error("navigation gain: give at least one --outage START:DURATION");
   if (!(rate > 0)) throw Error("navigation gain: recording rate must be > 0");
   auto plan = std::make_shared<NavGainPlan>();
@@ -54,6 +57,23 @@ std::shared_ptr<const NavGainPlan> prepareNavGain(const NavGainOptions& opt, dou
       opt.propagate_every > 0 ? opt.propagate_every : std::max(1, static_cast<int>(std::lround(rate / 20.0)));
   ro.initial_sigma = opt.initial_sigma;
   plan->run = planRuns(ro);
+  {
+    // Work and result memory, estimated before the runs (README "Ranges and budgets"):
+    // per run its emulation and two filters; per run and model 3 numbers per
+    // recorded epoch and 4 per outage.
+    const double steps = double(opt.runs) * double(plan->run.samples()) * 3.0;
+    const double bytes = double(opt.runs) * 2.0 *
+                         (3.0 * double(plan->run.truth.t.size()) + 4.0 * double(plan->run.nav.outages.size())) * 8.0;
+    if (!opt.allow_large && steps > limits::kDefaultFilterStepBudget)
+      throw Error("navigation gain: --nav-runs " + std::to_string(opt.runs) + ": about " + formatNumber(steps, 3) +
+                  " IMU steps (runs x " + std::to_string(plan->run.samples()) +
+                  " samples x 3: emulation and two filters), above the budget of " +
+                  formatNumber(limits::kDefaultFilterStepBudget, 3) + ": lower --nav-runs or pass --allow-large");
+    if (!opt.allow_large && bytes > limits::kDefaultMemoryBudgetBytes)
+      throw Error("navigation gain: --nav-runs " + std::to_string(opt.runs) + ": the runs' results would hold about " +
+                  formatNumber(bytes / 1e6, 3) + " MB, above the budget of " +
+                  formatNumber(limits::kDefaultMemoryBudgetBytes / 1e6, 3) + " MB: lower --nav-runs or pass --allow-large");
+  }
   if (plan->run.samples() > samples)
     throw Error("static recording too short for the navigation gain: " + formatNumber(samples / rate, 6) +
                 " s available, " + formatNumber(plan->run.duration_s(), 6) + " s needed for the trajectory " +

@@ -480,7 +480,14 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
                     const Progress& progress) {
   if (opt.folds < 2) throw Error("diagnose --run: --folds must be >= 2");
   const std::size_t D = measured.size();
-  const int K = opt.folds;
+  // At most one fold per outage (leave one outage out): more would be empty time
+  // blocks, and a fold count from the command line must not size memory.
+  std::size_t outages = 0;
+  for (const auto& so : simOut) outages += so.size();
+  const int K = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(opt.folds), std::max<std::size_t>(outages, 2)));
+  if (K < opt.folds)
+    out.notices.push_back("--folds " + std::to_string(opt.folds) + " is more than the run's " + std::to_string(outages) +
+                          " outages: " + std::to_string(K) + " folds (time blocks), about one outage each");
   out.folds = K;
   const ReferenceInfo& ref = out.reference;
   const double rate = out.imu_rate_hz;
@@ -1037,7 +1044,9 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   for (double d : opt.durations_s)
     if (!(d > 0.0) || !std::isfinite(d)) throw Error("diagnose --run: outage durations must be > 0 s, got " + formatNumber(d));
   if (!(opt.reconverge_s > 0.0)) throw Error("diagnose --run: --reconverge must be > 0 s");
-  if (opt.realisations < 2) throw Error("diagnose --run: --realisations must be >= 2");
+  if (opt.realisations < 2 || opt.realisations > limits::kMaxMonteCarloRuns)
+    throw Error("diagnose --run: --realisations must be in [2, " + std::to_string(limits::kMaxMonteCarloRuns) +
+                "], got " + std::to_string(opt.realisations));
   if (!(opt.alpha > 0.0 && opt.alpha < 0.5)) throw Error("diagnose --run: --alpha must be in (0, 0.5)");
   if (opt.replay.model_spec.empty())
     throw Error("diagnose --run: give the IMU model with --model FILE[:NAME] (the model whose simulation is judged)");
@@ -1157,8 +1166,29 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   const std::vector<GnssFix>& realGnss = r0.gnss;
   const std::vector<BaroSample>& realBaro = r0.baro;
 
-  // 3. Simulated realisations.
+  // 3. Simulated realisations. Their work and memory, estimated before they start
+  // (README "Ranges and budgets"): per realisation its emulation and a filter run
+  // per duration (two with the causes: the calibration random walk), and per
+  // outage end 9 + 1 numbers (19 with the causes).
   const int R = opt.realisations;
+  {
+    std::size_t outs = 0;
+    for (const auto& so : simOut) outs += so.size();
+    const double passes = 1.0 + double(D) * (opt.causes ? 2.0 : 1.0);
+    const double steps = double(R) * double(n) * passes;
+    const double bytes = double(R) * double(outs) * (opt.causes ? 19.0 : 10.0) * 8.0;
+    if (!opt.allow_large && steps > limits::kDefaultFilterStepBudget)
+      throw Error("diagnose --run: --realisations " + std::to_string(R) + ": the simulation would run about " +
+                  formatNumber(steps, 3) + " IMU steps (" + std::to_string(R) + " realisations x " + std::to_string(n) +
+                  " samples x " + formatNumber(passes) + " passes), above the budget of " +
+                  formatNumber(limits::kDefaultFilterStepBudget, 3) +
+                  ": lower --realisations or --durations, or pass --allow-large");
+    if (!opt.allow_large && bytes > limits::kDefaultMemoryBudgetBytes)
+      throw Error("diagnose --run: --realisations " + std::to_string(R) + ": the simulated outage ends would hold about " +
+                  formatNumber(bytes / 1e6, 3) + " MB, above the budget of " +
+                  formatNumber(limits::kDefaultMemoryBudgetBytes / 1e6, 3) +
+                  " MB: lower --realisations or --durations, or pass --allow-large");
+  }
   std::vector<RealisationOut> sims(R);
   parallelFor(std::size_t(R), static_cast<unsigned>(std::max(opt.threads, 0)), [&](std::size_t r) {
     const std::uint64_t seed = stochastic::deriveSeed(opt.seed, static_cast<std::uint64_t>(r));

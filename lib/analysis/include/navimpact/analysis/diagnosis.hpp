@@ -207,6 +207,7 @@ struct DiagnoseOptions {
   double alpha = 0.01;           ///< family-wise level for the whole record, in (0, 0.5)
   int max_terms = 3;             ///< most processes added per channel
   int threads = 0;               ///< worker threads over channels (0 = hardware)
+  bool allow_large = false;      ///< run above the work budget (limits.hpp)
   /// Called from worker threads with (fraction done 0..1, stage); may be empty.
   std::function<void(double, const std::string&)> progress;
 };
@@ -234,6 +235,7 @@ struct NavGainOptions {
                                     0.2 * 0.017453292519943295, 0.2 * 0.017453292519943295,
                                     1.0 * 0.017453292519943295).finished();
   int threads = 0;                ///< worker threads over runs (0 = hardware)
+  bool allow_large = false;       ///< run above the work and memory budgets (limits.hpp)
   double record_rate_hz = 1.0;          ///< error epochs outside outages [Hz]
   double outage_record_rate_hz = 5.0;   ///< error epochs inside outages [Hz]
 };
@@ -316,6 +318,15 @@ struct Diagnosis {
   DiagnoseOptions options;
   std::optional<NavGain> navigation;  ///< with a trajectory (addNavigationGain)
 };
+
+/**
+ * The options of diagnose() for a record of @p channels x @p samples: alpha,
+ * the simulation count (0 or [2, limits::kMaxMonteCarloRuns]) and their work
+ * against limits::kDefaultSimulatedSampleBudget unless allow_large. diagnose()
+ * calls it; a caller may call it before reading or fitting the data.
+ * @throws navimpact::Error naming the option.
+ */
+void checkDiagnoseOptions(const DiagnoseOptions& opt, std::size_t channels, std::size_t samples);
 
 /**
  * Diagnose @p data against @p model (converted to the data rate, with a notice,

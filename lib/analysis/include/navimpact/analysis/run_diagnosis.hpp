@@ -157,7 +157,8 @@ struct RunDiagnosisOptions {
   std::string static_file;                    ///< "" = the model's simulated errors; else a static recording (CSV)
   CsvImuOptions static_csv;                   ///< units, rate, axes of that recording
   int threads = 0;                            ///< worker threads (0 = hardware)
-  int folds = 5;                              ///< cross-validation folds (time blocks of the run), >= 2
+  int folds = 5;                              ///< cross-validation folds (time blocks of the run), >= 2; at most one per outage
+  bool allow_large = false;                   ///< run above the work and memory budgets (limits.hpp)
   bool causes = true;                         ///< fit and score the causes (false: comparison only)
   /// Progress (fraction done 0..1, stage); may be empty.
   std::function<void(double, const std::string&)> progress;

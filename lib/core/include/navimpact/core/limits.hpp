@@ -118,6 +118,16 @@ inline constexpr int kMaxImuStatesPerAxis = 32;
 /// on a 2-core build machine: a 48 h static run at 200 Hz with a 24-state model
 /// is 9.8e11, about 7 minutes).
 inline constexpr double kDefaultWorkBudget = 1.0e13;
+/// Default work budget of one run diagnosis's simulation, in IMU steps summed
+/// over its realisations' emulations and filter runs: about an hour of one core
+/// (0.5-2.5 us per step). The defaults on a 600 s run at 200 Hz with three
+/// durations: 50 x 1.2e5 x 7 = 4.2e7.
+inline constexpr double kDefaultFilterStepBudget = 2.0e9;
+/// Default work budget of the model simulations of one static diagnosis, in
+/// simulated samples over channels and simulations (simulation and wavelet
+/// variance ~50-100 ns per sample: about half an hour of one core). The
+/// defaults on a 2.8 h record at 100 Hz: 8 x 6 x 1e6 = 4.8e7.
+inline constexpr double kDefaultSimulatedSampleBudget = 2.0e10;
 /// Default memory budget of the results a run holds [bytes].
 inline constexpr double kDefaultMemoryBudgetBytes = 2.0e9;
 
