@@ -68,7 +68,7 @@ Drawn drawNull(std::mt19937_64& rng) {
   return d;
 }
 
-double mcBound(double alpha, int R) { return alpha + 3.0 * std::sqrt(alpha * (1 - alpha) / R); }
+using navimpact::test::plausibleMaxCount;
 
 /// Stated detection limit of a line (lines.hpp): amplitude at which the Hann
 /// peak reaches the threshold with the worst scalloping (0.72 in power).
@@ -95,7 +95,7 @@ TEST(Lines, NullFalseAlarmsAtAlpha) {
   }
   std::cout << "lines null: " << alarms << "/" << R << " false alarms at alpha " << alpha
             << " (seed " << rootSeed() << ")\n";
-  EXPECT_LE(alarms, mcBound(alpha, R) * R);
+  EXPECT_LE(alarms, plausibleMaxCount(R, alpha));
 }
 
 TEST(Lines, PowerAtFiveTimesTheLimitAndParameters) {
@@ -178,7 +178,7 @@ TEST(Lines, BroadbandMisfitIsNotALine) {
     if (!res.lines.empty()) ++alarms;
   }
   std::cout << "GM misfit called a line: " << alarms << "/" << R << "\n";
-  EXPECT_LE(alarms, mcBound(0.05, R) * R);
+  EXPECT_LE(alarms, plausibleMaxCount(R, 0.05));
 }
 
 TEST(ChangePoints, NullFalseAlarmsAtAlpha) {
@@ -198,7 +198,7 @@ TEST(ChangePoints, NullFalseAlarmsAtAlpha) {
     }
   }
   std::cout << "change points null: " << alarms << "/" << R << " at alpha " << alpha << "\n";
-  EXPECT_LE(alarms, mcBound(alpha, R) * R);
+  EXPECT_LE(alarms, plausibleMaxCount(R, alpha));
 }
 
 TEST(ChangePoints, PowerAtFiveTimesTheLimitAndLocation) {
@@ -314,7 +314,7 @@ TEST(ChangePoints, KnocksAreTransientsJudgedAtTheirOwnScale) {
   std::cout << "knocks at 3-100x limit: right " << right << "/" << R << "; null records with a transient " << null_alarms
             << "/" << R << " at alpha " << alpha << "\n";
   EXPECT_GE(right, 0.9 * R);
-  EXPECT_LE(null_alarms, mcBound(alpha, R) * R);
+  EXPECT_LE(null_alarms, plausibleMaxCount(R, alpha));
 }
 
 TEST(Outliers, NullFalseAlarmsAtAlpha) {
@@ -329,7 +329,7 @@ TEST(Outliers, NullFalseAlarmsAtAlpha) {
     if (!res.events.empty()) ++alarms;
   }
   std::cout << "outliers null: " << alarms << "/" << R << " at alpha " << alpha << "\n";
-  EXPECT_LE(alarms, mcBound(alpha, R) * R);
+  EXPECT_LE(alarms, plausibleMaxCount(R, alpha));
 }
 
 TEST(Outliers, SpikesAndBurstsAreEventsAtFiveTimesTheLimit) {

@@ -2,7 +2,9 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 
 namespace fs = std::filesystem;
@@ -51,6 +53,29 @@ std::string gzipBytes(const std::string& text, int level) {
 std::uint64_t envOr(const char* name, std::uint64_t dflt) {
   const char* v = std::getenv(name);
   return v && *v ? std::strtoull(v, nullptr, 10) : dflt;
+}
+
+namespace {
+/// P(X <= k) for X ~ Binomial(n, p), summed exactly from log pmfs.
+double binomialCdf(int k, int n, double p) {
+  if (k < 0) return 0.0;
+  if (k >= n) return 1.0;
+  if (p <= 0.0) return 1.0;
+  if (p >= 1.0) return 0.0;
+  double s = 0.0;
+  for (int i = 0; i <= k; ++i)
+    s += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * std::log(p) +
+                  (n - i) * std::log1p(-p));
+  return std::min(1.0, s);
+}
+}  // namespace
+
+bool plausiblyAtLeast(int k, int n, double p, double level) { return binomialCdf(k, n, p) > level; }
+
+int plausibleMaxCount(int n, double p, double level) {
+  int k = 0;
+  while (k < n && 1.0 - binomialCdf(k, n, p) > level) ++k;  // P(X > k) > level: k + 1 still plausible
+  return k;
 }
 
 }  // namespace navimpact::test

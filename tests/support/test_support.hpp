@@ -41,6 +41,16 @@ std::string gzipBytes(const std::string& text, int level = 6);
 /// it is unset or empty (seeds and run counts a user may override).
 std::uint64_t envOr(const char* name, std::uint64_t dflt);
 
+// Monte Carlo rate claims, checked with exact one-sided binomial tests at
+// @p level (a claim fails only where its draws are that unlikely under it;
+// "rate >= 0.9" asserted on the point estimate fails half the time when the
+// rate is exactly 0.9, and mean + 3 sd of a rare count is far from 3 sigma:
+// P(X >= 2 | 24 draws, 1 %) = 2.4 %).
+/// Whether @p k successes in @p n draws are plausible for a success rate of at least @p p.
+bool plausiblyAtLeast(int k, int n, double p, double level = 1e-3);
+/// The largest count of @p n draws still plausible for an event rate of at most @p p.
+int plausibleMaxCount(int n, double p, double level = 1e-3);
+
 }  // namespace navimpact::test
 
 /// Skip the current test, saying why, when the shared data (../shared next to
