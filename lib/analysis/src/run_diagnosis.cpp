@@ -756,7 +756,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
       // of a gamma law with that mean and variance (test inversion on a grid);
       // the interval is the union with the bootstrap's.
       const double q0 = kCalibrationRwDensity * kCalibrationRwDensity;
-      auto pseudoEstimate = [&](std::size_t r, double q, bool vertical) {
+      auto pseudoEstimate = [&](std::size_t r, double q, bool vertical, bool clamp = true) {
         const double sc = std::sqrt(q / q0), R = static_cast<double>(nr);
         double num = 0.0, den = 0.0;
         for (const Item* it : tr_items) {
@@ -770,11 +770,28 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
           num += (e2 - pred) * x;
           den += x * x;
         }
-        return den > 0 ? std::max(0.0, num / den) : 0.0;
+        const double est = den > 0 ? num / den : 0.0;
+        return clamp ? std::max(0.0, est) : est;
+      };
+      // An estimate clamped at 0 lies within the estimator's noise floor s0 (its
+      // sd over the realisations at q = 0, unclamped): q is kept where the gamma
+      // law of its simulated runs reaches down to s0 with probability >= 0.5 %.
+      auto noiseFloor = [&](bool vertical) {
+        double m = 0.0, m2 = 0.0;
+        for (std::size_t r = 0; r < nr; ++r) {
+          const double v = pseudoEstimate(r, 0.0, vertical, false);
+          m += v;
+          m2 += v * v;
+        }
+        m /= double(nr);
+        return std::sqrt(std::max(0.0, (m2 - double(nr) * m * m) / double(nr - 1)));
       };
       auto parametric = [&](double obs, double boot_hi, bool vertical) -> std::optional<std::pair<double, double>> {
-        if (nr < 3 || !(obs > 0.0)) return std::nullopt;
-        const double top = std::max(obs, boot_hi);
+        if (nr < 3) return std::nullopt;
+        const bool zero = !(obs > 0.0);
+        const double s0 = zero ? noiseFloor(vertical) : 0.0;
+        if (zero && !(s0 > 0.0)) return std::nullopt;
+        const double top = zero ? std::max(boot_hi, s0) : std::max(obs, boot_hi);
         std::optional<std::pair<double, double>> kept;
         for (int g = -1; g <= 270; ++g) {
           const double q = g < 0 ? 0.0 : top * std::pow(10.0, -6.0 + g / 30.0);  // 0, then 1e-6 .. 1e3 x top
@@ -788,8 +805,10 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
           const double var = std::max(0.0, (m2 - double(nr) * m * m) / double(nr - 1));
           if (!(m > 0.0) || !(var > 0.0)) continue;
           const boost::math::gamma_distribution<double> law(m * m / var, var / m);
-          if (obs < boost::math::quantile(law, 0.005) || obs > boost::math::quantile(law, 0.995)) continue;
-          if (!kept) kept = std::pair{q, q};
+          if (zero ? boost::math::cdf(law, s0) < 0.005
+                   : obs < boost::math::quantile(law, 0.005) || obs > boost::math::quantile(law, 0.995))
+            continue;
+          if (!kept) kept = std::pair{zero ? 0.0 : q, q};
           kept->first = std::min(kept->first, q);
           kept->second = std::max(kept->second, q);
         }
