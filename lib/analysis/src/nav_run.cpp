@@ -68,6 +68,9 @@ struct NavRunner::Impl {
     return u.accepted;
   }
 
+  /// A measurement's epoch @p t relative to the filter time (0 when on the sample).
+  static double epochOffset(double t, double t_now) { return std::abs(t - t_now) > 1e-9 ? t - t_now : 0.0; }
+
   void applyAiding(double t_now, double half_dt) {
     // With a time-offset state d = t_IMU - t_true, a fix taken at true time t
     // is the state at IMU time t + d: it waits for that epoch, so that its
@@ -82,7 +85,7 @@ struct NavRunner::Impl {
       if (inOutage(f.t, opt.outages)) continue;
       if (!f.cov_pos_N) throw Error("navigation run: GNSS fix at " + formatNumber(f.t, 10) + " s has no position covariance");
       // the fix's own epoch relative to the filter time (0 when on a sample)
-      const double dt_meas = std::abs(f.t - t_now) > 1e-9 ? f.t - t_now : 0.0;
+      const double dt_meas = epochOffset(f.t, t_now);
       const Eigen::Vector3d sp = f.cov_pos_N->diagonal().cwiseSqrt();
       const filter::UpdateResult up = ekf.updateGnssPosition(f.pos, sp, opt.lever_arm_B, dt_meas);
       if (up.innovation.size() == 3 && up.S.rows() == 3)
@@ -101,7 +104,7 @@ struct NavRunner::Impl {
       if (b.t < x0.t - half_dt) continue;
       if (!opt.baro_in_outage && inOutage(b.t, opt.outages)) continue;
       if (!b.sigma_m) throw Error("navigation run: baro sample at " + formatNumber(b.t, 10) + " s has no sigma");
-      const double dt_meas = std::abs(b.t - t_now) > 1e-9 ? b.t - t_now : 0.0;
+      const double dt_meas = epochOffset(b.t, t_now);
       if (check(ekf.updateBaro(b.h, *b.sigma_m, dt_meas), "baro")) ++res.baro_updates;
     }
   }

@@ -776,16 +776,18 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
       // An estimate clamped at 0 lies within the estimator's noise floor s0 (its
       // sd over the realisations at q = 0, unclamped): q is kept where the gamma
       // law of its simulated runs reaches down to s0 with probability >= 0.5 %.
-      auto noiseFloor = [&](bool vertical) {
+      // Mean and sample variance of the estimates over the realisations at q.
+      auto moments = [&](double q, bool vertical, bool clamp) {
         double m = 0.0, m2 = 0.0;
         for (std::size_t r = 0; r < nr; ++r) {
-          const double v = pseudoEstimate(r, 0.0, vertical, false);
+          const double v = pseudoEstimate(r, q, vertical, clamp);
           m += v;
           m2 += v * v;
         }
         m /= double(nr);
-        return std::sqrt(std::max(0.0, (m2 - double(nr) * m * m) / double(nr - 1)));
+        return std::pair{m, std::max(0.0, (m2 - double(nr) * m * m) / double(nr - 1))};
       };
+      auto noiseFloor = [&](bool vertical) { return std::sqrt(moments(0.0, vertical, false).second); };
       auto parametric = [&](double obs, double boot_hi, bool vertical) -> std::optional<std::pair<double, double>> {
         if (nr < 3) return std::nullopt;
         const bool zero = !(obs > 0.0);
@@ -795,14 +797,7 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
         std::optional<std::pair<double, double>> kept;
         for (int g = -1; g <= 270; ++g) {
           const double q = g < 0 ? 0.0 : top * std::pow(10.0, -6.0 + g / 30.0);  // 0, then 1e-6 .. 1e3 x top
-          double m = 0.0, m2 = 0.0;
-          for (std::size_t r = 0; r < nr; ++r) {
-            const double v = pseudoEstimate(r, q, vertical);
-            m += v;
-            m2 += v * v;
-          }
-          m /= double(nr);
-          const double var = std::max(0.0, (m2 - double(nr) * m * m) / double(nr - 1));
+          const auto [m, var] = moments(q, vertical, true);
           if (!(m > 0.0) || !(var > 0.0)) continue;
           const boost::math::gamma_distribution<double> law(m * m / var, var / m);
           if (zero ? boost::math::cdf(law, s0) < 0.005

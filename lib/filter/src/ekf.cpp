@@ -833,12 +833,15 @@ Vector3d ErrorStateEkf::accelerationN() const {
          (2.0 * w_ie + earth::w_EN_N(x.lat, x.h, x.v_N)).cross(x.v_N);
 }
 
+Vector3d ErrorStateEkf::w_EB_B(const Eigen::Matrix3d& C_BtoN) const {
+  return w_end_IB_B_ - C_BtoN.transpose() * earth::w_IE_N(state().lat);
+}
+
 Vector3d ErrorStateEkf::antennaAcceleration(const Vector3d& l) const {
   // d/dt [v_N + C (w x l)] = a_N + C (w x (w x l)) + C (dw/dt x l), w the body
   // rate w.r.t. the Earth (Earth rate and transport rate in C's derivative left out)
-  const ins::NavState& x = state();
-  const Eigen::Matrix3d C = x.C_BtoN();
-  const Vector3d w = w_end_IB_B_ - C.transpose() * earth::w_IE_N(x.lat);
+  const Eigen::Matrix3d C = state().C_BtoN();
+  const Vector3d w = w_EB_B(C);
   return accelerationN() + C * (w.cross(w.cross(l)) + dw_IB_B_.cross(l));
 }
 
@@ -871,9 +874,8 @@ MatrixXd ErrorStateEkf::H_antennaRotationAcceleration(const Vector3d& l) const {
   // d(C u) = -[(C u) x] psi + C du; du = M dw + ([w x][w x] + [dw/dt x]) dl with
   // M = -[(w x l) x] - [w x][l x]; dw = -Hg dx_imu (- diag(w) ds_g + [w x] dm_g); dl = -de
   MatrixXd H = MatrixXd::Zero(3, size());
-  const ins::NavState& x = state();
-  const Eigen::Matrix3d C = x.C_BtoN();
-  const Vector3d w = w_end_IB_B_ - C.transpose() * earth::w_IE_N(x.lat);
+  const Eigen::Matrix3d C = state().C_BtoN();
+  const Vector3d w = w_EB_B(C);
   const Vector3d u = w.cross(w.cross(l)) + dw_IB_B_.cross(l);
   H.block<3, 3>(0, kAtt) = -skew(C * u);
   const Eigen::Matrix3d CM = C * (-skew(w.cross(l)) - skew(w) * skew(l));

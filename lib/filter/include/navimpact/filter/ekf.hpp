@@ -31,9 +31,9 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <memory>
-#include <array>
 #include <optional>
 #include <string>
 
@@ -400,6 +400,8 @@ class ErrorStateEkf {
   Eigen::Vector3d w_end_IB_B_ = Eigen::Vector3d::Zero();  ///< [rad/s]
   Eigen::Vector3d dw_IB_B_ = Eigen::Vector3d::Zero();     ///< [rad/s^2]
   void pushRate(const Eigen::Vector3d& w, double dt);
+  /// The body rate w.r.t. the Earth at the sample's end, w_end_IB_B - C' w_IE_N [rad/s].
+  Eigen::Vector3d w_EB_B(const Eigen::Matrix3d& C_BtoN) const;
   /// The antenna's acceleration in N for lever arm @p l [m/s^2].
   Eigen::Vector3d antennaAcceleration(const Eigen::Vector3d& l) const;
   /// Jacobian of the lever arm's rotation terms of antennaAcceleration (3 x size()).
