@@ -142,19 +142,19 @@ navimpact_cli_fail(cli_diagnose_nav_runs_range EXIT 1 NOOUT ${_dg_out}/bud1
   REGEX "^navimpact: navigation gain: --nav-runs must be in \\[2, 1000000\\], got 2000000000$")
 navimpact_cli_fail(cli_diagnose_nav_runs_budget EXIT 1 NOOUT ${_dg_out}/bud2
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model ${_dg_ref} ${_dg_nav} --nav-runs 100000 --out ${_dg_out}/bud2
-  REGEX "^navimpact: navigation gain: --nav-runs 100000: about 7.8e\\+09 IMU steps .* above the budget of 2e\\+09: lower --nav-runs or pass --allow-large$")
+  REGEX "^navimpact: navigation gain: --nav-runs 100000: the runs would need about 7.8e\\+09 IMU steps .* above the budget of 2e\\+09 IMU steps: lower --nav-runs, or pass --allow-large$")
 navimpact_cli_fail(cli_diagnose_simulations_range EXIT 1 NOOUT ${_dg_out}/bud3
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model ${_dg_ref} --simulations 2000000000 --out ${_dg_out}/bud3
   REGEX "^navimpact: diagnose: --simulations must be 0 or in \\[2, 1000000\\], got 2000000000$")
 navimpact_cli_fail(cli_diagnose_simulations_budget EXIT 1 NOOUT ${_dg_out}/bud4
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --simulations 100000 --out ${_dg_out}/bud4
-  REGEX "^navimpact: diagnose: --simulations 100000: about 1.57e\\+11 simulated samples .*above the budget of 2e\\+10: lower --simulations or pass --allow-large$")
+  REGEX "^navimpact: diagnose: --simulations 100000: the model's simulations would need about 1.57e\\+11 simulated samples .*above the budget of 2e\\+10 simulated samples: lower --simulations, or pass --allow-large$")
 navimpact_cli_fail(cli_diagnose_run_realisations_range EXIT 1 NOOUT ${_dg_out}/bud5
   ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --realisations 100000000 --out ${_dg_out}/bud5
   REGEX "^navimpact: diagnose --run: --realisations must be in \\[2, 1000000\\], got 100000000$")
 navimpact_cli_fail(cli_diagnose_run_realisations_budget EXIT 1 NOOUT ${_dg_out}/bud6
   ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --durations 10 --realisations 1000000 --out ${_dg_out}/bud6
-  REGEX "^navimpact: diagnose --run: --realisations 1000000: the simulation would run about .* IMU steps .* above the budget of 2e\\+09: lower --realisations or --durations, or pass --allow-large$")
+  REGEX "^navimpact: diagnose --run: --realisations 1000000: the simulation would need about .* IMU steps .* above the budget of 2e\\+09 IMU steps: lower --realisations or --durations, or pass --allow-large$")
 add_test(NAME cli_diagnose_run_folds_above_outages
   COMMAND ${NI} diagnose --run ${_dg_rawlog} --model ${_dg_ref} --durations 10 --realisations 2 --folds 1000
           --out ${_dg_out}/folds --overwrite)

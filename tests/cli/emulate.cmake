@@ -82,7 +82,7 @@ imu: {rate_hz: 10000, errors: none}
 ")
 navimpact_cli_fail(cli_emulate_budget
   ARGS emulate --config ${_edir}/long.yaml --out ${_edir}/long.rawlog
-  REGEX "long.yaml: key 'imu.rate_hz': the run is 1.2e.08 IMU samples .12000 s at 10000 Hz; about 8.04 GB of rawlog.*above the budget of 1e.08: .*--allow-large"
+  REGEX "long.yaml: key 'imu.rate_hz': the run would need about 1.2e.08 IMU samples .12000 s at 10000 Hz; about 8.04 GB of rawlog.*above the budget of 1e.08 IMU samples: .*, or pass --allow-large"
   NOOUT ${_edir}/long.rawlog)
 
 # Sensor effects in an emulation (effects: ...): a 240 s run whose gyros read

@@ -279,21 +279,12 @@ CovarianceBudget estimateCovarianceBudget(const CovarianceStudyConfig& cfg, long
 
 void checkBudget(const CovarianceStudyConfig& cfg, long n) {
   const CovarianceBudget b = estimateCovarianceBudget(cfg, n);
-  auto g = [](double v) {
-    char s[32];
-    std::snprintf(s, sizeof s, "%.3g", v);
-    return std::string(s);
-  };
-  if (cfg.allow_large) return;
-  if (b.work > limits::kDefaultWorkBudget)
-    throw keyError(cfg.source, "duration_s",
-                   "the run needs about " + g(b.work) + " floating-point operations (" + g(double(n)) +
-                       " IMU steps; imu_rate_hz, filter.propagate_every and the models' state counts), above the budget of " +
-                       g(limits::kDefaultWorkBudget) + ": shorten it or pass --allow-large");
-  if (b.memory_bytes > limits::kDefaultMemoryBudgetBytes)
-    throw keyError(cfg.source, "output_rate_hz",
-                   "the results need about " + g(b.memory_bytes / 1e6) + " MB, above the budget of " +
-                       g(limits::kDefaultMemoryBudgetBytes / 1e6) + " MB: lower it or duration_s, or pass --allow-large");
+  limits::checkBudget(
+      {{keyPlace(cfg.source, "duration_s"), "the run", b.work, limits::kDefaultWorkBudget, "operations",
+        formatNumber(double(n), 3) + " IMU steps", "shorten it (or lower imu_rate_hz or the models' states)"},
+       {keyPlace(cfg.source, "output_rate_hz"), "the results", b.memory_bytes / 1e6,
+        limits::kDefaultMemoryBudgetBytes / 1e6, "MB", "", "lower it or duration_s"}},
+      cfg.allow_large);
 }
 
 CovarianceStudyResult runCovarianceStudy(const CovarianceStudyConfig& cfg,

@@ -438,12 +438,12 @@ void checkDiagnoseOptions(const DiagnoseOptions& opt, std::size_t channels, std:
   // Work of the model's simulations, estimated before they start (README
   // "Ranges and budgets"): simulated samples over channels and simulations.
   const double work = double(opt.simulations) * double(channels) * double(samples);
-  if (!opt.allow_large && work > limits::kDefaultSimulatedSampleBudget)
-    throw Error("diagnose: --simulations " + std::to_string(opt.simulations) + ": about " + formatNumber(work, 3) +
-                " simulated samples (simulations x " + std::to_string(channels) + " channels x " +
-                std::to_string(samples) + " samples), above the budget of " +
-                formatNumber(limits::kDefaultSimulatedSampleBudget, 3) +
-                ": lower --simulations or pass --allow-large");
+  limits::checkBudget({{"diagnose: --simulations " + std::to_string(opt.simulations), "the model's simulations", work,
+                        limits::kDefaultSimulatedSampleBudget, "simulated samples",
+                        "simulations x " + std::to_string(channels) + " channels x " + std::to_string(samples) +
+                            " samples",
+                        "lower --simulations"}},
+                      opt.allow_large);
 }
 
 Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,

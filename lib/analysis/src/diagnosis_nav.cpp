@@ -64,15 +64,13 @@ std::shared_ptr<const NavGainPlan> prepareNavGain(const NavGainOptions& opt, dou
     const double steps = double(opt.runs) * double(plan->run.samples()) * 3.0;
     const double bytes = double(opt.runs) * 2.0 *
                          (3.0 * double(plan->run.truth.t.size()) + 4.0 * double(plan->run.nav.outages.size())) * 8.0;
-    if (!opt.allow_large && steps > limits::kDefaultFilterStepBudget)
-      throw Error("navigation gain: --nav-runs " + std::to_string(opt.runs) + ": about " + formatNumber(steps, 3) +
-                  " IMU steps (runs x " + std::to_string(plan->run.samples()) +
-                  " samples x 3: emulation and two filters), above the budget of " +
-                  formatNumber(limits::kDefaultFilterStepBudget, 3) + ": lower --nav-runs or pass --allow-large");
-    if (!opt.allow_large && bytes > limits::kDefaultMemoryBudgetBytes)
-      throw Error("navigation gain: --nav-runs " + std::to_string(opt.runs) + ": the runs' results would hold about " +
-                  formatNumber(bytes / 1e6, 3) + " MB, above the budget of " +
-                  formatNumber(limits::kDefaultMemoryBudgetBytes / 1e6, 3) + " MB: lower --nav-runs or pass --allow-large");
+    const std::string place = "navigation gain: --nav-runs " + std::to_string(opt.runs);
+    limits::checkBudget({{place, "the runs", steps, limits::kDefaultFilterStepBudget, "IMU steps",
+                          "runs x " + std::to_string(plan->run.samples()) + " samples x 3: emulation and two filters",
+                          "lower --nav-runs"},
+                         {place, "the runs' results", bytes / 1e6, limits::kDefaultMemoryBudgetBytes / 1e6, "MB", "",
+                          "lower --nav-runs"}},
+                        opt.allow_large);
   }
   if (plan->run.samples() > samples)
     throw Error("static recording too short for the navigation gain: " + formatNumber(samples / rate, 6) +

@@ -1191,17 +1191,15 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
     const double passes = 1.0 + double(D) * (opt.causes ? 2.0 : 1.0);
     const double steps = double(R) * double(n) * passes;
     const double bytes = double(R) * double(outs) * (opt.causes ? 19.0 : 10.0) * 8.0;
-    if (!opt.allow_large && steps > limits::kDefaultFilterStepBudget)
-      throw Error("diagnose --run: --realisations " + std::to_string(R) + ": the simulation would run about " +
-                  formatNumber(steps, 3) + " IMU steps (" + std::to_string(R) + " realisations x " + std::to_string(n) +
-                  " samples x " + formatNumber(passes) + " passes), above the budget of " +
-                  formatNumber(limits::kDefaultFilterStepBudget, 3) +
-                  ": lower --realisations or --durations, or pass --allow-large");
-    if (!opt.allow_large && bytes > limits::kDefaultMemoryBudgetBytes)
-      throw Error("diagnose --run: --realisations " + std::to_string(R) + ": the simulated outage ends would hold about " +
-                  formatNumber(bytes / 1e6, 3) + " MB, above the budget of " +
-                  formatNumber(limits::kDefaultMemoryBudgetBytes / 1e6, 3) +
-                  " MB: lower --realisations or --durations, or pass --allow-large");
+    const std::string place = "diagnose --run: --realisations " + std::to_string(R);
+    const std::string remedy = "lower --realisations or --durations";
+    limits::checkBudget({{place, "the simulation", steps, limits::kDefaultFilterStepBudget, "IMU steps",
+                          std::to_string(R) + " realisations x " + std::to_string(n) + " samples x " +
+                              formatNumber(passes) + " passes",
+                          remedy},
+                         {place, "the simulated outage ends", bytes / 1e6, limits::kDefaultMemoryBudgetBytes / 1e6,
+                          "MB", "", remedy}},
+                        opt.allow_large);
   }
   std::vector<RealisationOut> sims(R);
   parallelFor(std::size_t(R), static_cast<unsigned>(std::max(opt.threads, 0)), [&](std::size_t r) {

@@ -12,11 +12,12 @@ Error fileError(const std::string& file, std::size_t line, const std::string& wh
   return Error(msg);
 }
 
+std::string keyPlace(const std::string& file, const std::string& key) {
+  return (file.empty() ? std::string() : file + ": ") + "key '" + printable(key, 80) + "'";
+}
+
 Error keyError(const std::string& file, const std::string& key, const std::string& what) {
-  std::string msg;
-  if (!file.empty()) msg = file + ": ";
-  msg += "key '" + printable(key, 80) + "': " + what;
-  return Error(msg);
+  return Error(keyPlace(file, key) + ": " + what);
 }
 
 namespace {

@@ -21,4 +21,15 @@ double check(const std::string& file, const std::string& key, double v, const Ra
   return v;
 }
 
+void checkBudget(const std::initializer_list<BudgetEstimate>& estimates, bool allow_large) {
+  if (allow_large) return;
+  for (const BudgetEstimate& e : estimates) {
+    if (e.need <= e.budget) continue;  // NaN is refused too
+    const auto n = [](double v) { return formatNumber(v, 3); };
+    throw Error(e.place + ": " + e.what + " would need about " + n(e.need) + " " + e.unit +
+                (e.how.empty() ? "" : " (" + e.how + ")") + ", above the budget of " + n(e.budget) + " " + e.unit +
+                ": " + e.remedy + ", or pass --allow-large");
+  }
+}
+
 }  // namespace navimpact::limits

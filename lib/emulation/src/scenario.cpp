@@ -186,12 +186,6 @@ class Collect : public RecordingSink {
   }
 };
 
-std::string g3(double v) {
-  char s[32];
-  std::snprintf(s, sizeof s, "%.3g", v);
-  return s;
-}
-
 }  // namespace
 
 EmulationBudget emulationBudget(const EmulationConfig& cfg, double duration_s) {
@@ -201,19 +195,14 @@ EmulationBudget emulationBudget(const EmulationConfig& cfg, double duration_s) {
   b.rawlog_bytes = b.imu_samples * kRawlogBytesPerSample;
   b.work_s = b.imu_samples * kCpuSecondsPerSample;
   if (!cfg.effects.none()) b.memory_bytes = b.imu_samples * kEffectsBytesPerSample;
-  if (cfg.allow_large) return b;
-  const std::string what = "the run is " + g3(b.imu_samples) + " IMU samples (" + formatNumber(duration_s) + " s at " +
-                           formatNumber(cfg.imu_rate_hz) + " Hz; about " + g3(b.rawlog_bytes / 1e9) + " GB of rawlog, " +
-                           g3(b.work_s / 60.0) + " min of CPU)";
-  if (b.imu_samples > kSampleBudget)
-    throw keyError(cfg.config_file, "imu.rate_hz",
-                   what + ", above the budget of " + g3(kSampleBudget) +
-                       ": lower it, shorten the trajectory (start_s, end_s) or pass --allow-large");
-  if (b.memory_bytes > limits::kDefaultMemoryBudgetBytes)
-    throw keyError(cfg.config_file, "effects",
-                   what + ", held in memory with sensor effects: about " + g3(b.memory_bytes / 1e9) +
-                       " GB, above the budget of " + g3(limits::kDefaultMemoryBudgetBytes / 1e9) +
-                       " GB: shorten the run or pass --allow-large");
+  limits::checkBudget(
+      {{keyPlace(cfg.config_file, "imu.rate_hz"), "the run", b.imu_samples, kSampleBudget, "IMU samples",
+        formatNumber(duration_s) + " s at " + formatNumber(cfg.imu_rate_hz) + " Hz; about " +
+            formatNumber(b.rawlog_bytes / 1e9, 3) + " GB of rawlog, " + formatNumber(b.work_s / 60.0, 3) + " min of CPU",
+        "lower it or shorten the trajectory (start_s, end_s)"},
+       {keyPlace(cfg.config_file, "effects"), "the run held in memory with sensor effects", b.memory_bytes / 1e9,
+        limits::kDefaultMemoryBudgetBytes / 1e9, "GB", "", "shorten the run"}},
+      cfg.allow_large);
   return b;
 }
 

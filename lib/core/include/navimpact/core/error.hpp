@@ -38,6 +38,9 @@ Error fileError(const std::string& file, std::size_t line, const std::string& wh
  */
 Error keyError(const std::string& file, const std::string& key, const std::string& what);
 
+/// The place keyError() names: "FILE: key 'KEY'" ("key 'KEY'" without a file).
+std::string keyPlace(const std::string& file, const std::string& key);
+
 /**
  * Raw input made safe to echo in a message: control characters, bytes that are
  * not valid UTF-8 and the backslash are escaped (\n, \t, \xHH, \\), and the

@@ -35,6 +35,7 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 
 namespace navimpact::limits {
@@ -109,6 +110,10 @@ inline constexpr Range kAtRestAccSigmaMps2{1.0e-6, 1.0e5, false, "m/s^2"};
 /// Most Monte Carlo runs of one study (monte_carlo.runs).
 inline constexpr long long kMaxMonteCarloRuns = 1000000;
 
+/// Most GNSS outages of one run (a replay's outages_every over a long log with
+/// a short period: 1e-4 s periods over 40 s made 4e5 windows).
+inline constexpr long long kMaxOutagesPerRun = 1000000;
+
 /// Most IMU error states of one sensor axis in the filter.
 inline constexpr int kMaxImuStatesPerAxis = 32;
 
@@ -130,6 +135,27 @@ inline constexpr double kDefaultFilterStepBudget = 2.0e9;
 inline constexpr double kDefaultSimulatedSampleBudget = 2.0e10;
 /// Default memory budget of the results a run holds [bytes].
 inline constexpr double kDefaultMemoryBudgetBytes = 2.0e9;
+
+/**
+ * One estimate of a run's work or memory, made before the run starts, with its
+ * budget (README "Ranges and budgets").
+ */
+struct BudgetEstimate {
+  std::string place;   ///< what sizes it: keyPlace(file, key) or "COMMAND: --flag VALUE"
+  std::string what;    ///< what needs it: "the simulation", "the results"
+  double need = 0.0;   ///< the estimate, in @ref unit
+  double budget = 0.0; ///< its budget, in @ref unit
+  std::string unit;    ///< "IMU steps", "MB", "floating-point operations"
+  std::string how;     ///< how it is counted (may be empty): "50 realisations x 1.2e5 samples x 7 passes"
+  std::string remedy;  ///< what the user can lower: "lower --realisations or --durations"
+};
+
+/**
+ * The one budget check of every command: unless @p allow_large, throws for the
+ * first estimate above its budget
+ *   "PLACE: WHAT would need about NEED UNIT (HOW), above the budget of BUDGET UNIT: REMEDY, or pass --allow-large".
+ */
+void checkBudget(const std::initializer_list<BudgetEstimate>& estimates, bool allow_large);
 
 /// Text of a range, e.g. "(0, 1e+04] m".
 std::string describe(const Range& r);
