@@ -69,7 +69,7 @@ navimpact::cli::Registrar reg({
           std::vector<navimpact::Outage> outages;
           std::vector<std::string> names;
           for (const auto& s : o->outages) {
-            outages.push_back(navimpact::parseOutage(s));
+            outages.push_back(navimpact::parseOutage(s, "--outage"));
             names.push_back("--outage " + navimpact::outageText(outages.back()));
           }
           cfg.setOutages(std::move(outages), std::move(names));

@@ -37,6 +37,19 @@ navimpact_cli_check(cli_replay_outages_every CHECK run_json
 navimpact_cli_fail(cli_replay_outages_every_bad
   ARGS replay --rawlog ${_rlog} --outages-every 15:40 --out ${_rdir}/everybad
   REGEX "PERIOD > DURATION" NOOUT ${_rdir}/everybad)
+# the flags have the configuration's ranges (durations [0.1 ms, 7 days]): a
+# period of 1e-300 s made windows that never advanced (8 GB in 14 s)
+navimpact_cli_fail(cli_replay_outages_every_tiny
+  ARGS replay --rawlog ${_rlog} --outages-every 1e-300:1e-301 --out ${_rdir}/everytiny
+  REGEX "^navimpact: outages every '1e-300:1e-301': PERIOD and DURATION must be in \\[0.0001, 604800\\] s, PERIOD > DURATION" NOOUT ${_rdir}/everytiny)
+navimpact_cli_fail(cli_replay_outage_tiny
+  ARGS replay --rawlog ${_rlog} --outage 25:0.00001 --out ${_rdir}/outagetiny
+  REGEX "^navimpact: --outage '25:0.00001': START must be in \\[0, 1e\\+10\\] s and DURATION in \\[0.0001, 604800\\] s$" NOOUT ${_rdir}/outagetiny)
+# a period whose windows exceed the most outages of one run (1e6) is refused
+# when the count passes it, naming the rawlog (1.3e6 windows over 260 s)
+navimpact_cli_fail(cli_replay_outages_every_too_many
+  ARGS replay --rawlog ${_rlog} --outages-every 0.0002:0.0001 --out ${_rdir}/everymany
+  REGEX "uav_flight_260s_ref.rawlog: outages every 0.0002:0.0001 s make more than 1e\\+06 outages over the run" NOOUT ${_rdir}/everymany)
 
 # A gate below the chi-square median would reject most innovations of a
 # consistent filter: refused at load, naming the key.

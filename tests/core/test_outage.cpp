@@ -68,7 +68,9 @@ TEST(Outage, ParsesStartColonDuration) {
   EXPECT_EQ(navimpact::outageText(o), "200:60");
   for (const char* bad : {"200", "200-60", "abc", ":60", "200:", "200:60:1", "200:6O", ""})
     EXPECT_THROW(navimpact::parseOutage(bad), navimpact::Error) << bad;
-  for (const char* bad : {"-1:5", "5:0", "5:-1", "nan:5", "5:inf"}) {
+  // outside the documented ranges: a start beyond the time axis [0, 1e10] s, a
+  // duration outside [0.1 ms, 7 days] (1e300:10 used to end as "1e+300:0")
+  for (const char* bad : {"-1:5", "5:0", "5:-1", "nan:5", "5:inf", "1e300:10", "1e11:10", "25:0.00001", "0:604801"}) {
     try {
       navimpact::parseOutage(bad, "--outage");
       ADD_FAILURE() << bad << " accepted";
@@ -139,8 +141,10 @@ TEST(Outage, PatternClosedForm) {
     EXPECT_DOUBLE_EQ(before, 90.0);
   }
   EXPECT_TRUE(navimpact::outagesEvery(p, 0.0, 119.0).empty());
-  for (const char* bad : {"30", "30:30", "20:30", "a:b", "120:0", "120:-1", ":"})
+  for (const char* bad : {"30", "30:30", "20:30", "a:b", "120:0", "120:-1", ":", "1e-300:1e-301", "0.00005:0.00001",
+                          "604801:30", "nan:1", "inf:1"})
     EXPECT_THROW(navimpact::parseOutagePattern(bad), navimpact::Error) << bad;
+  EXPECT_NO_THROW(navimpact::parseOutagePattern("0.0002:0.0001"));  // both at the range's lower end
 }
 
 // Raw user text in a parse error is bounded and escaped (printable()): a control

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -128,6 +129,24 @@ TEST(OutputSet, SingleFile) {
   in >> s;
   EXPECT_EQ(s, "new");
   EXPECT_EQ(entries(base), std::vector<std::string>{"x.rawlog"});
+}
+
+// A device, pipe or socket at the output's path is never replaced by a file,
+// --overwrite or not (import --out /dev/full --overwrite replaced the device).
+TEST(OutputSet, NeverReplacesANodeThatIsNotAFile) {
+  const fs::path base = test::tempDir();
+  const fs::path fifo = base / "pipe.rawlog";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const Overwrite ow : {Overwrite::Refuse, Overwrite::Replace}) {
+    try {
+      OutputSet::singleFile(fifo, ow);
+      ADD_FAILURE() << "a FIFO accepted as the output";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("exists and is not a regular file"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_EQ(entries(base), std::vector<std::string>{"pipe.rawlog"});
 }
 
 TEST(OutputSet, FailureRemovesTheParentsItCreated) {

@@ -55,8 +55,8 @@ struct TrueRun {
   bool increments = false;
 };
 
-// One random run, written and imported; returns the recording and the truth.
-Recording randomRun(std::uint64_t seed, TrueRun& run, const fs::path& dir) {
+// One random run, written to @p dir; returns its manifest's path and the truth.
+std::string randomRun(std::uint64_t seed, TrueRun& run, const fs::path& dir) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   std::normal_distribution<double> N(0.0, 1.0);
@@ -151,16 +151,33 @@ Recording randomRun(std::uint64_t seed, TrueRun& run, const fs::path& dir) {
   m << "time_offset_s: {gnss: " << g17(run.off_gnss) << ", reference: " << g17(run.off_ref) << "}\n";
   if (run.zero_unix) m << "time_zero_unix_s: " << g17(*run.zero_unix) << "\n";
   writeFile(dir / "run.yaml", m.str());
-  return import::importManifest((dir / "run.yaml").string());
+  return (dir / "run.yaml").string();
 }
 
 TEST(ImportManifest, RandomRunsComeBackAsTheirTruth) {
   const std::uint64_t base = 20261124;
-  for (std::uint64_t s = 0; s < 12; ++s) {
+  for (std::uint64_t s = 0; s < 24; ++s) {
     const fs::path dir = test::tempDir() / ("run" + std::to_string(s));
     fs::create_directories(dir);
     TrueRun run;
-    const Recording d = randomRun(base + s, run, dir);
+    const std::string manifest = randomRun(base + s, run, dir);
+    // an aiding stream with no record inside the IMU's time span (its time
+    // offset drawn over +-5 s, the IMU's span 0.4-8 s) is refused, naming its file
+    const double imuA = run.t_imu.front(), imuB = run.t_imu.back();
+    auto overlaps = [&](const std::vector<double>& t, double off) { return t.back() + off >= imuA && t.front() + off <= imuB; };
+    const bool gnssIn = overlaps(run.t_gnss, run.off_gnss), refIn = overlaps(run.t_ref, run.off_ref);
+    std::printf("  gnss %s, reference %s the IMU's span\n", gnssIn ? "within" : "outside", refIn ? "within" : "outside");
+    if (!gnssIn || !refIn) {
+      try {
+        import::importManifest(manifest);
+        ADD_FAILURE() << "a stream outside the IMU's time span accepted";
+      } catch (const Error& e) {
+        const std::string m = e.what(), file = (dir / (gnssIn ? "ref.csv" : "gnss.csv")).string();
+        EXPECT_EQ(m.rfind(file + ": no record of stream " + (gnssIn ? "reference" : "gnss") + " lies within the IMU's time span", 0), 0u) << m;
+      }
+      continue;
+    }
+    const Recording d = import::importManifest(manifest);
     ASSERT_EQ(d.imu.size(), run.t_imu.size());
     ASSERT_EQ(d.gnss.size(), run.gnss.size());
     ASSERT_EQ(d.reference.size(), run.ref.size());
@@ -169,7 +186,7 @@ TEST(ImportManifest, RandomRunsComeBackAsTheirTruth) {
     auto abs = [&](double t) { return static_cast<double>(d.start_unix_s) + t; };
     if (run.zero_unix) {
       EXPECT_GE(d.imu.front().t, 0.0);
-      EXPECT_LT(std::min(d.imu.front().t, d.gnss.front().t), 1.0);
+      EXPECT_LT(std::min({d.imu.front().t, d.gnss.front().t, d.reference.front().t}), 1.0);
     }
     for (std::size_t k = 0; k < d.imu.size(); ++k) {
       // the first increment's interval is not in the file: divided by the nominal step (checked below)
@@ -304,12 +321,64 @@ TEST(ImportManifest, DataErrorsNameFileLineAndKey) {
        "gnss.csv:3: column 't_s' (key gnss.time.column): gap of 1.02 s after line 2 exceeds gnss.max_gap_s = 0.5 s"},
       {kImu, "t_s,lat,lon\n", kManifest, "gnss.csv:1: no column 'h' (key gnss.position.height)"},
       {"", kGnss, kManifest, "imu.csv: file is empty"},
+      // values beyond any sensor or vehicle (recording.hpp), refused at their line
+      // instead of written into a rawlog that no reader takes back
+      {replaced(kImu, "0.01,0.1", "0.01,2000"), kGnss, kManifest,
+       "imu.csv:3: keys imu.gyro, imu.acc: angular rate x = 2000 rad/s is beyond any IMU (|value| <= 1000 rad/s) (are the units right?)"},
+      {replaced(kImu, "0.02,0.1,0.2,0.3,0.1,0.2,9.8", "0.02,0.1,0.2,0.3,0.1,0.2,1e7"), kGnss, kManifest,
+       "imu.csv:4: keys imu.gyro, imu.acc: specific force z = 1e+07 m/s^2 is beyond any IMU"},
+      {replaced(kImu, "0.00,", "-1e11,"), kGnss, kManifest,
+       "imu.csv:2: time -1e+11 s (key imu.time, with time_offset_s) is outside [-1e+10, 1e+10] s"},
+      {kImu, "t_s,lat,lon,h,vn,ve,vd\n0.00,46.5,6.6,400,1,2,3\n0.02,46.5,6.6,400,1e9,0,0\n",
+       replaced(kManifest, "  height_datum: ellipsoid\n", "  height_datum: ellipsoid\n  velocity: {columns: [vn, ve, vd], frame: NED, unit: m/s}\n"),
+       "gnss.csv:3: key gnss: GNSS velocity north = 1e+09 m/s is beyond any vehicle (|value| <= 10000 m/s)"},
+      {kImu, "t_s,lat,lon,h,s\n0.00,46.5,6.6,400,1\n0.02,46.5,6.6,400,1e30\n",
+       replaced(kManifest, "  height_datum: ellipsoid\n", "  height_datum: ellipsoid\n  sigma: {columns: [s, s], unit: m}\n"),
+       "gnss.csv:3: key gnss: GNSS position sigma 1e+30 m is outside [0.0001, 1e+06] m"},
+      {kImu, replaced(kGnss, "0.02,46.5,6.6,400", "0.02,46.5,6.6,2e6"), kManifest, "gnss.csv:3: column key gnss.position.height: height 2e+06"},
+      // an aiding stream wholly outside the IMU's time span (a time offset or unit gone wrong)
+      {kImu, kGnss, std::string(kManifest) + "time_offset_s: {gnss: 10000}\n",
+       "gnss.csv: no record of stream gnss lies within the IMU's time span [0, 0.03] s (it spans [10000, 10000.02] s"},
   };
   for (const auto& c : cases) {
     const std::string e = importError(c.manifest, c.imu, c.gnss);
     EXPECT_NE(e.find(c.expect), std::string::npos) << "expected '" << c.expect << "' in: " << e;
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   }
+}
+
+// The barometer's heights and the reference's attitude angles have ranges too:
+// a height of 1e12 m replayed to a vertical RMS of 1.1e8 m with exit 0; a pitch
+// of 120 deg is not an attitude (roll and yaw wrap, pitch does not).
+TEST(ImportManifest, BaroHeightsAndReferenceAnglesOutsideTheirRanges) {
+  const std::string baro = "t_s,h\n0.00,400\n0.02,1e12\n";
+  const std::string ref = "t_s,lat,lon,h,r,p,y\n0.00,46.5,6.6,400,10,5,350\n0.02,46.5,6.6,400,-170,120,-20\n";
+  const std::string streams = "baro:\n  file: baro.csv\n  time: {column: t_s, unit: s}\n  height: {column: h, unit: m}\n"
+                              "reference:\n  file: ref.csv\n  time: {column: t_s, unit: s}\n"
+                              "  position: {lat: lat, lon: lon, height: h, angle_unit: deg}\n"
+                              "  attitude: {roll: r, pitch: p, yaw: y, unit: deg}\n";
+  auto error = [&](const std::string& b, const std::string& r) {
+    const fs::path dir = test::tempDir();
+    writeFile(dir / "m.yaml", std::string(kManifest) + streams);
+    writeFile(dir / "imu.csv", kImu);
+    writeFile(dir / "gnss.csv", kGnss);
+    writeFile(dir / "baro.csv", b);
+    writeFile(dir / "ref.csv", r);
+    try {
+      import::importManifest((dir / "m.yaml").string());
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string okBaro = replaced(baro, "1e12", "401"), okRef = replaced(ref, ",120,", ",-89.9,");
+  EXPECT_EQ(error(okBaro, okRef), "(no error)");
+  std::string e = error(baro, okRef);
+  EXPECT_NE(e.find("baro.csv:3: key baro: barometric height 1e+12 m is outside [-12000, 1e+06] m"), std::string::npos) << e;
+  e = error(okBaro, ref);
+  EXPECT_NE(e.find("ref.csv:3: column key reference.attitude.pitch: 120 is outside [-90, 90] deg"), std::string::npos) << e;
+  e = error(okBaro, replaced(ref, "-170,", "1e9,"));
+  EXPECT_NE(e.find("ref.csv:3: column key reference.attitude.roll: 1e+09 is outside [-360, 360] deg"), std::string::npos) << e;
 }
 
 TEST(ImportManifest, IncrementsAreDividedByTheirOwnInterval) {

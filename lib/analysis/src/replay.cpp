@@ -10,6 +10,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <string_view>
 #include <optional>
 #include <cstdio>
 #include <ctime>
@@ -462,6 +463,10 @@ void ReplayDriver::decideWindows(double t_now) {
       windowsOpen_ = false;
       return;
     }
+    if (nextWindow_ >= limits::kMaxOutagesPerRun)
+      throw Error(cfg_.rawlog + ": outages every " + formatNumber(p.period_s, 10) + ":" + formatNumber(p.duration_s, 10) +
+                  " s make more than " + formatNumber(double(limits::kMaxOutagesPerRun)) +
+                  " outages over the run (at most that many per run): a longer period");
     runner_->addOutage({a, b});
     r_.cfg.outages.push_back({a - r_.t_zero, b - r_.t_zero});
     ++nextWindow_;
@@ -726,18 +731,25 @@ void ReplayDriver::run() {
   // a negative time-offset estimate applies a fix before its own time stamp
   // (NavRunner): the records are read that far ahead
   const double fixLookahead = opt_.ekf.imu.extra.time_offset_sigma_s > 0.0 ? -limits::kTimeOffsetS.lo : 0.0;
-  ins::ImuSample s;
-  while (nextSample(s)) {
-    if (s.t - r.t_zero > stopAfter_) {
-      while (!eof_) readOne();  // what depends on the whole data (reference content, data end) as in a full replay
-      break;
+  // the filter's errors (a covariance no longer positive definite, a fix
+  // without sigma) name the rawlog whose data caused them; the reader's name it already
+  try {
+    ins::ImuSample s;
+    while (nextSample(s)) {
+      if (s.t - r.t_zero > stopAfter_) {
+        while (!eof_) readOne();  // what depends on the whole data (reference content, data end) as in a full replay
+        break;
+      }
+      decideWindows(s.t + s.dt);
+      fillTo(s.t + 0.5 * s.dt + fixLookahead);
+      run.step(s);
     }
-    decideWindows(s.t + s.dt);
-    fillTo(s.t + 0.5 * s.dt + fixLookahead);
-    run.step(s);
+    r.run = run.finish();
+  } catch (const Error& e) {
+    if (std::string_view(e.what()).rfind(cfg.rawlog, 0) == 0) throw;
+    throw Error(cfg.rawlog + ": " + e.what());
   }
   const double t_last = lastImuT_;
-  r.run = run.finish();
   r.nav = opt_;
   r.nav.outages = run.outages();
   r.read_s = readS_;

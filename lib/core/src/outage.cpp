@@ -6,6 +6,7 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/text_io.hpp"
 
 namespace navimpact {
@@ -24,8 +25,10 @@ Outage parseOutage(const std::string& text, const std::string& what) {
   if (c == std::string::npos || !parseDouble(trim(std::string_view(text).substr(0, c)), start) ||
       !parseDouble(trim(std::string_view(text).substr(c + 1)), duration))
     throw Error(what + " '" + printable(text, 60) + "': expected START:DURATION in seconds, e.g. 200:60");
-  if (!(start >= 0.0) || !(duration > 0.0) || !std::isfinite(start) || !std::isfinite(duration))
-    throw Error(what + " '" + printable(text, 60) + "': START must be >= 0 s and DURATION > 0 s");
+  // the ranges of a configuration's outages: times on a run's axis, durations (limits.hpp)
+  if (!(start >= 0.0 && start <= limits::kFileTimeS.hi) || !(duration >= limits::kDurationS.lo && duration <= limits::kDurationS.hi))
+    throw Error(what + " '" + printable(text, 60) + "': START must be in [0, " + formatNumber(limits::kFileTimeS.hi) +
+                "] s and DURATION in " + limits::describe(limits::kDurationS));
   return Outage::fromStartDuration(start, duration);
 }
 
@@ -35,9 +38,10 @@ OutagePattern parseOutagePattern(const std::string& text) {
   if (c == std::string::npos || !parseDouble(trim(std::string_view(text).substr(0, c)), p.period_s) ||
       !parseDouble(trim(std::string_view(text).substr(c + 1)), p.duration_s))
     throw Error("outages every '" + printable(text, 60) + "': expected PERIOD:DURATION in seconds, e.g. 120:30");
-  if (!(p.duration_s > 0.0) || !(p.period_s > p.duration_s) || !std::isfinite(p.period_s))
-    throw Error("outages every '" + printable(text, 60) +
-                "': DURATION must be > 0 s and PERIOD > DURATION (GNSS time between outages to reconverge)");
+  const auto in = [](double v) { return v >= limits::kDurationS.lo && v <= limits::kDurationS.hi; };
+  if (!in(p.duration_s) || !in(p.period_s) || !(p.period_s > p.duration_s))
+    throw Error("outages every '" + printable(text, 60) + "': PERIOD and DURATION must be in " +
+                limits::describe(limits::kDurationS) + ", PERIOD > DURATION (GNSS time between outages to reconverge)");
   return p;
 }
 

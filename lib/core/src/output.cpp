@@ -147,6 +147,9 @@ OutputSet::OutputSet(fs::path dest, Overwrite ow, Kind kind) : dest_(std::move(d
         }
       } else {
         if (fs::is_directory(st)) throw Error(shown + ": is a folder (an output file is expected)");
+        if (!fs::is_regular_file(st) && !fs::is_symlink(st))
+          throw Error(shown + ": exists and is not a regular file (a device, pipe or socket is never replaced, "
+                              "--overwrite or not)");
         if (ow_ == Overwrite::Refuse) throw Error(shown + ": output file exists (pass --overwrite to replace it)");
       }
     }

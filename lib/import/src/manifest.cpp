@@ -7,11 +7,12 @@
 #include <cmath>
 #include <filesystem>
 #include <set>
-#include <sstream>
 
 #include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/limits.hpp"
+#include "navimpact/core/recording.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/import/csv_columns.hpp"
@@ -69,11 +70,6 @@ struct Keys {
     for (const auto& a : names) list += (list.empty() ? "" : ", ") + a;
     throw err(key, "must be one of " + list + ", got " + (n.isScalar() ? "'" + printable(s) + "'" : std::string("a list or a map")));
   }
-  static std::string formatRange(double v) {
-    std::ostringstream o;
-    o << v;
-    return o.str();
-  }
 };
 
 // ---------------------------------------------------------------------------
@@ -116,7 +112,7 @@ StreamSpec streamSpec(const Keys& k, const ConfigNode& n, const std::string& nam
     static const double f[] = {1.0, 1e-3, 1e-6, 1e-9};
     s.time_factor = f[k.oneOf(t["unit"], tk + ".unit", {"s", "ms", "us", "ns"})];
   }
-  if (n["max_gap_s"]) s.max_gap_s = k.positive(n["max_gap_s"], limits::kDurationS, 1e9);
+  if (n["max_gap_s"]) s.max_gap_s = n["max_gap_s"].asNumber(limits::kDurationS);
   return s;
 }
 
@@ -127,22 +123,30 @@ std::vector<double> streamTimes(const StreamSpec& s, const ColumnTable& tab, std
   if (s.time_column) {
     const auto& c = tab.columns[timeCol];
     for (std::size_t i = 0; i < n; ++i) t[i] = c[i] * s.time_factor + s.offset_s;
+    // on the recording's axis (with time_offset_s) within the documented range of times
+    for (std::size_t i = 0; i < n; ++i)
+      if (!(std::abs(t[i]) <= limits::kFileTimeS.hi))
+        throw fileError(s.file, tab.line[i], "time " + formatNumber(t[i]) + " s (key " + s.name +
+                                                 ".time, with time_offset_s) is outside " + limits::describe(limits::kFileTimeS));
     const std::string key = s.name + ".time.column";
     for (std::size_t i = 1; i < n; ++i) {
       const double dt = t[i] - t[i - 1];
       if (dt <= 0.0)
         throw fileError(s.file, tab.line[i], "column '" + printable(s.column) + "' (key " + key + "): time " +
                                                  (dt == 0.0 ? "repeats" : "goes backwards") + " (" +
-                                                 Keys::formatRange(c[i]) + " after " + Keys::formatRange(c[i - 1]) +
+                                                 formatNumber(c[i]) + " after " + formatNumber(c[i - 1]) +
                                                  " on line " + std::to_string(tab.line[i - 1]) + ")");
       if (s.max_gap_s > 0.0 && dt > s.max_gap_s)
         throw fileError(s.file, tab.line[i], "column '" + printable(s.column) + "' (key " + key + "): gap of " +
-                                                 Keys::formatRange(dt) + " s after line " +
+                                                 formatNumber(dt) + " s after line " +
                                                  std::to_string(tab.line[i - 1]) + " exceeds " + s.name +
-                                                 ".max_gap_s = " + Keys::formatRange(s.max_gap_s) + " s");
+                                                 ".max_gap_s = " + formatNumber(s.max_gap_s) + " s");
     }
   } else {
     for (std::size_t i = 0; i < n; ++i) t[i] = s.start_s + static_cast<double>(i) / s.rate_hz + s.offset_s;
+    if (n > 0 && !(std::abs(t[0]) <= limits::kFileTimeS.hi && std::abs(t[n - 1]) <= limits::kFileTimeS.hi))
+      throw fileError(s.file, 0, "times " + formatNumber(t[0]) + " .. " + formatNumber(t[n - 1]) + " s (key " + s.name +
+                                     ".time, with time_offset_s) are outside " + limits::describe(limits::kFileTimeS));
   }
   return t;
 }
@@ -231,13 +235,13 @@ earth::Geodetic positionAt(const StreamSpec& s, const ColumnTable& tab, const Po
   const double lat = tab.columns[p.lat][i] * p.angle, lon = tab.columns[p.lon][i] * p.angle;
   const double h = tab.columns[p.h][i] + undulation;
   if (std::abs(lat) > 90.0 * kDeg)
-    throw fileError(s.file, tab.line[i], "column key " + key + ".lat: latitude " + Keys::formatRange(tab.columns[p.lat][i]) +
+    throw fileError(s.file, tab.line[i], "column key " + key + ".lat: latitude " + formatNumber(tab.columns[p.lat][i]) +
                                              " is outside [-90, 90] deg (is angle_unit right?)");
   if (lon < -180.0 * kDeg || lon > 360.0 * kDeg)
-    throw fileError(s.file, tab.line[i], "column key " + key + ".lon: longitude " + Keys::formatRange(tab.columns[p.lon][i]) +
+    throw fileError(s.file, tab.line[i], "column key " + key + ".lon: longitude " + formatNumber(tab.columns[p.lon][i]) +
                                              " is outside [-180, 360] deg (is angle_unit right?)");
   if (h < -12000.0 || h > 1e6)
-    throw fileError(s.file, tab.line[i], "column key " + key + ".height: height " + Keys::formatRange(h) +
+    throw fileError(s.file, tab.line[i], "column key " + key + ".height: height " + formatNumber(h) +
                                              " m is outside [-12000, 1e6] m");
   return {lat, lon > 180.0 * kDeg ? lon - 360.0 * kDeg : lon, h};
 }
@@ -278,7 +282,7 @@ Eigen::Vector3d sigmaAt(const StreamSpec& st, const ColumnTable& tab, const Sigm
     const double v = tab.columns[s.cols[c]][i];
     if (!(v > 0.0))
       throw fileError(st.file, tab.line[i], "column key " + key + ".columns[" + std::to_string(c) + "]: sigma " +
-                                                Keys::formatRange(v) + " must be > 0");
+                                                formatNumber(v) + " must be > 0");
   }
   if (s.cols.size() == 3) return {tab.columns[s.cols[0]][i], tab.columns[s.cols[1]][i], tab.columns[s.cols[2]][i]};
   return {tab.columns[s.cols[0]][i], tab.columns[s.cols[0]][i], tab.columns[s.cols[1]][i]};
@@ -333,12 +337,6 @@ double median(std::vector<double> v) {
   return *mid;
 }
 
-std::string fmt17(double x) {
-  std::ostringstream o;
-  o.precision(17);
-  o << x;
-  return o.str();
-}
 
 }  // namespace
 
@@ -441,6 +439,8 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
         v[q] = C_FtoB * file * (increments[q] ? factor[q] / dt : factor[q]);
       }
       d.imu[i] = {t[i], v[0], v[1]};
+      if (const std::string p = recordProblem(d.imu[i]); !p.empty())
+        throw fileError(s.file, tab.line[i], "keys imu.gyro, imu.acc: " + p + " (are the units right?)");
     }
     rep.imu_file = s.file;
     rep.imu_rate_hz = d.imu_rate_hz;
@@ -475,6 +475,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       f.v_N = velocityAt(s, tab, vs, "gnss.velocity", i);
       if (ss.present) f.cov_pos_N = sigmaAt(s, tab, ss, "gnss.sigma", i).cwiseAbs2().asDiagonal();
       if (f.v_N && vs.sigma.present) f.cov_vel_N = sigmaAt(s, tab, vs.sigma, "gnss.velocity.sigma", i).cwiseAbs2().asDiagonal();
+      if (const std::string p = recordProblem(f); !p.empty()) throw fileError(s.file, tab.line[i], "key gnss: " + p);
     }
     rep.gnss_file = s.file;
   }
@@ -498,7 +499,10 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
     const std::vector<double> t = streamTimes(s, tab, tc);
     d.baro.resize(tab.rows());
-    for (std::size_t i = 0; i < tab.rows(); ++i) d.baro[i] = {t[i], tab.columns[hc][i] + und, sigma};
+    for (std::size_t i = 0; i < tab.rows(); ++i) {
+      d.baro[i] = {t[i], tab.columns[hc][i] + und, sigma};
+      if (const std::string p = recordProblem(d.baro[i]); !p.empty()) throw fileError(s.file, tab.line[i], "key baro: " + p);
+    }
     rep.baro_file = s.file;
   }
 
@@ -539,15 +543,43 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       e.t = t[i];
       e.p_L = earth::geodeticToNed(d.origin, pos[i]);
       e.v_N = velocityAt(s, tab, vs, "reference.velocity", i);
-      if (att) e.q_BtoN = quatRpy(tab.columns[ac[0]][i] * aunit, tab.columns[ac[1]][i] * aunit, tab.columns[ac[2]][i] * aunit);
+      if (att) {
+        // roll and yaw in [-360, 360] deg (either convention of the wrap), pitch in [-90, 90] deg
+        const char* names[] = {"roll", "pitch", "yaw"};
+        for (int a = 0; a < 3; ++a) {
+          const double v = tab.columns[ac[a]][i] * aunit, lim = (a == 1 ? 90.0 : 360.0) * kDeg;
+          if (!(std::abs(v) <= lim * (1.0 + 1e-12)))
+            throw fileError(s.file, tab.line[i], std::string("column key reference.attitude.") + names[a] + ": " +
+                                                     formatNumber(tab.columns[ac[a]][i]) + " is outside [-" +
+                                                     formatNumber(lim / aunit) + ", " + formatNumber(lim / aunit) +
+                                                     "] " + (aunit == 1.0 ? "rad" : "deg") + " (is the unit right?)");
+        }
+        e.q_BtoN = quatRpy(tab.columns[ac[0]][i] * aunit, tab.columns[ac[1]][i] * aunit, tab.columns[ac[2]][i] * aunit);
+      }
       if (ss.present) e.sigma_p_L = sigmaAt(s, tab, ss, "reference.sigma", i);
       if (e.v_N && vs.sigma.present) e.sigma_v_N = sigmaAt(s, tab, vs.sigma, "reference.velocity.sigma", i);
+      if (const std::string p = recordProblem(e); !p.empty()) throw fileError(s.file, tab.line[i], "key reference: " + p);
     }
     rep.reference_file = s.file;
   } else if (origin) {
     d.origin = *origin;
   } else if (!d.gnss.empty()) {
     d.origin = d.gnss.front().pos;
+  }
+
+  // --- every aiding stream overlaps the IMU's time span --------------------------
+  {
+    const double a = d.imu.front().t, b = d.imu.back().t;
+    auto overlaps = [&](const std::string& file, const char* key, double first, double last) {
+      if (last >= a && first <= b) return;
+      throw fileError(file, 0, std::string("no record of stream ") + key + " lies within the IMU's time span [" +
+                                   formatNumber(a, 10) + ", " + formatNumber(b, 10) + "] s (it spans [" +
+                                   formatNumber(first, 10) + ", " + formatNumber(last, 10) +
+                                   "] s: are the time units and time_offset_s right?)");
+    };
+    if (!d.gnss.empty()) overlaps(rep.gnss_file, "gnss", d.gnss.front().t, d.gnss.back().t);
+    if (!d.baro.empty()) overlaps(rep.baro_file, "baro", d.baro.front().t, d.baro.back().t);
+    if (!d.reference.empty()) overlaps(rep.reference_file, "reference", d.reference.front().t, d.reference.back().t);
   }
 
   // --- time base --------------------------------------------------------------
@@ -573,20 +605,20 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     y << YAML::Key << "frames" << YAML::Value
       << "body FRD, navigation NED, reference position tangent-plane NED at origin, attitude C_BtoN";
     y << YAML::Key << "origin" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "lat_deg" << YAML::Value
-      << fmt17(d.origin.lat / kDeg) << YAML::Key << "lon_deg" << YAML::Value << fmt17(d.origin.lon / kDeg) << YAML::Key
-      << "height_m" << YAML::Value << fmt17(d.origin.h) << YAML::EndMap;
+      << formatExact(d.origin.lat / kDeg) << YAML::Key << "lon_deg" << YAML::Value << formatExact(d.origin.lon / kDeg) << YAML::Key
+      << "height_m" << YAML::Value << formatExact(d.origin.h) << YAML::EndMap;
     y << YAML::Key << "time" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "start_unix_s" << YAML::Value
       << d.start_unix_s << YAML::Key << "time_base_known" << YAML::Value << zeroUnix.has_value() << YAML::EndMap;
     y << YAML::Key << "imu" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value
-      << fmt17(d.imu_rate_hz) << YAML::EndMap;
+      << formatExact(d.imu_rate_hz) << YAML::EndMap;
     if (d.lever_arm_B) {
       y << YAML::Key << "gnss" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "lever_arm_B_m" << YAML::Value
-        << YAML::Flow << YAML::BeginSeq << fmt17((*d.lever_arm_B)[0]) << fmt17((*d.lever_arm_B)[1])
-        << fmt17((*d.lever_arm_B)[2]) << YAML::EndSeq << YAML::EndMap;
+        << YAML::Flow << YAML::BeginSeq << formatExact((*d.lever_arm_B)[0]) << formatExact((*d.lever_arm_B)[1])
+        << formatExact((*d.lever_arm_B)[2]) << YAML::EndSeq << YAML::EndMap;
     }
     if (!d.baro.empty() && d.baro.front().sigma_m) {  // rawlogs keep the barometer's sigma here
       y << YAML::Key << "baro" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "sigma_m" << YAML::Value
-        << fmt17(*d.baro.front().sigma_m) << YAML::EndMap;
+        << formatExact(*d.baro.front().sigma_m) << YAML::EndMap;
     }
     y << YAML::EndMap;
     y << YAML::Key << "navimpact_import" << YAML::Value << YAML::BeginMap;

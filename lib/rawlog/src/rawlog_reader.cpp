@@ -86,6 +86,18 @@ struct RawlogReader::Impl {
     }
   }
 
+  /// The physical ranges every reader applies (recording.hpp), checked on the entry that holds the record.
+  void checkPlausible(const RawlogRecord& r, const std::string& label, double t) const {
+    std::string p;
+    switch (r.kind) {
+      case RawlogRecord::Kind::Imu: p = recordProblem(r.imu); break;
+      case RawlogRecord::Kind::Gnss: p = recordProblem(r.gnss); break;
+      case RawlogRecord::Kind::Baro: p = recordProblem(r.baro); break;
+      case RawlogRecord::Kind::Reference: p = recordProblem(r.reference); break;
+    }
+    if (!p.empty()) throw Error(where(label, t) + ": " + p);
+  }
+
   void emit(RawlogRecord&& r) { ready.push_back(std::move(r)); }
   void flushGt() {
     if (pendingGt) {
@@ -164,6 +176,7 @@ struct RawlogReader::Impl {
       }
       if (c(0, 0) > 0 && c(1, 1) > 0 && c(2, 2) > 0)
         r.sigma_p_L = Eigen::Vector3d(std::sqrt(c(1, 1)), std::sqrt(c(0, 0)), std::sqrt(c(2, 2)));
+      checkPlausible(rec, label, t);
       pendingGt = std::move(rec);
       return;
     }
@@ -176,6 +189,7 @@ struct RawlogReader::Impl {
         if (!m->has(i)) throw Error(where(label, t) + ": a velocity field (IMU_X_VEL, IMU_Y_VEL, IMU_Z_VEL) is not set");
       pendingGt->reference.v_N = Eigen::Vector3d(m->get(mrpt::obs::IMU_X_VEL), m->get(mrpt::obs::IMU_Y_VEL),
                                                  m->get(mrpt::obs::IMU_Z_VEL));
+      checkPlausible(*pendingGt, label, t);
       return;
     }
     if (label == "IMU" || label == "BARO" || label == "GT") {
@@ -212,6 +226,7 @@ struct RawlogReader::Impl {
       } else if (label == "BARO") {
         rec.kind = RawlogRecord::Kind::Baro;
         rec.baro = {t, need(mrpt::obs::IMU_ALTITUDE, "IMU_ALTITUDE"), std::nullopt};
+        checkPlausible(rec, label, t);
         emit(std::move(rec));
       } else {
         if (!haveOrigin) throw Error(where(label, t) + ": ground truth needs the scenario comment's origin, none found before it");
@@ -229,6 +244,7 @@ struct RawlogReader::Impl {
                                         need(mrpt::obs::IMU_ORI_QUAT_X, "IMU_ORI_QUAT_X"),
                                         need(mrpt::obs::IMU_ORI_QUAT_Y, "IMU_ORI_QUAT_Y"),
                                         need(mrpt::obs::IMU_ORI_QUAT_Z, "IMU_ORI_QUAT_Z"));
+        checkPlausible(rec, label, t);
         pendingGt = std::move(rec);
       }
     } else if (label == "GNSS") {
@@ -272,6 +288,7 @@ struct RawlogReader::Impl {
         head.origin = f.pos;
         fromCommentOrigin = true;
       }
+      checkPlausible(rec, label, t);
       emit(std::move(rec));
     } else {
       ++skipped;

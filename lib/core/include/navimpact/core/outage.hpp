@@ -43,7 +43,8 @@ std::string outageText(const Outage& o);
 /// Parses "START:DURATION" [s] (e.g. "200:60"; spaces around the numbers allowed).
 /// @param what how the text is named in a message ("outage", "--outage").
 /// @throws navimpact::Error "WHAT 'TEXT': expected START:DURATION in seconds, e.g. 200:60"
-///         or "WHAT 'TEXT': START must be >= 0 s and DURATION > 0 s".
+///         or "WHAT 'TEXT': START must be in [0, 1e10] s and DURATION in [0.0001, 604800] s"
+///         (the ranges of times and durations in limits.hpp).
 Outage parseOutage(const std::string& text, const std::string& what = "outage");
 
 /// Outages all along a run: every PERIOD seconds one of DURATION seconds.
@@ -52,9 +53,10 @@ struct OutagePattern {
   double duration_s = 0.0;  ///< [s], > 0
 };
 
-/// Parses "PERIOD:DURATION" [s] (e.g. "120:30"; spaces around the numbers allowed), PERIOD > DURATION > 0.
+/// Parses "PERIOD:DURATION" [s] (e.g. "120:30"; spaces around the numbers allowed), PERIOD > DURATION,
+/// both durations in limits::kDurationS.
 /// @throws navimpact::Error "outages every 'TEXT': expected PERIOD:DURATION in seconds, e.g. 120:30"
-///         or "outages every 'TEXT': DURATION must be > 0 s and PERIOD > DURATION (...)".
+///         or "outages every 'TEXT': PERIOD and DURATION must be in [0.0001, 604800] s, PERIOD > DURATION (...)".
 OutagePattern parseOutagePattern(const std::string& text);
 
 /**

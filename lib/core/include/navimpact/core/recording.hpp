@@ -90,4 +90,24 @@ struct Recording {
   std::vector<std::string> notices;   ///< notes for the user (rate conversions, skipped entries, ...)
 };
 
+/// Physical ranges of a record's values, beyond any vehicle and sensor
+/// navimpact navigates (README "Ranges and budgets"), applied by every reader
+/// (rawlog, import) so that what navimpact writes it reads back:
+/// IMU rates and forces as imu_series.hpp (kMaxAbsAngularRate, kMaxAbsSpecificForce);
+/// reference positions within 10^4 km of the origin; heights [-12 km, 1000 km]; velocity components [-1e4, 1e4] m/s (orbital
+/// speed is 7.8 km/s); standard deviations of positions and heights
+/// [0.1 mm, 1000 km], of velocities [0.1 mm/s, 1000 km/s], of attitudes (0, pi] rad.
+inline constexpr double kMinHeightM = -12000.0;
+inline constexpr double kMaxHeightM = 1.0e6;
+inline constexpr double kMaxAbsSpeedMps = 1.0e4;
+inline constexpr double kMinRecordSigma = 1.0e-4;
+inline constexpr double kMaxRecordSigma = 1.0e6;
+
+/// What is physically impossible in a record, as "what = value is ... (accepted)";
+/// empty when nothing is. Times are the reader's to check (their order, their axis).
+std::string recordProblem(const ImuRecord& r);
+std::string recordProblem(const GnssFix& r);
+std::string recordProblem(const BaroSample& r);
+std::string recordProblem(const ReferenceRecord& r);
+
 }  // namespace navimpact
