@@ -31,6 +31,7 @@ struct Opts {
   double alpha = 0.01;
   int simulations = 4;
   int threads = 0;
+  bool allow_large = false;
 };
 
 std::pair<double, double> range(const std::string& flag, const std::string& v) {
@@ -76,13 +77,13 @@ int run(const Opts& o) {
       if (!ok) throw navimpact::Error("--causes: unknown cause '" + item + "' (white_noise, quantization_noise, random_walk, drift, gauss_markov, sinusoid, level_shift, outliers)");
     }
   }
-  if (o.runs < 0 || o.null_runs < 0) throw navimpact::Error("--runs and --null-runs must be >= 0");
   if (!(o.alpha > 0 && o.alpha < 0.5)) throw navimpact::Error("--alpha must be in (0, 0.5)");
-  if (o.simulations < 0 || o.simulations == 1) throw navimpact::Error("--simulations must be 0 or >= 2");
   p.seed = o.seed;
   p.alpha = o.alpha;
   p.simulations = o.simulations;
   p.threads = o.threads;
+  p.allow_large = o.allow_large;
+  pw::checkPowerOptions(p);  // before any work
   navimpact::cli::Progress bar("diagnose-power", 1000);
   p.progress = [&bar](double f) { bar.update(static_cast<std::size_t>(f * 1000)); };
   const pw::PowerResult r = pw::runPower(p);
@@ -121,6 +122,7 @@ navimpact::cli::Registrar reg(
        app.add_option("--alpha", o->alpha, "family-wise level of each diagnosis")->capture_default_str();
        app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel in each diagnosis")->capture_default_str();
        app.add_option("--threads", o->threads, "worker threads over records (0 = all cores)");
+       app.add_flag("--allow-large", o->allow_large, "run above the work and memory budgets (README \"Ranges and budgets\")");
        return [o]() { return run(*o); };
      }});
 

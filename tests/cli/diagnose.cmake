@@ -91,6 +91,23 @@ navimpact_cli_fail(cli_diagnose_power_bad_cause EXIT 1 NOOUT ${_dg_out}/bad10
 navimpact_cli_fail(cli_diagnose_power_bad_snr EXIT 1 NOOUT ${_dg_out}/bad11
   ARGS diagnose-power --out ${_dg_out}/bad11 --snr 5
   REGEX "^navimpact: --snr '5': expected LO:HI")
+# diagnose-power's counts, rates and record lengths have ranges and budgets,
+# checked before any record is drawn (found by a bad-input probe: --runs 1e9
+# held 11.6 GB within 30 s, --samples 1e12 ended in "out of memory" (exit 3),
+# --rate 1e-300 wrote a duration of 4e303 s with exit 0)
+foreach(_case "runs|--runs 1000000000|--runs and --null-runs must be in \\[0, 1000000\\], got 1000000000"
+              "samples|--samples 1000000000000:1000000000000|the records would need about [0-9.e+]+ simulated samples .* or pass --allow-large$"
+              "memory|--samples 100000000:100000000 --runs 1 --null-runs 1|the records held at once would need about .* MB .* lower --samples or --threads, or pass --allow-large$"
+              "rate|--rate 1e-300:1e-300|--rate must lie in \\[1, 10000\\] Hz"
+              "nothing|--runs 0 --null-runs 0|--runs and --null-runs are both 0: no record to diagnose$"
+              "twice|--causes random_walk,random_walk|--causes: 'random_walk' is listed twice$"
+              "threads|--threads -1|--threads must be in \\[0, 1024\\]")
+  navimpact_cli_case("${_case}" _n _args _re)
+  separate_arguments(_args)
+  navimpact_cli_fail(cli_diagnose_power_range_${_n} EXIT 1 NOOUT ${_dg_out}/pw_${_n}
+    ARGS diagnose-power --out ${_dg_out}/pw_${_n} ${_args}
+    REGEX "^navimpact: diagnose-power: ${_re}")
+endforeach()
 
 # --model fit:auto: each channel's structure chosen by the WIC first (on the
 # first 600 s of the excerpt, --end); --robust applies to fit:SPEC only.

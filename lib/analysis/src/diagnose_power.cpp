@@ -8,11 +8,13 @@
 #include <ctime>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include <boost/math/distributions/normal.hpp>
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/parallel.hpp"
 #include "navimpact/detect/null_model.hpp"
 #include "navimpact/stochastic/model_text.hpp"
@@ -376,13 +378,65 @@ Outcome judge(const Case& c, const Diagnosis& d) {
   return o;
 }
 
+namespace {
+std::vector<Cause> allCauses() {
+  return {Cause::WhiteNoise, Cause::QuantizationNoise, Cause::RandomWalk, Cause::Drift,
+          Cause::GaussMarkov, Cause::Sinusoid, Cause::LevelShift, Cause::Outliers};
+}
+}  // namespace
+
+void checkPowerOptions(const PowerOptions& opt) {
+  const auto fail = [](const std::string& what) { throw Error("diagnose-power: " + what); };
+  const long long maxRuns = limits::kMaxMonteCarloRuns;
+  if (opt.runs_per_cause < 0 || opt.runs_per_cause > maxRuns || opt.null_runs < 0 || opt.null_runs > maxRuns)
+    fail("--runs and --null-runs must be in [0, " + std::to_string(maxRuns) + "], got " +
+         std::to_string(opt.runs_per_cause) + " and " + std::to_string(opt.null_runs));
+  const std::size_t causes = opt.causes.empty() ? allCauses().size() : opt.causes.size();
+  const double records = double(opt.runs_per_cause) * double(causes) + double(opt.null_runs);
+  if (records < 1) fail("--runs and --null-runs are both 0: no record to diagnose");
+  for (std::size_t i = 0; i < opt.causes.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (opt.causes[i] == opt.causes[j]) fail(std::string("--causes: '") + causeName(opt.causes[i]) + "' is listed twice");
+  if (!(opt.min_snr > 0 && opt.max_snr >= opt.min_snr && opt.max_snr <= 1000))
+    fail("--snr must be LO:HI with 0 < LO <= HI <= 1000, got " + formatNumber(opt.min_snr) + ":" + formatNumber(opt.max_snr));
+  const DrawRanges& r = opt.ranges;
+  if (!(r.min_rate_hz >= limits::kImuRateHz.lo && r.max_rate_hz <= limits::kImuRateHz.hi && r.min_rate_hz <= r.max_rate_hz))
+    fail("--rate must lie in " + limits::describe(limits::kImuRateHz) + ", got " + formatNumber(r.min_rate_hz) + ":" +
+         formatNumber(r.max_rate_hz));
+  // the smallest and largest record [samples]
+  double nMin = double(r.min_samples), nMax = double(r.max_samples);
+  std::string lengthFlag = "--samples";
+  if (r.max_duration_s > 0) {
+    nMin = r.min_duration_s * r.min_rate_hz;
+    nMax = r.max_duration_s * r.max_rate_hz;
+    lengthFlag = "--duration-h";
+  }
+  if (!(nMin >= 4096 && nMax >= nMin))
+    fail(lengthFlag + ": the shortest record would have " + formatNumber(nMin, 3) +
+         " samples (at least 4096: the diagnosis's wavelet variance needs 12 scales)");
+  if (opt.threads < 0 || opt.threads > 1024) fail("--threads must be in [0, 1024], got " + std::to_string(opt.threads));
+  if (opt.simulations < 0 || opt.simulations == 1 || opt.simulations > maxRuns)
+    fail("--simulations must be 0 or in [2, " + std::to_string(maxRuns) + "], got " + std::to_string(opt.simulations));
+  // six channels on null records, one otherwise; each simulated (1 + simulations) times
+  const double work = (double(opt.runs_per_cause) * double(causes) + 6.0 * double(opt.null_runs)) * nMax *
+                      (1.0 + double(opt.simulations));
+  const unsigned workers = opt.threads > 0 ? unsigned(opt.threads) : std::max(1u, std::thread::hardware_concurrency());
+  // a record's six channels and their workspace: ~3 doubles per sample and channel
+  // (measured: a null record of 1e6 samples peaks 88 MB above one of 2.5e5)
+  const double bytes = std::min(double(workers), records) * nMax * 6.0 * 3.0 * 8.0;
+  limits::checkBudget({{"diagnose-power", "the records", work, limits::kDefaultSimulatedSampleBudget, "simulated samples",
+                        formatNumber(records, 3) + " records x " + formatNumber(nMax, 3) + " samples x " +
+                            std::to_string(1 + opt.simulations),
+                        "lower --runs, --null-runs, --simulations or " + lengthFlag},
+                       {"diagnose-power", "the records held at once", bytes / 1e6, limits::kDefaultMemoryBudgetBytes / 1e6,
+                        "MB", std::to_string(workers) + " workers", "lower " + lengthFlag + " or --threads"}},
+                      opt.allow_large);
+}
+
 PowerResult runPower(const PowerOptions& opt_in) {
+  checkPowerOptions(opt_in);
   PowerOptions opt = opt_in;
-  if (opt.causes.empty())
-    opt.causes = {Cause::WhiteNoise, Cause::QuantizationNoise, Cause::RandomWalk, Cause::Drift,
-                  Cause::GaussMarkov, Cause::Sinusoid, Cause::LevelShift, Cause::Outliers};
-  if (opt.runs_per_cause < 0 || opt.null_runs < 0) throw Error("diagnose-power: run counts must be >= 0");
-  if (!(opt.min_snr > 0 && opt.max_snr >= opt.min_snr)) throw Error("diagnose-power: need 0 < min SNR <= max SNR");
+  if (opt.causes.empty()) opt.causes = allCauses();
   PowerResult res;
   res.options = opt;
   struct Job {

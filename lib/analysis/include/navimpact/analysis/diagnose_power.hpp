@@ -99,8 +99,21 @@ struct PowerOptions {
   double alpha = 0.01;
   int simulations = 4;
   int threads = 0;
+  bool allow_large = false;           ///< run above the work and memory budgets (limits.hpp)
   std::function<void(double)> progress;
 };
+
+/**
+ * The ranges and budgets of a power sweep, checked before any record is drawn:
+ * run counts [0, 1e6] (at least one record in all), SNR (0, 1000], rates within
+ * limits::kImuRateHz, records of at least 4096 samples, causes once each,
+ * threads [0, 1024], simulations 0 or [2, 1e6]; the simulated samples
+ * (records x largest record x channels x (1 + simulations)) within
+ * limits::kDefaultSimulatedSampleBudget and the records the workers hold at once
+ * within limits::kDefaultMemoryBudgetBytes, unless allow_large.
+ * @throws navimpact::Error naming the flag.
+ */
+void checkPowerOptions(const PowerOptions& opt);
 
 struct PowerRun {
   Cause cause = Cause::WhiteNoise;
