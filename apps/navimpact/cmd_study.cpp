@@ -24,6 +24,7 @@ struct StudyOpts {
   std::optional<std::uint64_t> seed;
   std::optional<int> threads;
   bool overwrite = false;
+  bool allow_large = false;
 };
 
 void printSummary(const an::StudyResults& r, const std::string& dir) {
@@ -41,6 +42,7 @@ int runStudyCmd(const StudyOpts& o) {
   const an::Shard shard = o.shard.empty() ? an::Shard{} : an::parseShard(o.shard);
 
   const auto plan = an::prepareStudy(cfg, NAVIMPACT_VERSION);  // every input error is thrown here
+  an::checkStudyBudget("study", an::studyWork(*plan, shard, cfg.threads), o.allow_large);
   std::size_t todo = 0;
   for (std::size_t i = 0; i < cfg.runs; ++i) todo += shard.contains(i) ? 1 : 0;
   navimpact::cli::Progress bar("study", todo);
@@ -78,6 +80,9 @@ navimpact::cli::Registrar regStudy({"study",
                                           ->required();
                                       app.add_option("--out", o->out, "output folder")->required();
                                       navimpact::cli::addOverwriteFlag(app, o->overwrite);
+                                      app.add_flag("--allow-large", o->allow_large,
+                                                   "run above the work and memory budgets (IMU steps, workers' memory; "
+                                                   "README \"Ranges and budgets\")");
                                       app.add_option("--runs", o->runs, "Monte Carlo runs (overrides the config)")
                                           ->check(CLI::Range(1LL, navimpact::limits::kMaxMonteCarloRuns));
                                       app.add_option("--seed", o->seed, "study seed (overrides the config)")->check(navimpact::cli::seedValue());

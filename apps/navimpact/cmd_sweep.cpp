@@ -41,6 +41,7 @@ struct SweepOpts {
   std::optional<std::uint64_t> seed;
   std::optional<int> threads;
   bool overwrite = false;
+  bool allow_large = false;
 };
 
 void printSummary(const an::SweepResults& r, const std::string& dir) {
@@ -83,6 +84,7 @@ int runSweepCmd(const SweepOpts& o) {
 
   const auto plan = an::prepareSweep(cfg, NAVIMPACT_VERSION);  // every input error is thrown here
   if (emit) return emitSlurm(o, cfg, an::sweepMeta(*plan));
+  an::checkStudyBudget("sweep", an::sweepWork(*plan, shard, cfg.study.threads), o.allow_large);
   std::size_t per = 0;
   for (std::size_t i = 0; i < cfg.study.runs; ++i) per += shard.contains(i) ? 1 : 0;
   navimpact::cli::Progress bar("sweep", per * an::sweepMeta(*plan).columns.size());
@@ -182,7 +184,7 @@ int emitSlurm(const SweepOpts& o, const an::SweepConfig& cfg, const an::SweepMet
       << " already complete: ${SHARD}\"; exit 0; fi\n"
       << "mkdir -p \"" << work << "\"\n"
       << "exec \"" << ni << "\" sweep --config \"" << config << "\"" << overrides << " --shard \"${K}/" << N
-      << "\" --threads \"${SLURM_CPUS_PER_TASK:-1}\" --out \"${SHARD}\" --overwrite\n";
+      << "\" --threads \"${SLURM_CPUS_PER_TASK:-1}\" --out \"${SHARD}\" --overwrite --allow-large\n";
 
   std::ostringstream mrg;
   mrg << "#!/bin/bash\n"
@@ -260,6 +262,9 @@ navimpact::cli::Registrar regSweep(
                       "K/N: run only the run indices i with i % N == K-1 (in every column) and write partial "
                       "results for sweep-merge");
        navimpact::cli::addOverwriteFlag(app, o->overwrite);
+       app.add_flag("--allow-large", o->allow_large,
+                    "run above the work and memory budgets (IMU steps, workers' memory; README \"Ranges and budgets\"); "
+                    "the scripts of --emit-slurm pass it, their shards sized by --shards");
        SlurmOpts& sl = o->slurm;
        app.add_option("--emit-slurm", sl.dir,
                       "write Slurm scripts to DIR instead of running: a job array of --shards tasks (one shard "

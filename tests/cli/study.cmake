@@ -40,3 +40,14 @@ _study_bad(bad_shard "study|--config|${_sdir}/short.yaml|--out|${_sdir}/out_bad_
            "--shard '3/2'")
 _study_bad(merge_missing "study-merge|${_sdir}/no_such_shard|--out|${_sdir}/out_merge_missing"
            "no_such_shard/shard.json")
+# work and memory are estimated before the first run (found by a bad-input
+# probe: --runs 1000000 ran for weeks of CPU; 8 workers at 10 kHz held 2.5 GB
+# within 30 s): refused naming the runs, unless --allow-large
+_study_bad(runs_budget "study|--config|${_sdir}/short.yaml|--out|${_sdir}/out_runs_budget|--runs|1000000"
+           "^navimpact: study: 1e\\+06 runs: the runs would need about 1.2e\\+10 IMU steps .4e\\+03 samples x 3 .emulation and filters. per run., above the budget of 2e\\+09 IMU steps: lower --runs .monte_carlo.runs. or run shards .--shard K/N., or pass --allow-large$")
+file(READ ${_sdir}/short.yaml _s10k)
+string(REPLACE "end_s: 40}" "end_s: 130}" _s10k "${_s10k}")
+string(REPLACE "rate_hz: 100}" "rate_hz: 10000}" _s10k "${_s10k}")
+file(WRITE ${_sdir}/fast_imu.yaml "${_s10k}")
+_study_bad(memory_budget "study|--config|${_sdir}/fast_imu.yaml|--out|${_sdir}/out_memory_budget|--runs|16|--threads|16"
+           "^navimpact: study: 16 runs: the workers would need about 2.63e\\+03 MB .16 workers x 1.3e\\+06 samples., above the budget of 2e\\+03 MB: lower --threads or imu.rate_hz, or pass --allow-large$")

@@ -45,6 +45,20 @@ TEST(ModelText, ParseModelGivesTheTermsAtTheRate) {
   EXPECT_NE(errorOf([] { parseModel("WN(sigma=)", 50.0); }).find("expected a number"), std::string::npos);
 }
 
+// At most limits::kMaxTermsPerModel terms: 32 load, 33 are refused before the
+// 33rd is parsed (300,000 WN terms made emulate hold 2.5 GB).
+TEST(ModelText, AtMostThirtyTwoTerms) {
+  auto terms = [](int n) {
+    std::string t = "WN(sigma=1e-3)";
+    for (int i = 1; i < n; ++i) t += " + GM(sigma=1e-4, T=" + std::to_string(i) + ")";
+    return t;
+  };
+  EXPECT_EQ(parseTerms(terms(32), 200.0).size(), 32u);
+  const std::string e = parseError(terms(33));
+  EXPECT_NE(e.find("expected at most 32 terms in one model"), std::string::npos) << e;
+  EXPECT_LE(e.size(), 300u) << e;
+}
+
 TEST(ModelText, NoneIsEmpty) {
   EXPECT_TRUE(parseTerms("none", 200.0).empty());
   EXPECT_TRUE(parseTerms("  none ", 200.0).empty());

@@ -18,6 +18,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/imu_series.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/parallel.hpp"
 #include "navimpact/core/units.hpp"
 #include "navimpact/analysis/run_plan.hpp"
@@ -284,6 +285,30 @@ std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std:
      << " deg, yaw " << formatNumber(cfg.initial_sigma(8) / units::kDeg) << " deg (drawn per run, same for all models)";
   meta.settings = st.str();
   return plan;
+}
+
+StudyWork studyWork(const StudyPlan& p, const Shard& shard, unsigned threads) {
+  StudyWork w;
+  for (std::size_t i = 0; i < p.cfg.runs; ++i) w.runs += shard.contains(i) ? 1.0 : 0.0;
+  w.samples = double(p.run.samples());
+  w.filters = double(p.filter_models.size());
+  w.workers = double(workerThreads(threads, static_cast<std::size_t>(w.runs)));
+  w.steps = w.runs * w.samples * (1.0 + w.filters);
+  w.bytes = (w.workers * 120.0 + 100.0) * w.samples;
+  return w;
+}
+
+void checkStudyBudget(const std::string& command, const StudyWork& w, bool allow_large) {
+  const std::string place = command + ": " + formatNumber(w.runs) + " runs";
+  limits::checkBudget(
+      {{place, "the runs", w.steps, limits::kDefaultFilterStepBudget, "IMU steps",
+        formatNumber(w.samples, 3) + " samples x " + formatNumber(1.0 + w.filters) + " (emulation and filters) per run" +
+            (w.columns > 1 ? " x " + formatNumber(w.columns) + " columns" : ""),
+        "lower --runs (monte_carlo.runs) or run shards (--shard K/N)"},
+       {place, "the workers", w.bytes / 1e6, limits::kDefaultMemoryBudgetBytes / 1e6, "MB",
+        formatNumber(w.workers) + " workers x " + formatNumber(w.samples, 3) + " samples",
+        "lower --threads or imu.rate_hz"}},
+      allow_large);
 }
 
 // ---------------------------------------------------------------------------

@@ -189,6 +189,23 @@ std::shared_ptr<const SweepPlan> prepareSweep(const SweepConfig& cfg, const std:
 // ---------------------------------------------------------------------------
 // Runs
 
+StudyWork sweepWork(const SweepPlan& p, const Shard& shard, unsigned threads) {
+  StudyWork w;
+  w.columns = double(p.studies.size());
+  for (const auto& sp : p.studies) {
+    const StudyWork c = studyWork(*sp, shard, threads);
+    w.runs = c.runs;
+    w.workers = c.workers;
+    w.filters = c.filters;
+    w.steps += c.steps;
+    if (c.bytes >= w.bytes) {
+      w.bytes = c.bytes;
+      w.samples = c.samples;
+    }
+  }
+  return w;
+}
+
 SweepRuns runSweep(const std::shared_ptr<const SweepPlan>& plan, const Shard& shard, unsigned threads,
                    const SweepProgressFn& progress) {
   if (!plan) throw Error("sweep: no plan");

@@ -12,6 +12,7 @@
 
 #include "kind.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/stochastic/process_kind.hpp"
 
 namespace navimpact::stochastic {
@@ -238,6 +239,10 @@ std::vector<Process> parseTerms(const std::string& text, double rate_hz) {
     }
   }
   while (true) {
+    // a model has a handful of terms: 300,000 WN terms made emulate hold 2.5 GB
+    if (terms.size() == static_cast<std::size_t>(limits::kMaxTermsPerModel))
+      P.fail(0, "at most " + std::to_string(limits::kMaxTermsPerModel) + " terms in one model",
+             "more (a model has a handful)");
     terms.push_back(parseTerm(P, rate_hz));
     if (P.atEnd()) break;
     if (P.peek() != '+') P.failHere("'+' or end of text");

@@ -152,6 +152,22 @@ struct StudyResults;
  */
 std::shared_ptr<const StudyPlan> prepareStudy(const StudyConfig& cfg, const std::string& version);
 
+/// Work and memory of running the runs of @p shard of a prepared study on
+/// @p threads workers (0 = all hardware threads): IMU steps = runs x samples x
+/// (1 emulation + the models' filters); memory = (workers x 120 + 100) bytes
+/// per IMU sample (measured: 63 bytes per sample and worker at 200 Hz, 115 at 10 kHz).
+struct StudyWork {
+  double runs = 0.0, samples = 0.0, filters = 0.0, workers = 0.0, columns = 1.0;  ///< columns: a sweep's studies
+  double steps = 0.0, bytes = 0.0;
+};
+StudyWork studyWork(const StudyPlan& plan, const Shard& shard, unsigned threads);
+
+/// The budgets of `study` and `sweep` (README "Ranges and budgets"): @p steps
+/// IMU steps above limits::kDefaultFilterStepBudget or @p bytes above
+/// limits::kDefaultMemoryBudgetBytes are refused unless @p allow_large.
+/// @p command "study" or "sweep" names the refusal.
+void checkStudyBudget(const std::string& command, const StudyWork& w, bool allow_large);
+
 struct StudyMeta;
 /// The description of a prepared study (labels, states, epochs, outages, notices).
 const StudyMeta& studyMeta(const StudyPlan& plan);

@@ -134,6 +134,10 @@ std::shared_ptr<const SweepPlan> prepareSweep(const SweepConfig& cfg, const std:
 /// The meta of a prepared sweep.
 const SweepMeta& sweepMeta(const SweepPlan& plan);
 
+/// The work of a sweep's shard (studyWork()): steps summed over its columns,
+/// memory of the largest column (the columns run one after another).
+StudyWork sweepWork(const SweepPlan& plan, const Shard& shard, unsigned threads);
+
 /// Per-run values of a sweep (or a shard of it).
 struct SweepRuns {
   SweepMeta meta;

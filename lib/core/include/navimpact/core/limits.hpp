@@ -116,6 +116,10 @@ inline constexpr long long kMaxOutagesPerRun = 1000000;
 
 /// Most IMU error states of one sensor axis in the filter.
 inline constexpr int kMaxImuStatesPerAxis = 32;
+/// Most process terms of one model (one axis of a model file): a model has a
+/// handful, and every term costs a simulated stream (300,000 WN terms made
+/// emulate hold 2.5 GB).
+inline constexpr int kMaxTermsPerModel = 32;
 
 /// Default work budget of one covariance command, in estimated floating-point
 /// operations summed over its models (analysis::estimateCovarianceBudget):
