@@ -78,7 +78,9 @@ navimpact::cli::Registrar reg({
                      "model structure for every channel, e.g. WN+GM+GM+DR, or 'auto' (WIC selection)")
           ->required();
       app.add_option("--max-gm", o->fit.max_gm, "auto: largest number of GM terms among the candidates (0..3)");
-      app.add_option("--bootstrap", o->fit.bootstrap, "parametric bootstrap replicates for the intervals (0: asymptotic)");
+      app.add_option("--bootstrap", o->fit.bootstrap, "parametric bootstrap replicates for the intervals (0: asymptotic; at most 10000)");
+      app.add_flag("--allow-large", o->fit.allow_large,
+                   "bootstrap above the simulated-sample budget (README \"Ranges and budgets\")");
       app.add_option("--intervals", o->fit.intervals,
                      "95 % intervals without --bootstrap: profile (default; follows the objective along "
                      "GM/RW ridges) or asymptotic (delta method)");

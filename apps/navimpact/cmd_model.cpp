@@ -87,6 +87,16 @@ int runConvert(const Opts& o) {
   const st::ImuModel m = st::loadImuModel(o.spec);
   const st::ImuModel c = st::convertRate(m, o.rate_hz);
   const std::string note = "converted from " + formatNumber(m.rate_hz) + " Hz to " + formatNumber(o.rate_hz) + " Hz";
+  // what it writes loads again: the converted terms within the ranges of a model file
+  // (a WN sigma of 9e4 at 1 Hz is 9e6 at 10 kHz, beyond any IMU)
+  static const char* axes[] = {"gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z"};
+  for (int i = 0; i < 6; ++i) {
+    try {
+      st::validate(c.axis[i]);
+    } catch (const navimpact::Error& e) {
+      throw navimpact::Error(m.source + ": " + note + ", axis " + axes[i] + ": " + e.what());
+    }
+  }
   const std::string yaml = st::toYaml(c, "navimpact model convert: " + m.source + ", " + note +
                                              "\n(exact: same noise densities and continuous processes)");
   if (o.out.empty()) {

@@ -169,6 +169,13 @@ navimpact_cli_fail(cli_diagnose_simulations_budget EXIT 1 NOOUT ${_dg_out}/bud4
 navimpact_cli_fail(cli_diagnose_run_realisations_range EXIT 1 NOOUT ${_dg_out}/bud5
   ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --realisations 100000000 --out ${_dg_out}/bud5
   REGEX "^navimpact: diagnose --run: --realisations must be in \\[2, 1000000\\], got 100000000$")
+# --durations: a handful, each once, each in [0.1 ms, 7 days] (2000 durations held 1.3 GB and ran on)
+navimpact_cli_fail(cli_diagnose_run_durations_twice EXIT 1 NOOUT ${_dg_out}/dur1
+  ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --durations 30,30 --out ${_dg_out}/dur1
+  REGEX "^navimpact: diagnose --run: --durations: 30 s is listed twice$")
+navimpact_cli_fail(cli_diagnose_run_durations_many EXIT 1 NOOUT ${_dg_out}/dur2
+  ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --durations 1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17 --out ${_dg_out}/dur2
+  REGEX "^navimpact: diagnose --run: --durations: at most 16 outage durations, got 17$")
 navimpact_cli_fail(cli_diagnose_run_realisations_budget EXIT 1 NOOUT ${_dg_out}/bud6
   ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --durations 10 --realisations 1000000 --out ${_dg_out}/bud6
   REGEX "^navimpact: diagnose --run: --realisations 1000000: the simulation would need about .* IMU steps .* above the budget of 2e\\+09 IMU steps: lower --realisations or --durations, or pass --allow-large$")

@@ -47,3 +47,11 @@ file(WRITE ${_mdir}/huge_rate.yaml
 add_test(NAME cli_model_show_huge_rate COMMAND ${NI} model show ${_mdir}/huge_rate.yaml)
 set_tests_properties(cli_model_show_huge_rate PROPERTIES TIMEOUT 60
   PASS_REGULAR_EXPRESSION "ARW +[0-9.e+-]+ deg/sqrt\\(h\\)|rate_hz")
+
+# model convert writes only what loads again: a WN sigma of 9e4 at 1 Hz is 9e6 at
+# 10 kHz, beyond any IMU (it was written with exit 0 and refused by model show)
+file(WRITE ${_mdir}/big_at_1hz.yaml "rate_hz: 1\ngyroscope: \"WN(sigma=9e4)\"\naccelerometer: \"WN(sigma=1e-3)\"\n")
+navimpact_cli_fail(cli_model_convert_beyond_any_imu
+  ARGS model convert ${_mdir}/big_at_1hz.yaml --rate 10000 --out ${_mdir}/big_at_10khz.yaml
+  REGEX "^navimpact: .*big_at_1hz.yaml: converted from 1 Hz to 10000 Hz, axis gyro_x: .*sigma = 9e\\+06 is beyond any IMU"
+  NOOUT ${_mdir}/big_at_10khz.yaml)

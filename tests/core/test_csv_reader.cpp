@@ -111,6 +111,17 @@ TEST(CsvReader, BadInputsNameFileAndLine) {
     EXPECT_NE(m.find("back.csv:4"), std::string::npos) << m;
     const auto g = errorOf(writeFile("gap.csv", "t,gyro_x\n0,1\n0.01,1\n0.02,1\n0.05,1\n0.06,1\n"), t);
     EXPECT_NE(g.find("gap.csv:5"), std::string::npos) << g;
+    // a time column whose rate lies outside the IMU rates [1, 10000] Hz (a unit
+    // gone wrong: steps of 1e300 s wrote tau = 2e300 s into wv.csv, of 1 ns a
+    // model at 1e9 Hz that no reader loads), and times printed as numbers, not
+    // as 300 digits of %f
+    const auto slow = errorOf(writeFile("slow.csv", "t,gyro_x\n0,1\n1e300,1\n2e300,1\n"), t);
+    EXPECT_NE(slow.find("slow.csv: the time column gives a rate of 1e-300 Hz, outside [1, 10000] Hz (is the time unit right?)"),
+              std::string::npos) << slow;
+    const auto fast = errorOf(writeFile("fast.csv", "t,gyro_x\n0,1\n1e-9,1\n2e-9,1\n"), t);
+    EXPECT_NE(fast.find("fast.csv: the time column gives a rate of 1e+09 Hz"), std::string::npos) << fast;
+    const auto back = errorOf(writeFile("back300.csv", "t,gyro_x\n1e300,1\n0,1\n"), t);
+    EXPECT_NE(back.find("back300.csv:3: time 0 s is not after the previous 1e+300 s"), std::string::npos) << back;
   }
   {
     CsvImuOptions t = o;

@@ -21,6 +21,7 @@
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/limits.hpp"
+#include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/core/parallel.hpp"
 #include "navimpact/gmwm/estimator.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
@@ -176,7 +177,16 @@ WvCheck checkWv(Shared& sh, const ChannelContext& ctx, const std::vector<double>
     for (int s = 0; s < ctx.simulations; ++s) {
       const auto sim = stochastic::simulate(
           m0, n, stochastic::deriveSeed(ctx.seed, 1000u * static_cast<unsigned>(ctx.index) + s));
-      const auto ws = gmwm::waveletVariance(sim.data(), n, rate);
+      // a simulation of the model, not the record: its errors name the model
+      // (a GM with T = 1e300 s simulates as a constant, which was blamed on the CSV)
+      const auto ws = [&] {
+        try {
+          return gmwm::waveletVariance(sim.data(), n, rate);
+        } catch (const Error& e) {
+          throw Error("the model's simulation of channel " + cd.name + " (" + stochastic::formatTerms(m0.terms) +
+                      "): " + e.what());
+        }
+      }();
       for (int j = 0; j < J && j < ws.scales(); ++j) {
         env_lo[j] = std::min(env_lo[j], ws.wv(j));
         env_hi[j] = std::max(env_hi[j], ws.wv(j));

@@ -1052,12 +1052,26 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
     }
 }
 
+/// Most outage durations of one run diagnosis (each is a replay of the run per realisation).
+constexpr std::size_t kMaxRunDurations = 16;
+
 RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   const auto wall0 = std::chrono::steady_clock::now();
   if (opt.durations_s.empty()) throw Error("diagnose --run: give at least one outage duration (--durations)");
-  for (double d : opt.durations_s)
-    if (!(d > 0.0) || !std::isfinite(d)) throw Error("diagnose --run: outage durations must be > 0 s, got " + formatNumber(d));
-  if (!(opt.reconverge_s > 0.0)) throw Error("diagnose --run: --reconverge must be > 0 s");
+  // a handful of durations, each once, each a duration (limits::kDurationS); 2000 durations held 1.3 GB and ran on
+  if (opt.durations_s.size() > kMaxRunDurations)
+    throw Error("diagnose --run: --durations: at most " + std::to_string(kMaxRunDurations) + " outage durations, got " +
+                std::to_string(opt.durations_s.size()));
+  for (std::size_t i = 0; i < opt.durations_s.size(); ++i) {
+    const double d = opt.durations_s[i];
+    if (!(d >= limits::kDurationS.lo && d <= limits::kDurationS.hi))
+      throw Error("diagnose --run: --durations: " + formatNumber(d) + " s is outside " + limits::describe(limits::kDurationS));
+    for (std::size_t j = 0; j < i; ++j)
+      if (opt.durations_s[j] == d) throw Error("diagnose --run: --durations: " + formatNumber(d) + " s is listed twice");
+  }
+  if (!(opt.reconverge_s >= limits::kDurationS.lo && opt.reconverge_s <= limits::kDurationS.hi))
+    throw Error("diagnose --run: --reconverge must be in " + limits::describe(limits::kDurationS) + ", got " +
+                formatNumber(opt.reconverge_s));
   if (opt.realisations < 2 || opt.realisations > limits::kMaxMonteCarloRuns)
     throw Error("diagnose --run: --realisations must be in [2, " + std::to_string(limits::kMaxMonteCarloRuns) +
                 "], got " + std::to_string(opt.realisations));

@@ -6,6 +6,7 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/core/gz_input.hpp"
 #include "navimpact/core/text_io.hpp"
 
@@ -185,19 +186,21 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
     for (std::size_t k = 1; k < n; ++k) {
       dts[k - 1] = times[k] - times[k - 1];
       if (!(dts[k - 1] > 0.0))
-        throw fileError(path, k + 2, "time " + std::to_string(times[k]) +
-                                         " s is not after the previous " +
-                                         std::to_string(times[k - 1]) + " s");
+        throw fileError(path, k + 2, "time " + formatNumber(times[k], 10) + " s is not after the previous " +
+                                         formatNumber(times[k - 1], 10) + " s");
     }
     std::vector<double> sorted = dts;
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
     const double med = sorted[sorted.size() / 2];
     for (std::size_t k = 0; k < dts.size(); ++k)
       if (std::abs(dts[k] - med) > opt.max_dt_deviation * med)
-        throw fileError(path, k + 3, "time step " + std::to_string(dts[k]) +
-                                         " s differs from the nominal " + std::to_string(med) +
-                                         " s (gap or jitter); resample or split the recording");
+        throw fileError(path, k + 3, "time step " + formatNumber(dts[k]) + " s differs from the nominal " +
+                                         formatNumber(med) + " s (gap or jitter); resample or split the recording");
     const double rate = (n - 1) / (times[n - 1] - times[0]);
+    // the documented range of IMU rates (a time column in the wrong unit: a step of 1e300 s or 1 ns)
+    if (!(rate >= limits::kImuRateHz.lo && rate <= limits::kImuRateHz.hi))
+      throw fileError(path, 0, "the time column gives a rate of " + formatNumber(rate) + " Hz, outside " +
+                                   limits::describe(limits::kImuRateHz) + " (is the time unit right?)");
     if (opt.rate_hz && std::abs(*opt.rate_hz - rate) > 1e-3 * rate)
       throw fileError(path, 0, "--rate " + formatNumber(*opt.rate_hz) +
                                    " Hz disagrees with the time column (" + formatNumber(rate) + " Hz)");

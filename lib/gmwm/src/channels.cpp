@@ -6,6 +6,7 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
+#include "navimpact/core/limits.hpp"
 #include "navimpact/stochastic/datasheet.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
@@ -99,18 +100,27 @@ std::string whiteNoiseNote(const stochastic::Model& m, const std::vector<bool>& 
   return os.str();
 }
 
+/// Most parametric bootstrap replicates of one fit (the intervals' 2.5 % and
+/// 97.5 % quantiles are stable long before).
+constexpr int kMaxBootstrap = 10000;
+
 void checkRecordingFitOptions(const RecordingFitOptions& opt) {
   if (opt.structure != "auto") stochastic::parseStructure(opt.structure);
-  if (opt.bootstrap < 0) throw Error("--bootstrap must be >= 0, got " + std::to_string(opt.bootstrap));
+  if (opt.bootstrap < 0 || opt.bootstrap > kMaxBootstrap)
+    throw Error("--bootstrap must be in [0, " + std::to_string(kMaxBootstrap) + "], got " + std::to_string(opt.bootstrap));
   if (opt.max_gm < 0 || opt.max_gm > 3) throw Error("--max-gm must be in 0..3");
   if (!(opt.eff > 0.0 && opt.eff < 1.0))
     throw Error("--eff must be in (0, 1), got " + formatNumber(opt.eff));
   weightingOf(opt.weights);
   intervalsOf(opt.intervals);
-  for (const auto& n : opt.channels)
+  for (std::size_t i = 0; i < opt.channels.size(); ++i) {
+    const std::string& n = opt.channels[i];
     if (channelIndex(n) < 0)
-      throw Error("--channels: unknown channel '" + n +
+      throw Error("--channels: unknown channel '" + printable(n) +
                   "' (expected gyro_x, gyro_y, gyro_z, acc_x, acc_y, acc_z)");
+    for (std::size_t j = 0; j < i; ++j)
+      if (opt.channels[j] == n) throw Error("--channels: '" + n + "' is listed twice");
+  }
 }
 
 RecordingFit fitRecording(const ImuSeries& s, const RecordingFitOptions& opt,
@@ -127,6 +137,13 @@ RecordingFit fitRecording(const ImuSeries& s, const RecordingFitOptions& opt,
     for (const auto& n : opt.channels) chans.push_back(&s.channel(n));
   }
   if (chans.empty()) throw Error(s.source + ": no IMU channel to fit");
+  // each bootstrap replicate simulates the record and fits it again (README "Ranges and budgets")
+  limits::checkBudget({{"fit: --bootstrap " + std::to_string(opt.bootstrap), "the bootstrap",
+                        double(opt.bootstrap) * double(chans.size()) * double(s.size()),
+                        limits::kDefaultSimulatedSampleBudget, "simulated samples",
+                        std::to_string(chans.size()) + " channels x " + std::to_string(s.size()) + " samples",
+                        "lower --bootstrap"}},
+                      opt.allow_large);
 
   FitOptions fo;
   fo.bootstrap = opt.bootstrap;
