@@ -48,6 +48,10 @@ inline Overwrite overwriteMode(bool flag) { return flag ? Overwrite::Replace : O
 /// PositiveNumber let NaN and 1e308 through and printed DBL_MAX in 309 digits.)
 /// @p hi_open excludes the upper end too (an efficiency in (0, 1)).
 CLI::Validator within(const limits::Range& r, bool hi_open = false);
+/// A family-wise level --alpha: (0, 0.5) (with hi_open).
+inline constexpr limits::Range kAlpha{0.0, 0.5, true, ""};
+/// Worker threads --threads: 0 (all cores) .. 1024, as monte_carlo.threads.
+inline constexpr limits::Range kThreads{0.0, 1024.0, false, ""};
 
 /// A seed: an integer 0 .. 2^64 - 1 in decimal digits (CLI11 read "-1" as
 /// 2^64 - 1, a silent wrap), the same seeds as a configuration's seed keys.

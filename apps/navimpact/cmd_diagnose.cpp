@@ -29,6 +29,9 @@
 
 namespace {
 
+/// counts of runs, realisations and folds: [2, 1e6]
+const navimpact::limits::Range kCountFrom2{2.0, double(navimpact::limits::kMaxMonteCarloRuns), false, ""};
+
 namespace na = navimpact::analysis;
 namespace st = navimpact::stochastic;
 
@@ -238,10 +241,12 @@ navimpact::cli::Registrar reg(
            ->capture_default_str()
            ->check(navimpact::cli::within(navimpact::limits::kDurationS));
        app.add_option("--realisations", o->realisations, "--run: simulated realisations (seeded by --seed)")
-           ->capture_default_str();
+           ->capture_default_str()
+           ->check(navimpact::cli::within(kCountFrom2));
        app.add_option("--folds", o->folds,
                       "--run: cross-validation folds (time blocks of the run) for the causes; at most one per outage")
-           ->capture_default_str();
+           ->capture_default_str()
+           ->check(navimpact::cli::within(kCountFrom2));
        app.add_flag("--allow-large", o->allow_large,
                     "run even when the estimated work or memory of the simulations or navigation runs is above the "
                     "documented budget");
@@ -267,15 +272,19 @@ navimpact::cli::Registrar reg(
                       "GNSS outage START:DURATION [s from the trajectory start] (repeatable)");
        app.add_option("--nav-runs", o->nav_runs,
                       "paired navigation runs (recording windows x GNSS/baro noise), >= 2")
-           ->capture_default_str();
+           ->capture_default_str()
+           ->check(navimpact::cli::within(kCountFrom2));
        app.add_option("--out", o->out, "output directory")->required();
        navimpact::cli::addOverwriteFlag(app, o->overwrite);
-       app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel")
-           ->capture_default_str();
+       app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel (0, or 2 and more)")
+           ->capture_default_str()
+           ->check(navimpact::cli::within({0.0, double(navimpact::limits::kMaxMonteCarloRuns), false, ""}));
        app.add_option("--seed", o->seed, "root seed")->capture_default_str()->check(navimpact::cli::seedValue());
        app.add_option("--alpha", o->alpha, "family-wise level for the whole record")
-           ->capture_default_str();
-       app.add_option("--threads", o->threads, "worker threads (0 = all cores)");
+           ->capture_default_str()
+           ->check(navimpact::cli::within(navimpact::cli::kAlpha, true));
+       app.add_option("--threads", o->threads, "worker threads (0 = all cores)")
+           ->check(navimpact::cli::within(navimpact::cli::kThreads));
        return [o]() { return run(*o); };
      }});
 

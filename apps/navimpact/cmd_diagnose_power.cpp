@@ -111,17 +111,25 @@ navimpact::cli::Registrar reg(
        auto o = std::make_shared<Opts>();
        app.add_option("--out", o->out, "output directory")->required();
        navimpact::cli::addOverwriteFlag(app, o->overwrite);
-       app.add_option("--runs", o->runs, "records per cause")->capture_default_str();
-       app.add_option("--null-runs", o->null_runs, "null records (six channels, drawn from the model)")->capture_default_str();
+       const navimpact::limits::Range counts{0.0, double(navimpact::limits::kMaxMonteCarloRuns), false, ""};
+       app.add_option("--runs", o->runs, "records per cause")->capture_default_str()->check(navimpact::cli::within(counts));
+       app.add_option("--null-runs", o->null_runs, "null records (six channels, drawn from the model)")
+           ->capture_default_str()
+           ->check(navimpact::cli::within(counts));
        app.add_option("--snr", o->snr, "effect size as multiples of the detection limit, drawn log-uniform LO:HI")->capture_default_str();
        app.add_option("--rate", o->rate, "sampling rate range LO:HI [Hz], log-uniform")->capture_default_str();
        app.add_option("--duration-h", o->duration_h, "record duration range LO:HI [h], log-uniform (e.g. 0.5:10; overrides --samples)");
        app.add_option("--samples", o->samples, "record length range LO:HI [samples], log-uniform")->capture_default_str();
        app.add_option("--causes", o->causes, "comma-separated causes (default: all eight)");
        app.add_option("--seed", o->seed, "root seed")->capture_default_str()->check(navimpact::cli::seedValue());
-       app.add_option("--alpha", o->alpha, "family-wise level of each diagnosis")->capture_default_str();
-       app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel in each diagnosis")->capture_default_str();
-       app.add_option("--threads", o->threads, "worker threads over records (0 = all cores)");
+       app.add_option("--alpha", o->alpha, "family-wise level of each diagnosis")
+           ->capture_default_str()
+           ->check(navimpact::cli::within(navimpact::cli::kAlpha, true));
+       app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel in each diagnosis")
+           ->capture_default_str()
+           ->check(navimpact::cli::within(counts));
+       app.add_option("--threads", o->threads, "worker threads over records (0 = all cores)")
+           ->check(navimpact::cli::within(navimpact::cli::kThreads));
        app.add_flag("--allow-large", o->allow_large, "run above the work and memory budgets (README \"Ranges and budgets\")");
        return [o]() { return run(*o); };
      }});

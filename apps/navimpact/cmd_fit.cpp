@@ -77,8 +77,10 @@ navimpact::cli::Registrar reg({
       app.add_option("--structure", o->fit.structure,
                      "model structure for every channel, e.g. WN+GM+GM+DR, or 'auto' (WIC selection)")
           ->required();
-      app.add_option("--max-gm", o->fit.max_gm, "auto: largest number of GM terms among the candidates (0..3)");
-      app.add_option("--bootstrap", o->fit.bootstrap, "parametric bootstrap replicates for the intervals (0: asymptotic; at most 10000)");
+      app.add_option("--max-gm", o->fit.max_gm, "auto: largest number of GM terms among the candidates (0..3)")
+          ->check(navimpact::cli::within({0.0, 3.0, false, ""}));
+      app.add_option("--bootstrap", o->fit.bootstrap, "parametric bootstrap replicates for the intervals (0: asymptotic; at most 10000)")
+          ->check(navimpact::cli::within({0.0, 10000.0, false, ""}));
       app.add_flag("--allow-large", o->fit.allow_large,
                    "bootstrap above the simulated-sample budget (README \"Ranges and budgets\")");
       app.add_option("--intervals", o->fit.intervals,

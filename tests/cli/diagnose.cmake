@@ -95,18 +95,26 @@ navimpact_cli_fail(cli_diagnose_power_bad_snr EXIT 1 NOOUT ${_dg_out}/bad11
 # checked before any record is drawn (found by a bad-input probe: --runs 1e9
 # held 11.6 GB within 30 s, --samples 1e12 ended in "out of memory" (exit 3),
 # --rate 1e-300 wrote a duration of 4e303 s with exit 0)
-foreach(_case "runs|--runs 1000000000|--runs and --null-runs must be in \\[0, 1000000\\], got 1000000000"
-              "samples|--samples 1000000000000:1000000000000|the records would need about [0-9.e+]+ simulated samples .* or pass --allow-large$"
+foreach(_case "samples|--samples 1000000000000:1000000000000|the records would need about [0-9.e+]+ simulated samples .* or pass --allow-large$"
               "memory|--samples 100000000:100000000 --runs 1 --null-runs 1|the records held at once would need about .* MB .* lower --samples or --threads, or pass --allow-large$"
               "rate|--rate 1e-300:1e-300|--rate must lie in \\[1, 10000\\] Hz"
               "nothing|--runs 0 --null-runs 0|--runs and --null-runs are both 0: no record to diagnose$"
-              "twice|--causes random_walk,random_walk|--causes: 'random_walk' is listed twice$"
-              "threads|--threads -1|--threads must be in \\[0, 1024\\]")
+              "twice|--causes random_walk,random_walk|--causes: 'random_walk' is listed twice$")
   navimpact_cli_case("${_case}" _n _args _re)
   separate_arguments(_args)
   navimpact_cli_fail(cli_diagnose_power_range_${_n} EXIT 1 NOOUT ${_dg_out}/pw_${_n}
     ARGS diagnose-power --out ${_dg_out}/pw_${_n} ${_args}
     REGEX "^navimpact: diagnose-power: ${_re}")
+endforeach()
+# counts and threads are flag ranges: exit 2 naming the flag
+foreach(_case "runs|--runs 1000000000|--runs: must be in \\[0, 1e\\+06\\], got 1000000000"
+              "threads|--threads -1|--threads: must be in \\[0, 1024\\], got -1"
+              "alpha|--alpha nan|--alpha: must be in \\(0, 0.5\\), got nan")
+  navimpact_cli_case("${_case}" _n _args _re)
+  separate_arguments(_args)
+  navimpact_cli_fail(cli_diagnose_power_flag_${_n} EXIT 2 NOOUT ${_dg_out}/pwf_${_n}
+    ARGS diagnose-power --out ${_dg_out}/pwf_${_n} ${_args}
+    REGEX "^navimpact: ${_re} \\(see 'navimpact diagnose-power --help'\\)$")
 endforeach()
 
 # --model fit:auto: each channel's structure chosen by the WIC first (on the
@@ -154,21 +162,24 @@ navimpact_cli_check(cli_reproducible_diagnose_power CHECK reproducible
 # with a notice (the fold count no longer sizes memory).
 set(_dg_nav --trajectory ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz --outage 200:60)
 set(_dg_ref ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref)
-navimpact_cli_fail(cli_diagnose_nav_runs_range EXIT 1 NOOUT ${_dg_out}/bud1
+navimpact_cli_fail(cli_diagnose_nav_runs_range EXIT 2 NOOUT ${_dg_out}/bud1
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model ${_dg_ref} ${_dg_nav} --nav-runs 2000000000 --out ${_dg_out}/bud1
-  REGEX "^navimpact: navigation gain: --nav-runs must be in \\[2, 1000000\\], got 2000000000$")
+  REGEX "^navimpact: --nav-runs: must be in \\[2, 1e\\+06\\], got 2000000000 \\(see 'navimpact diagnose --help'\\)$")
 navimpact_cli_fail(cli_diagnose_nav_runs_budget EXIT 1 NOOUT ${_dg_out}/bud2
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model ${_dg_ref} ${_dg_nav} --nav-runs 100000 --out ${_dg_out}/bud2
   REGEX "^navimpact: navigation gain: --nav-runs 100000: the runs would need about 7.8e\\+09 IMU steps .* above the budget of 2e\\+09 IMU steps: lower --nav-runs, or pass --allow-large$")
-navimpact_cli_fail(cli_diagnose_simulations_range EXIT 1 NOOUT ${_dg_out}/bud3
+navimpact_cli_fail(cli_diagnose_simulations_range EXIT 2 NOOUT ${_dg_out}/bud3
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model ${_dg_ref} --simulations 2000000000 --out ${_dg_out}/bud3
-  REGEX "^navimpact: diagnose: --simulations must be 0 or in \\[2, 1000000\\], got 2000000000$")
+  REGEX "^navimpact: --simulations: must be in \\[0, 1e\\+06\\], got 2000000000 \\(see 'navimpact diagnose --help'\\)$")
+navimpact_cli_fail(cli_diagnose_simulations_one EXIT 1 NOOUT ${_dg_out}/bud3b
+  ARGS diagnose --input ${_dg_data} ${_dg_u} --model ${_dg_ref} --simulations 1 --out ${_dg_out}/bud3b
+  REGEX "^navimpact: diagnose: --simulations must be 0 or in \\[2, 1000000\\], got 1$")
 navimpact_cli_fail(cli_diagnose_simulations_budget EXIT 1 NOOUT ${_dg_out}/bud4
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --simulations 100000 --out ${_dg_out}/bud4
   REGEX "^navimpact: diagnose: --simulations 100000: the model's simulations would need about 1.57e\\+11 simulated samples .*above the budget of 2e\\+10 simulated samples: lower --simulations, or pass --allow-large$")
-navimpact_cli_fail(cli_diagnose_run_realisations_range EXIT 1 NOOUT ${_dg_out}/bud5
+navimpact_cli_fail(cli_diagnose_run_realisations_range EXIT 2 NOOUT ${_dg_out}/bud5
   ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --realisations 100000000 --out ${_dg_out}/bud5
-  REGEX "^navimpact: diagnose --run: --realisations must be in \\[2, 1000000\\], got 100000000$")
+  REGEX "^navimpact: --realisations: must be in \\[2, 1e\\+06\\], got 100000000 \\(see 'navimpact diagnose --help'\\)$")
 # --durations: a handful, each once, each in [0.1 ms, 7 days] (2000 durations held 1.3 GB and ran on)
 navimpact_cli_fail(cli_diagnose_run_durations_twice EXIT 1 NOOUT ${_dg_out}/dur1
   ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --durations 30,30 --out ${_dg_out}/dur1

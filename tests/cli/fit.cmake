@@ -142,9 +142,9 @@ navimpact_cli_check(cli_fit_auto_quiet CHECK run_json
   FILES model.yaml)
 
 # --bootstrap has a range (1e9 replicates ran without end) and a channel is fitted once
-navimpact_cli_fail(cli_fit_bootstrap_range
+navimpact_cli_fail(cli_fit_bootstrap_range EXIT 2
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --bootstrap 1000000000 --out ${_fdir}/boot
-  REGEX "^navimpact: --bootstrap must be in \\[0, 10000\\], got 1000000000$" NOOUT ${_fdir}/boot)
+  REGEX "^navimpact: --bootstrap: must be in \\[0, 10000\\], got 1000000000 \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/boot)
 navimpact_cli_fail(cli_fit_channel_twice
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --channels gyro_x,gyro_x --out ${_fdir}/twice
   REGEX "^navimpact: --channels: 'gyro_x' is listed twice$" NOOUT ${_fdir}/twice)
