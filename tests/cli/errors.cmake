@@ -49,10 +49,10 @@ string(REPEAT "z" 5000 _long)
 file(WRITE ${_erd}/long_field.csv "gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n1,2,3,4,5,${_long}\n")
 navimpact_cli_fail(cli_error_csv_long_field EXIT 1 ARGS wv --input ${_erd}/long_field.csv ${_units} --out ${_erd}/o7
   REGEX "long_field.csv:2: column 6 \\('acc_z'\\): 'z+\\.\\.\\.\\(5000 bytes\\)' is not a number$")
-string(REPEAT "GM(sigma=1, T=2) + " 200 _longmodel)
+string(REPEAT "GM(sigma=1, T=2) + " 30 _longmodel)
 file(WRITE ${_erd}/long_model.yaml "rate_hz: 100\ngyroscope: \"${_longmodel}XX(a=1)\"\n")
 navimpact_cli_fail(cli_error_model_text_long EXIT 1 ARGS model show ${_erd}/long_model.yaml
-  REGEX "long_model.yaml: key 'gyroscope': model '.*\\.\\.\\.\\([0-9]+ bytes\\)': at position 3801: expected a process name")
+  REGEX "long_model.yaml: key 'gyroscope': model '.*\\.\\.\\.\\([0-9]+ bytes\\)': at position 571: expected a process name")
 
 # A file named by a configuration key that cannot be read (missing, a folder)
 # is named with the configuration and the key as well as the path, in every
