@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <tuple>
 
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/error.hpp"
@@ -165,6 +166,46 @@ TEST(StudyRuns, IndependentOfThreadsAndShardingAndPaired) {
 
   // Missing shard: a clear error.
   EXPECT_THROW(an::mergeShards({dirs[0]}), navimpact::Error);
+
+  // A shard not as navimpact writes it is refused naming its file, never read on
+  // (found by a bad-input probe: a set naming an unknown reference, duplicate
+  // labels segfaulted; runs_total 1e12 ran out of memory; trailing bytes passed)
+  auto edited = [&](const std::string& name, const std::string& from, const std::string& to) {
+    const auto dir = test::tempDir() / name;
+    std::filesystem::copy(dirs[1], dir);
+    std::ifstream in(dir / "shard.json");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    std::ofstream(dir / "shard.json") << text;
+    return dir.string();
+  };
+  auto mergeError = [&](const std::string& shard) {
+    try {
+      an::mergeShards({shard, dirs[0]});
+    } catch (const navimpact::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  for (const auto& [from, to, expect] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"\"runs_total\": 5", "\"runs_total\": 1000000000000", "runs_total 1000000000000 is outside [1, 1000000]"},
+           {"\"Gyro Ref copy\"", "\"Gyro Ref\"", "candidate label 'Gyro Ref' appears twice"},
+           {"\"reference\": \"", "\"reference\": \"Nope", "has the unknown reference"},
+           {"\"meta\"", "\"nometa\"", "not a navimpact study shard ("},
+       }) {
+    const std::string e = mergeError(edited("bad" + std::to_string(from.size() + to.size()), from, to));
+    EXPECT_NE(e.find("shard.json: "), std::string::npos) << e;
+    EXPECT_NE(e.find(expect), std::string::npos) << e;
+  }
+  {
+    const auto dir = test::tempDir() / "trailing";
+    std::filesystem::copy(dirs[1], dir);
+    std::ofstream(dir / "runs.bin", std::ios::app | std::ios::binary) << std::string(1000, '\0');
+    const std::string e = mergeError(dir.string());
+    EXPECT_NE(e.find("runs.bin: bytes after its last run"), std::string::npos) << e;
+  }
 
   // Paired comparison: identical models see identical realisations.
   const auto& a = one.acc.models[modelIndex(one, "Gyro Ref")];

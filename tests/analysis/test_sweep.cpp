@@ -183,6 +183,38 @@ TEST(SweepShards, AnyPartitionMergesToTheUnshardedResultBitForBit) {
   expectError([&] { an::mergeSweepShards({a, b, c}, "B2"); }, "another build");
   const std::string other_build = shard("ob", {2, 3}, "B9");
   expectError([&] { an::mergeSweepShards({a, other_build, c}, "B1"); }, "another build");
+  // A shard not as navimpact writes it is refused naming its file (found by a
+  // bad-input probe: shard n = 0 and a duration's epoch beyond tau_s segfaulted,
+  // bootstrap -5 hung, trailing bytes and a broken timing.json passed or were
+  // internal errors)
+  auto edited = [&](const std::string& name, const std::string& file, const std::string& from, const std::string& to) {
+    const fs::path d = dir / name;
+    fs::copy(b, d);
+    std::string text = readFile(d / file);
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    std::ofstream(d / file, std::ios::binary | std::ios::trunc) << text;
+    return d.string();
+  };
+  expectError([&] { an::mergeSweepShards({a, edited("n0", "sweep_shard.json", "\"n\": 3", "\"n\": 0"), c}, "B1"); },
+              "sweep_shard.json: shard 2/0 is not K/N with 1 <= K <= N");
+  expectError([&] { an::mergeSweepShards({a, edited("boot", "sweep_shard.json", "\"bootstrap\": ", "\"bootstrap\": -5"), c}, "B1"); },
+              "is outside [0, 100000]");
+  expectError([&] { an::mergeSweepShards({a, edited("ep", "sweep_shard.json", "\"duration_epoch\": [", "\"duration_epoch\": [1000000000,"), c}, "B1"); },
+              "sweep_shard.json: ");
+  {
+    const fs::path d = dir / "tj";
+    fs::copy(b, d);
+    std::ofstream(d / "timing.json") << "{garbage";
+    expectError([&] { an::mergeSweepShards({a, d.string(), c}, "B1"); }, "timing.json: not a navimpact shard's timing");
+  }
+  {
+    const fs::path d = dir / "trail";
+    fs::copy(b, d);
+    std::ofstream(d / "sweep_runs.bin", std::ios::app | std::ios::binary) << std::string(1000, '\0');
+    expectError([&] { an::mergeSweepShards({a, d.string(), c}, "B1"); }, "sweep_runs.bin: bytes after its last column");
+  }
   {
     auto cfg2 = cfg;
     cfg2.study.seed = 18;

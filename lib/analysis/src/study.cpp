@@ -74,6 +74,30 @@ void headerToJson(const StudyHeader& h, json& j) {
   j["margin"] = h.margin;
 }
 
+namespace {
+bool finite(double v) { return std::isfinite(v); }
+}  // namespace
+
+void checkHeader(const StudyHeader& h, const std::string& where) {
+  const auto bad = [&](const std::string& what) { throw Error(where + ": " + what + " (not as navimpact writes it)"); };
+  if (h.runs_total < 1 || h.runs_total > std::size_t(limits::kMaxMonteCarloRuns))
+    bad("runs_total " + std::to_string(h.runs_total) + " is outside [1, " + std::to_string(limits::kMaxMonteCarloRuns) + "]");
+  if (h.labels.empty()) bad("no candidate labels");
+  for (std::size_t i = 0; i < h.labels.size(); ++i)
+    for (std::size_t k = 0; k < i; ++k)
+      if (h.labels[i] == h.labels[k]) bad("candidate label '" + printable(h.labels[i]) + "' appears twice");
+  const auto known = [&](const std::string& l) { return std::find(h.labels.begin(), h.labels.end(), l) != h.labels.end(); };
+  for (const auto& set : h.sets) {
+    if (set.models.empty()) bad("set '" + printable(set.name) + "' has no models");
+    for (const auto& m : set.models)
+      if (!known(m)) bad("set '" + printable(set.name) + "' names the unknown candidate '" + printable(m) + "'");
+    if (!known(set.reference)) bad("set '" + printable(set.name) + "' has the unknown reference '" + printable(set.reference) + "'");
+    if (!set.white_noise.empty() && !known(set.white_noise))
+      bad("set '" + printable(set.name) + "' has the unknown white-noise model '" + printable(set.white_noise) + "'");
+  }
+  if (!(h.margin >= 0.0 && h.margin <= 10.0)) bad("margin " + formatNumber(h.margin) + " is outside [0, 10]");
+}
+
 void headerFromJson(const json& j, StudyHeader& h) {
   h.version = j.at("version");
   h.versions = j.at("versions").get<std::vector<std::pair<std::string, std::string>>>();
@@ -126,9 +150,24 @@ StudyMeta metaFromJson(const json& j, const std::string& where) {
     m.plot_before_s = j.at("plot_before_s");
     m.plot_after_s = j.at("plot_after_s");
     m.settings = j.at("settings");
+    checkHeader(m, where);
+    const auto bad = [&](const std::string& what) { throw Error(where + ": " + what + " (not as navimpact writes it)"); };
+    if (m.states.size() != m.labels.size() || m.sources.size() != m.labels.size())
+      bad("states and sources do not match the " + std::to_string(m.labels.size()) + " candidates");
+    if (!(m.imu_rate_hz >= limits::kImuRateHz.lo && m.imu_rate_hz <= limits::kImuRateHz.hi))
+      bad("imu_rate_hz " + formatNumber(m.imu_rate_hz) + " is outside " + limits::describe(limits::kImuRateHz));
+    if (!finite(m.t0) || !(m.duration_s > 0.0 && m.duration_s <= limits::kDurationS.hi))
+      bad("t0 or duration_s is not a run's");
+    for (std::size_t k = 0; k < m.epochs.size(); ++k)
+      if (!finite(m.epochs[k]) || (k > 0 && !(m.epochs[k] > m.epochs[k - 1]))) bad("epochs are not finite and increasing");
+    for (const auto& o : m.outages)
+      if (!finite(o.start_s) || !finite(o.end_s) || !(o.end_s > o.start_s)) bad("an outage is not finite with start < end");
+    if (!(m.plot_before_s >= 0.0 && m.plot_before_s <= limits::kDurationS.hi) ||
+        !(m.plot_after_s >= 0.0 && m.plot_after_s <= limits::kDurationS.hi))
+      bad("plot_before_s or plot_after_s is outside [0, 604800] s");
     return m;
   } catch (const json::exception& e) {
-    throw Error(where + ": not a navimpact study shard (" + e.what() + ")");
+    throw Error(where + ": not a navimpact study shard (" + printable(e.what(), 120) + ")");
   }
 }
 
@@ -544,18 +583,24 @@ StudyResults mergeShards(const std::vector<std::string>& dirs) {
   for (const auto& d : dirs) {
     const std::string sj = d + "/shard.json";
     const json j = detail::readShardJson(d, "shard.json", "navimpact_study_shard", "study --shard");
-    const json meta = j.at("meta");
-    if (ins.empty()) {
-      first_meta = meta;
-      res.meta = detail::metaFromJson(meta, sj);
-    } else {
-      for (const char* k : {"config_text", "seed", "runs_total", "labels", "epochs", "outages", "version", "versions"})
-        if (meta.at(k) != first_meta.at(k))
-          throw Error(sj + ": shard of a different study (" + std::string(k) + " differs from " + dirs[0] + ")");
-    }
     In in;
     in.dir = d;
-    in.idx = j.at("run_indices").get<std::vector<std::uint64_t>>();
+    try {
+      const json& meta = j.at("meta");
+      if (ins.empty()) {
+        first_meta = meta;
+        res.meta = detail::metaFromJson(meta, sj);
+      } else {
+        (void)detail::metaFromJson(meta, sj);  // the same checks for every shard
+        for (const char* k : {"config_text", "seed", "runs_total", "labels", "sets", "states", "epochs", "outages",
+                              "version", "versions", "imu_rate_hz", "margin"})
+          if (meta.at(k) != first_meta.at(k))
+            throw Error(sj + ": shard of a different study (" + std::string(k) + " differs from " + dirs[0] + ")");
+      }
+      in.idx = j.at("run_indices").get<std::vector<std::uint64_t>>();
+    } catch (const json::exception& e) {
+      throw Error(sj + ": not a navimpact study shard (" + printable(e.what(), 120) + ")");
+    }
     const std::string bin = d + "/runs.bin";
     in.f = std::make_unique<std::ifstream>(bin, std::ios::binary);
     if (!*in.f) throw Error(bin + ": cannot open");
@@ -588,6 +633,9 @@ StudyResults mergeShards(const std::vector<std::string>& dirs) {
     rec.index = getU64(*in.f, bin);
     rec.seed = getU64(*in.f, bin);
     if (rec.index != i) throw Error(bin + ": runs not in index order (found " + std::to_string(rec.index) + ")");
+    if (rec.seed != stochastic::deriveSeed(res.meta.seed, rec.index))
+      throw Error(bin + ": run " + std::to_string(i) + " has a seed that is not the study's (seed " +
+                  std::to_string(res.meta.seed) + ")");
     rec.models.resize(M);
     for (auto& m : rec.models) {
       getD(*in.f, &m.wall_s, 1, bin);
@@ -600,6 +648,9 @@ StudyResults mergeShards(const std::vector<std::string>& dirs) {
     res.acc.add(rec, E, O);
     res.run_indices.push_back(i);
   }
+  for (const In& in : ins)
+    if (in.f->peek() != std::char_traits<char>::eof())
+      throw Error(in.dir + "/runs.bin: bytes after its last run (not as navimpact writes it)");
   res.shard = Shard{1, 1};
   return res;
 }

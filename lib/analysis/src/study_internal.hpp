@@ -18,6 +18,9 @@ constexpr int kEpochValues = 22;
 /// (json::exception for a missing or mistyped field: the caller names the file).
 void headerToJson(const StudyHeader& h, nlohmann::json& j);
 void headerFromJson(const nlohmann::json& j, StudyHeader& h);
+/// The header as navimpact writes it (a shard read back): runs_total [1, 1e6], unique
+/// candidate labels, sets naming only those, margin [0, 10]. @throws Error "WHERE: ...".
+void checkHeader(const StudyHeader& h, const std::string& where);
 
 nlohmann::json metaToJson(const StudyMeta& m);
 StudyMeta metaFromJson(const nlohmann::json& j, const std::string& where);

@@ -323,9 +323,29 @@ SweepMeta metaFromJson(const json& j, const std::string& where) {
       col.duration_epoch = c.at("duration_epoch").get<std::vector<std::size_t>>();
       m.columns.push_back(std::move(col));
     }
+    detail::checkHeader(m, where);
+    const auto bad = [&](const std::string& what) { throw Error(where + ": " + what + " (not as navimpact writes it)"); };
+    if (m.durations_s.empty()) bad("no outage durations");
+    for (double d : m.durations_s)
+      if (!(d >= limits::kDurationS.lo && d <= limits::kDurationS.hi)) bad("an outage duration is outside [0.0001, 604800] s");
+    if (!(m.alpha > 0.0 && m.alpha < 0.5)) bad("alpha " + formatNumber(m.alpha) + " is outside (0, 0.5)");
+    if (m.bootstrap > 100000) bad("bootstrap " + std::to_string(m.bootstrap) + " is outside [0, 100000]");
+    if (m.gnss.empty() || m.baro.empty() || m.imu_rates_hz.empty()) bad("an axis of the sweep is empty");
+    if (m.columns.empty()) bad("no columns");
+    for (const auto& c : m.columns) {
+      if (c.axes.gnss >= m.gnss.size() || c.axes.baro >= m.baro.size() || c.axes.rate >= m.imu_rates_hz.size())
+        bad("column '" + printable(c.name) + "' names an axis value the sweep does not have");
+      if (c.states.size() != m.labels.size()) bad("column '" + printable(c.name) + "' has states of another candidate list");
+      for (std::size_t k = 0; k < c.tau_s.size(); ++k)
+        if (!std::isfinite(c.tau_s[k]) || (k > 0 && !(c.tau_s[k] > c.tau_s[k - 1])))
+          bad("column '" + printable(c.name) + "': tau_s is not finite and increasing");
+      if (c.duration_epoch.size() != m.durations_s.size()) bad("column '" + printable(c.name) + "' has another duration count");
+      for (std::size_t e : c.duration_epoch)
+        if (e >= c.tau_s.size()) bad("column '" + printable(c.name) + "': a duration's epoch is beyond its tau_s");
+    }
     return m;
   } catch (const json::exception& e) {
-    throw Error(where + ": not a navimpact sweep shard (" + e.what() + ")");
+    throw Error(where + ": not a navimpact sweep shard (" + printable(e.what(), 120) + ")");
   }
 }
 
@@ -402,15 +422,20 @@ SweepRuns mergeSweepShards(const std::vector<std::string>& dirs, const std::stri
         throw Error(sj + ": shard written by another build of navimpact (" + b + "; this one is " + build_id +
                     "): rerun it with this build");
       in.shard = Shard{j.at("shard").at("k").get<unsigned>(), j.at("shard").at("n").get<unsigned>()};
+      if (!(in.shard.n >= 1 && in.shard.k >= 1 && in.shard.k <= in.shard.n))
+        throw Error(sj + ": shard " + std::to_string(in.shard.k) + "/" + std::to_string(in.shard.n) +
+                    " is not K/N with 1 <= K <= N (not as navimpact writes it)");
       in.idx = j.at("run_indices").get<std::vector<std::uint64_t>>();
+      (void)j.at("meta");
     } catch (const json::exception& e) {
-      throw Error(sj + ": not a navimpact sweep shard (" + std::string(e.what()).substr(0, 120) + ")");
+      throw Error(sj + ": not a navimpact sweep shard (" + printable(e.what(), 120) + ")");
     }
     const json& meta = j.at("meta");
     if (ins.empty()) {
       first = meta;
       res.meta = metaFromJson(meta, sj);
     } else {
+      (void)metaFromJson(meta, sj);  // the same checks for every shard
       for (const char* k : {"config_text", "inputs_hash", "seed", "runs_total", "version", "versions", "columns"})
         if (!meta.contains(k) || meta.at(k) != first.at(k)) {
           const std::string what = std::string(k) == "config_text" || std::string(k) == "inputs_hash"
@@ -439,6 +464,7 @@ SweepRuns mergeSweepShards(const std::vector<std::string>& dirs, const std::stri
         throw Error(bin + ": truncated");
       in.values.push_back(std::move(v));
     }
+    if (f.peek() != std::char_traits<char>::eof()) throw Error(bin + ": bytes after its last column (not as navimpact writes it)");
     ins.push_back(std::move(in));
   }
   // Every run exactly once; otherwise say which shards (or runs) are missing.
@@ -498,11 +524,19 @@ SweepRuns mergeSweepShards(const std::vector<std::string>& dirs, const std::stri
   res.shard = Shard{1, 1};
   // Cost figures from the shards' timing files (absent: zero).
   for (const auto& d : dirs) {
-    std::ifstream ft(d + "/timing.json");
-    json t;
-    if (ft && (ft >> t, true) && t.is_object()) {
-      res.filter_steps += t.value("filter_steps", 0.0);
-      res.filter_wall_s += t.value("filter_wall_s", 0.0);
+    const std::string tp = d + "/timing.json";
+    std::ifstream ft(tp);
+    if (!ft) continue;
+    try {
+      json t;
+      ft >> t;
+      const double steps = t.at("filter_steps").get<double>(), wall = t.at("filter_wall_s").get<double>();
+      if (!(steps >= 0.0 && std::isfinite(steps) && wall >= 0.0 && std::isfinite(wall)))
+        throw Error(tp + ": filter_steps and filter_wall_s must be finite and >= 0 (not as navimpact writes it)");
+      res.filter_steps += steps;
+      res.filter_wall_s += wall;
+    } catch (const json::exception& e) {
+      throw Error(tp + ": not a navimpact shard's timing (" + printable(e.what(), 120) + ")");
     }
   }
   return res;
