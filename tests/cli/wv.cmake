@@ -52,6 +52,12 @@ wv_expect_fail(constant "constant\\.csv: channel gyro_x: .*constant"
                --input ${_wv_dir}/constant.csv ${_u})
 wv_expect_fail(too_short "three\\.csv: channel gyro_x: .*at least 4 samples"
                --input ${_wv_dir}/three.csv ${_u})
+# samples of 1e-300 (not constant): their squares underflow, the wavelet variance
+# is 0 at every scale; named with file and channel (it was a plot error naming none)
+string(REPEAT "1e-300,2e-300,1e-300,2e-300,1e-300,2e-300\n2e-300,1e-300,2e-300,1e-300,2e-300,1e-300\n" 64 _tiny_rows)
+file(WRITE ${_wv_dir}/tiny.csv "gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n${_tiny_rows}")
+wv_expect_fail(underflow "^navimpact: .*tiny\\.csv: channel gyro_x: wavelet variance is 0 at every scale \\(the samples reach only .x. = 2e-300: their squares underflow; is the unit right\\?\\)$"
+               --input ${_wv_dir}/tiny.csv --rate 100 --gyro-unit rad/s --acc-unit m/s2)
 wv_expect_fail(unknown_unit
                "adis16405_static_excerpt\\.csv\\.gz: --acc-unit 'furlong' is not a known unit"
                --input ${_wv_data} --rate 100 --gyro-unit deg/s --acc-unit furlong)

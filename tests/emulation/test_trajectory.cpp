@@ -98,7 +98,7 @@ TEST(Trajectory, BadInputNamesFileAndLine) {
   std::string lat = "time_s,lat_rad,lon_rad,alt_m,roll_rad,pitch_rad,yaw_rad\n";
   for (int i = 0; i < 10; ++i) lat += std::to_string(i * 0.01) + (i == 2 ? ",1e300" : ",0.8") + ",0.1,500,0,0,0\n";
   geo.file = writeCsv("lat.csv", lat);
-  EXPECT_EQ(errorOf(geo), geo.file + ":4: column 'lat_rad': 1e+300 (5.72958e+301 deg) is out of [-90, 90] deg");
+  EXPECT_EQ(errorOf(geo), geo.file + ":4: column 'lat_rad': 1e+300 (5.72958e+301 deg) is out of [-89.9, 89.9] deg");
 }
 
 // The window's keys name the configuration that gave them (the CSV alone was

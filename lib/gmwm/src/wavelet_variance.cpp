@@ -344,6 +344,15 @@ std::vector<WaveletVariance> waveletVariances(const ImuSeries& s, const WvOption
       std::snprintf(buf, sizeof buf, "%g s is not finite (the samples reach |x| = %g)", w.tau[j] / s.rate_hz, big);
       throw Error(s.source + ": channel " + s.channels[c].name + ": wavelet variance at tau = " + buf);
     }
+    // ... and so is one that underflows to 0 at every scale (samples of 1e-300: a
+    // log-log plot of it has nothing to draw, and no model fits it)
+    if (w.wv.size() > 0 && (w.wv.array() == 0.0).all()) {
+      double big = 0.0;
+      for (double v : s.channels[c].x) big = std::max(big, std::abs(v));
+      throw Error(s.source + ": channel " + s.channels[c].name +
+                  ": wavelet variance is 0 at every scale (the samples reach only |x| = " + formatNumber(big) +
+                  ": their squares underflow; is the unit right?)");
+    }
   }
   return out;
 }

@@ -17,7 +17,7 @@
  *    [0.1 mm/s, 1 km/s]; attitude sigmas [1e-4, 180] deg;
  *  - lever-arm components [-100, 100] m;
  *  - durations [0.1 ms, 7 days]; times on a file's axis [-1e10, 1e10] s;
- *  - origins: latitude [-90, 90] deg, longitude [-360, 360] deg, height
+ *  - origins: latitude [-89.9, 89.9] deg (NED is singular at the poles), longitude [-360, 360] deg, height
  *    [-11 km, 100 km]; smoother cut-offs [1 mHz, 10 kHz];
  *  - IMU error states per axis at most 32 (a model has a handful);
  *  - Monte Carlo runs of a study at most 10^6;
@@ -69,7 +69,10 @@ inline constexpr Range kDurationS{1.0e-4, 7.0 * 86400.0, false, "s"};
 /// A time on a file's own axis (trajectory start_s/end_s: file time, e.g. Unix seconds) [s].
 inline constexpr Range kFileTimeS{-1.0e10, 1.0e10, false, "s"};
 /// Geodetic latitude, longitude and height of an origin [deg, deg, m].
-inline constexpr Range kLatitudeDeg{-90.0, 90.0, false, "deg"};
+/// Latitudes of positions navimpact navigates (origins, trajectory rows, a static
+/// state): the NED mechanisation's transport rate holds tan(latitude), singular
+/// at the poles (an emulation at 90 deg replayed to a covariance of NaN at 0.05 s).
+inline constexpr Range kLatitudeDeg{-89.9, 89.9, false, "deg"};
 inline constexpr Range kLongitudeDeg{-360.0, 360.0, false, "deg"};
 inline constexpr Range kHeightM{-1.1e4, 1.0e5, false, "m"};
 /// Cut-off frequency of a smoother [Hz]: from 1 mHz (a period of 17 min; a
