@@ -42,6 +42,7 @@ int runStudyCmd(const StudyOpts& o) {
   const an::Shard shard = o.shard.empty() ? an::Shard{} : an::parseShard(o.shard);
 
   const auto plan = an::prepareStudy(cfg, NAVIMPACT_VERSION);  // every input error is thrown here
+  cfg.threads = an::studyThreads(*plan, shard, cfg.threads);  // all cores: as many as the memory budget holds
   an::checkStudyBudget("study", an::studyWork(*plan, shard, cfg.threads), o.allow_large);
   std::size_t todo = 0;
   for (std::size_t i = 0; i < cfg.runs; ++i) todo += shard.contains(i) ? 1 : 0;

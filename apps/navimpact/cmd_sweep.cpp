@@ -84,6 +84,7 @@ int runSweepCmd(const SweepOpts& o) {
 
   const auto plan = an::prepareSweep(cfg, NAVIMPACT_VERSION);  // every input error is thrown here
   if (emit) return emitSlurm(o, cfg, an::sweepMeta(*plan));
+  cfg.study.threads = an::sweepThreads(*plan, shard, cfg.study.threads);  // all cores: as many as memory holds
   an::checkStudyBudget("sweep", an::sweepWork(*plan, shard, cfg.study.threads), o.allow_large);
   std::size_t per = 0;
   for (std::size_t i = 0; i < cfg.study.runs; ++i) per += shard.contains(i) ? 1 : 0;

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <random>
+#include <thread>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -148,6 +149,23 @@ TEST(DiagnoseThreads, ResultDoesNotDependOnTheThreadCount) {
 // diagnose-power's records go over the worker pool: every run (cause, SNR,
 // rate, length, verdict and why) and the null alarms are the same on 1 and 3
 // threads. Three causes drawn at random (seeded; printed), short records.
+// All cores (threads 0) means as many workers as the memory budget holds, at
+// least one; explicit threads are kept (and then judged by the budget): the
+// defaults must not be refused on a machine with many cores.
+TEST(DiagnoseThreads, PowerWorkersFitTheMemoryBudget) {
+  pw::PowerOptions o;
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  o.ranges.min_samples = o.ranges.max_samples = 1 << 18;  // 38 MB per worker
+  EXPECT_EQ(pw::powerThreads(o), std::min(hw, 52u));
+  o.ranges.max_samples = 100000000;  // 14 GB per worker: one, which the budget then refuses
+  EXPECT_EQ(pw::powerThreads(o), 1u);
+  EXPECT_THROW(pw::checkPowerOptions(o), navimpact::Error);
+  o.ranges.max_samples = 1 << 18;
+  o.threads = 3;
+  EXPECT_EQ(pw::powerThreads(o), 3u);
+  EXPECT_NO_THROW(pw::checkPowerOptions(o));
+}
+
 TEST(DiagnoseThreads, PowerDoesNotDependOnTheThreadCount) {
   const std::uint64_t s = ns::deriveSeed(rootSeed(), 771000u);
   std::vector<na::Cause> all = {na::Cause::WhiteNoise, na::Cause::QuantizationNoise, na::Cause::RandomWalk,

@@ -385,6 +385,21 @@ std::vector<Cause> allCauses() {
 }
 }  // namespace
 
+namespace {
+// a record's six channels and their workspace: ~3 doubles per sample and channel
+// (measured: a null record of 1e6 samples peaks 88 MB above one of 2.5e5)
+constexpr double kPowerBytesPerSample = 6.0 * 3.0 * 8.0;
+}  // namespace
+
+unsigned powerThreads(const PowerOptions& opt) {
+  if (opt.threads > 0) return unsigned(opt.threads);
+  const double hw = std::max(1u, std::thread::hardware_concurrency());
+  const DrawRanges& r = opt.ranges;
+  const double nMax = r.max_duration_s > 0 ? r.max_duration_s * r.max_rate_hz : double(r.max_samples);
+  const double fit = std::floor(limits::kDefaultMemoryBudgetBytes / (std::max(nMax, 1.0) * kPowerBytesPerSample));
+  return static_cast<unsigned>(std::max(1.0, std::min(hw, fit)));
+}
+
 void checkPowerOptions(const PowerOptions& opt) {
   const auto fail = [](const std::string& what) { throw Error("diagnose-power: " + what); };
   const long long maxRuns = limits::kMaxMonteCarloRuns;
@@ -420,16 +435,14 @@ void checkPowerOptions(const PowerOptions& opt) {
   // six channels on null records, one otherwise; each simulated (1 + simulations) times
   const double work = (double(opt.runs_per_cause) * double(causes) + 6.0 * double(opt.null_runs)) * nMax *
                       (1.0 + double(opt.simulations));
-  const unsigned workers = opt.threads > 0 ? unsigned(opt.threads) : std::max(1u, std::thread::hardware_concurrency());
-  // a record's six channels and their workspace: ~3 doubles per sample and channel
-  // (measured: a null record of 1e6 samples peaks 88 MB above one of 2.5e5)
-  const double bytes = std::min(double(workers), records) * nMax * 6.0 * 3.0 * 8.0;
+  const double workers = std::min(double(powerThreads(opt)), records);
+  const double bytes = workers * nMax * kPowerBytesPerSample;
   limits::checkBudget({{"diagnose-power", "the records", work, limits::kDefaultSimulatedSampleBudget, "simulated samples",
                         formatNumber(records, 3) + " records x " + formatNumber(nMax, 3) + " samples x " +
                             std::to_string(1 + opt.simulations),
                         "lower --runs, --null-runs, --simulations or " + lengthFlag},
                        {"diagnose-power", "the records held at once", bytes / 1e6, limits::kDefaultMemoryBudgetBytes / 1e6,
-                        "MB", std::to_string(workers) + " workers", "lower " + lengthFlag + " or --threads"}},
+                        "MB", formatNumber(workers) + " workers", "lower " + lengthFlag + " or --threads"}},
                       opt.allow_large);
 }
 
@@ -457,7 +470,7 @@ PowerResult runPower(const PowerOptions& opt_in) {
       opt.progress(static_cast<double>(done) / static_cast<double>(count));
     };
   try {
-    parallelFor(jobs.size(), static_cast<unsigned>(std::max(opt.threads, 0)), [&](std::size_t i) {
+    parallelFor(jobs.size(), powerThreads(opt), [&](std::size_t i) {
       const Job& j = jobs[i];
       const std::uint64_t s = stochastic::deriveSeed(opt.seed, 1000000u * static_cast<std::uint64_t>(j.cause + 1) + j.index);
       Rng rng(stochastic::deriveSeed(s, 1));

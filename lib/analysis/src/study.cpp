@@ -337,6 +337,13 @@ StudyWork studyWork(const StudyPlan& p, const Shard& shard, unsigned threads) {
   return w;
 }
 
+unsigned studyThreads(const StudyPlan& p, const Shard& shard, unsigned requested) {
+  if (requested > 0) return requested;
+  const StudyWork w = studyWork(p, shard, 0);
+  const double fit = std::floor((limits::kDefaultMemoryBudgetBytes / std::max(w.samples, 1.0) - 100.0) / 120.0);
+  return static_cast<unsigned>(std::max(1.0, std::min(w.workers, fit)));
+}
+
 void checkStudyBudget(const std::string& command, const StudyWork& w, bool allow_large) {
   const std::string place = command + ": " + formatNumber(w.runs) + " runs";
   limits::checkBudget(

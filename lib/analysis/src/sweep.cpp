@@ -206,6 +206,15 @@ StudyWork sweepWork(const SweepPlan& p, const Shard& shard, unsigned threads) {
   return w;
 }
 
+unsigned sweepThreads(const SweepPlan& p, const Shard& shard, unsigned requested) {
+  unsigned t = 0;
+  for (const auto& sp : p.studies) {
+    const unsigned c = studyThreads(*sp, shard, requested);
+    t = t == 0 ? c : std::min(t, c);
+  }
+  return std::max(t, 1u);
+}
+
 SweepRuns runSweep(const std::shared_ptr<const SweepPlan>& plan, const Shard& shard, unsigned threads,
                    const SweepProgressFn& progress) {
   if (!plan) throw Error("sweep: no plan");

@@ -115,6 +115,11 @@ struct PowerOptions {
  */
 void checkPowerOptions(const PowerOptions& opt);
 
+/// The workers of a power sweep: opt.threads when given; for 0 (all cores) the
+/// most, up to the hardware's, whose records fit in limits::kDefaultMemoryBudgetBytes,
+/// at least 1 (the results do not depend on it).
+unsigned powerThreads(const PowerOptions& opt);
+
 struct PowerRun {
   Cause cause = Cause::WhiteNoise;
   double snr = 0, rate_hz = 0, duration_s = 0;

@@ -162,6 +162,12 @@ struct StudyWork {
 };
 StudyWork studyWork(const StudyPlan& plan, const Shard& shard, unsigned threads);
 
+/// The workers a study uses for @p requested threads: @p requested when given;
+/// for 0 (all cores) the most, up to the hardware's, whose memory (studyWork)
+/// stays within limits::kDefaultMemoryBudgetBytes, at least 1 (the results do not
+/// depend on it; a 64-core machine would otherwise be refused at 10 kHz).
+unsigned studyThreads(const StudyPlan& plan, const Shard& shard, unsigned requested);
+
 /// The budgets of `study` and `sweep` (README "Ranges and budgets"): @p steps
 /// IMU steps above limits::kDefaultFilterStepBudget or @p bytes above
 /// limits::kDefaultMemoryBudgetBytes are refused unless @p allow_large.

@@ -137,6 +137,8 @@ const SweepMeta& sweepMeta(const SweepPlan& plan);
 /// The work of a sweep's shard (studyWork()): steps summed over its columns,
 /// memory of the largest column (the columns run one after another).
 StudyWork sweepWork(const SweepPlan& plan, const Shard& shard, unsigned threads);
+/// studyThreads() for the largest column of a sweep.
+unsigned sweepThreads(const SweepPlan& plan, const Shard& shard, unsigned requested);
 
 /// Per-run values of a sweep (or a shard of it).
 struct SweepRuns {
