@@ -95,26 +95,20 @@ navimpact_cli_fail(cli_diagnose_power_bad_snr EXIT 1 NOOUT ${_dg_out}/bad11
 # checked before any record is drawn (found by a bad-input probe: --runs 1e9
 # held 11.6 GB within 30 s, --samples 1e12 ended in "out of memory" (exit 3),
 # --rate 1e-300 wrote a duration of 4e303 s with exit 0)
-foreach(_case "samples|--samples 1000000000000:1000000000000|the records would need about [0-9.e+]+ simulated samples .* or pass --allow-large$"
-              "memory|--samples 100000000:100000000 --runs 1 --null-runs 1|the records held at once would need about .* MB .* lower --samples or --threads, or pass --allow-large$"
-              "rate|--rate 1e-300:1e-300|--rate must lie in \\[1, 10000\\] Hz"
-              "nothing|--runs 0 --null-runs 0|--runs and --null-runs are both 0: no record to diagnose$"
-              "twice|--causes random_walk,random_walk|--causes: 'random_walk' is listed twice$")
-  navimpact_cli_case("${_case}" _n _args _re)
+# NAME|EXIT|ARGS|REGEX: library checks are exit 1 ("diagnose-power: ..."), flag ranges exit 2 naming the flag
+foreach(_case "range_samples|1|--samples 1000000000000:1000000000000|diagnose-power: the records would need about [0-9.e+]+ simulated samples .* or pass --allow-large$"
+              "range_memory|1|--samples 100000000:100000000 --runs 1 --null-runs 1|diagnose-power: the records held at once would need about .* MB .* lower --samples or --threads, or pass --allow-large$"
+              "range_rate|1|--rate 1e-300:1e-300|diagnose-power: --rate must lie in \\[1, 10000\\] Hz"
+              "range_nothing|1|--runs 0 --null-runs 0|diagnose-power: --runs and --null-runs are both 0: no record to diagnose$"
+              "range_twice|1|--causes random_walk,random_walk|diagnose-power: --causes: 'random_walk' is listed twice$"
+              "flag_runs|2|--runs 1000000000|--runs: must be in \\[0, 1e\\+06\\], got 1000000000 \\(see 'navimpact diagnose-power --help'\\)$"
+              "flag_threads|2|--threads -1|--threads: must be in \\[0, 1024\\], got -1 \\(see 'navimpact diagnose-power --help'\\)$"
+              "flag_alpha|2|--alpha nan|--alpha: must be in \\(0, 0.5\\), got nan \\(see 'navimpact diagnose-power --help'\\)$")
+  navimpact_cli_case("${_case}" _n _exit _args _re)
   separate_arguments(_args)
-  navimpact_cli_fail(cli_diagnose_power_range_${_n} EXIT 1 NOOUT ${_dg_out}/pw_${_n}
+  navimpact_cli_fail(cli_diagnose_power_${_n} EXIT ${_exit} NOOUT ${_dg_out}/pw_${_n}
     ARGS diagnose-power --out ${_dg_out}/pw_${_n} ${_args}
-    REGEX "^navimpact: diagnose-power: ${_re}")
-endforeach()
-# counts and threads are flag ranges: exit 2 naming the flag
-foreach(_case "runs|--runs 1000000000|--runs: must be in \\[0, 1e\\+06\\], got 1000000000"
-              "threads|--threads -1|--threads: must be in \\[0, 1024\\], got -1"
-              "alpha|--alpha nan|--alpha: must be in \\(0, 0.5\\), got nan")
-  navimpact_cli_case("${_case}" _n _args _re)
-  separate_arguments(_args)
-  navimpact_cli_fail(cli_diagnose_power_flag_${_n} EXIT 2 NOOUT ${_dg_out}/pwf_${_n}
-    ARGS diagnose-power --out ${_dg_out}/pwf_${_n} ${_args}
-    REGEX "^navimpact: ${_re} \\(see 'navimpact diagnose-power --help'\\)$")
+    REGEX "^navimpact: ${_re}")
 endforeach()
 
 # --model fit:auto: each channel's structure chosen by the WIC first (on the

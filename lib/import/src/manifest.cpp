@@ -240,7 +240,7 @@ earth::Geodetic positionAt(const StreamSpec& s, const ColumnTable& tab, const Po
   if (lon < -180.0 * kDeg || lon > 360.0 * kDeg)
     throw fileError(s.file, tab.line[i], "column key " + key + ".lon: longitude " + formatNumber(tab.columns[p.lon][i]) +
                                              " is outside [-180, 360] deg (is angle_unit right?)");
-  if (h < -12000.0 || h > 1e6)
+  if (!(h >= kMinHeightM && h <= kMaxHeightM))
     throw fileError(s.file, tab.line[i], "column key " + key + ".height: height " + formatNumber(h) +
                                              " m is outside [-12000, 1e6] m");
   return {lat, lon > 180.0 * kDeg ? lon - 360.0 * kDeg : lon, h};
@@ -366,7 +366,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     k.map(o, "origin", {"lat_deg", "lon_deg", "height_m"}, {"lat_deg", "lon_deg", "height_m"});
     origin = earth::Geodetic{k.number(o["lat_deg"], "origin.lat_deg", -90.0, 90.0, "deg") * kDeg,
                              k.number(o["lon_deg"], "origin.lon_deg", -180.0, 360.0, "deg") * kDeg,
-                             k.number(o["height_m"], "origin.height_m", -12000.0, 1e6, "m")};
+                             k.number(o["height_m"], "origin.height_m", kMinHeightM, kMaxHeightM, "m")};
   }
   ImportReport rep;
 

@@ -281,14 +281,11 @@ struct RawlogReader::Impl {
       } else {
         throw Error(where(label, t) + ": GNSS entry has neither a TOPCON_PZS nor an NMEA GGA message");
       }
-      if (!std::isfinite(f.pos.lat) || !std::isfinite(f.pos.lon) || !std::isfinite(f.pos.h) ||
-          std::abs(f.pos.lat) > M_PI / 2 || std::abs(f.pos.lon) > 2 * M_PI || std::abs(f.pos.h) > 1e7)
-        throw Error(where(label, t) + ": GNSS position is not a place on Earth (latitude, longitude, height)");
+      checkPlausible(rec, label, t);  // a place on Earth (non-finite included), heights, velocity, sigmas
       if (!haveOrigin && !fromCommentOrigin) {  // no origin in the comment: the first fix
         head.origin = f.pos;
         fromCommentOrigin = true;
       }
-      checkPlausible(rec, label, t);
       emit(std::move(rec));
     } else {
       ++skipped;
