@@ -56,7 +56,7 @@ int runStudyCmd(const StudyOpts& o) {
     out.commit();
     printSummary(res, o.out);
   } else {
-    an::writeShard(res, out);
+    an::writeShard(res, navimpact::cli::buildId(), out);
     out.commit();
     std::cout << "study shard " << shard.k << "/" << shard.n << ": " << res.acc.runs << " of " << cfg.runs
               << " runs written to " << o.out << "/ (merge with: navimpact study-merge DIR... --out DIR)\n";
@@ -66,7 +66,7 @@ int runStudyCmd(const StudyOpts& o) {
 
 int runMergeCmd(const navimpact::cli::MergeOpts& o) {
   navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
-  const an::StudyResults res = an::mergeShards(o.dirs);
+  const an::StudyResults res = an::mergeShards(o.dirs, navimpact::cli::buildId());
   navimpact::report::writeStudyOutputs(res, out);
   out.commit();
   printSummary(res, o.out);

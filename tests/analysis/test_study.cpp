@@ -157,15 +157,15 @@ TEST(StudyRuns, IndependentOfThreadsAndShardingAndPaired) {
     EXPECT_EQ(part.acc.runs, k == 1 ? 3u : 2u);
     const auto dir = test::tempDir() / ("shard" + std::to_string(k));
     navimpact::OutputSet out(dir);
-    an::writeShard(part, out);
+    an::writeShard(part, "B1", out);
     out.commit();
     dirs.push_back(dir.string());
   }
-  const an::StudyResults merged = an::mergeShards(dirs);
+  const an::StudyResults merged = an::mergeShards(dirs, "B1");
   EXPECT_EQ(navimpact::report::studyMetricsJson(merged), m1) << "merged shards differ from the unsharded study";
 
   // Missing shard: a clear error.
-  EXPECT_THROW(an::mergeShards({dirs[0]}), navimpact::Error);
+  EXPECT_THROW(an::mergeShards({dirs[0]}, "B1"), navimpact::Error);
 
   // A shard not as navimpact writes it is refused naming its file, never read on
   // (found by a bad-input probe: a set naming an unknown reference, duplicate
@@ -183,7 +183,7 @@ TEST(StudyRuns, IndependentOfThreadsAndShardingAndPaired) {
   };
   auto mergeError = [&](const std::string& shard) {
     try {
-      an::mergeShards({shard, dirs[0]});
+      an::mergeShards({shard, dirs[0]}, "B1");
     } catch (const navimpact::Error& e) {
       return std::string(e.what());
     }
@@ -194,6 +194,7 @@ TEST(StudyRuns, IndependentOfThreadsAndShardingAndPaired) {
            {"\"Gyro Ref copy\"", "\"Gyro Ref\"", "candidate label 'Gyro Ref' appears twice"},
            {"\"reference\": \"", "\"reference\": \"Nope", "has the unknown reference"},
            {"\"meta\"", "\"nometa\"", "not a navimpact study shard ("},
+           {"\"build_id\": \"B1\"", "\"build_id\": \"B0\"", "shard written by another build of navimpact (B0"},
        }) {
     const std::string e = mergeError(edited("bad" + std::to_string(from.size() + to.size()), from, to));
     EXPECT_NE(e.find("shard.json: "), std::string::npos) << e;

@@ -548,9 +548,10 @@ using detail::putD;
 using detail::putU64;
 }  // namespace
 
-void writeShard(const StudyResults& r, OutputSet& out) {
+void writeShard(const StudyResults& r, const std::string& build_id, OutputSet& out) {
   json j;
   j["navimpact_study_shard"] = 1;
+  j["build_id"] = build_id;
   j["meta"] = detail::metaToJson(r.meta);
   j["shard"] = {{"k", r.shard.k}, {"n", r.shard.n}};
   j["run_indices"] = r.run_indices;
@@ -576,7 +577,7 @@ void writeShard(const StudyResults& r, OutputSet& out) {
   if (!f) throw Error(out.dir().string() + "/runs.bin: write failed");
 }
 
-StudyResults mergeShards(const std::vector<std::string>& dirs) {
+StudyResults mergeShards(const std::vector<std::string>& dirs, const std::string& build_id) {
   if (dirs.empty()) throw Error("study-merge: no shard folders given");
   struct In {
     std::string dir;
@@ -593,6 +594,10 @@ StudyResults mergeShards(const std::vector<std::string>& dirs) {
     In in;
     in.dir = d;
     try {
+      const std::string b = j.at("build_id");
+      if (b != build_id)
+        throw Error(sj + ": shard written by another build of navimpact (" + b + "; this one is " + build_id +
+                    "): rerun it with this build");
       const json& meta = j.at("meta");
       if (ins.empty()) {
         first_meta = meta;

@@ -269,17 +269,19 @@ struct StudyResults {
 
 /**
  * Write a shard's partial results to DIR: shard.json (meta, shard, indices)
- * and runs.bin (every run record, native little-endian doubles).
+ * and runs.bin (every run record, native little-endian doubles); @p build_id
+ * names the program that wrote it (mergeShards refuses another).
  */
-void writeShard(const StudyResults& r, OutputSet& out);
+void writeShard(const StudyResults& r, const std::string& build_id, OutputSet& out);
 
 /**
  * Merge shard folders into the results of one unsharded run: checks that the
  * shards come from the same configuration, seed and run count and that their
- * runs are disjoint and complete, then adds the runs in index order.
+ * runs are disjoint and complete and were written by the build @p build_id
+ * (the merging program's), then adds the runs in index order.
  * @throws navimpact::Error naming the folder for any mismatch or missing file.
  */
-StudyResults mergeShards(const std::vector<std::string>& dirs);
+StudyResults mergeShards(const std::vector<std::string>& dirs, const std::string& build_id);
 
 /// Two-sided 95 % band of the average NEES of @p runs runs with @p dof dof.
 std::pair<double, double> aneesBand(std::size_t runs, int dof, double confidence = 0.95);
