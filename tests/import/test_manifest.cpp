@@ -396,8 +396,10 @@ TEST(ImportManifest, IncrementsAreDividedByTheirOwnInterval) {
     EXPECT_NEAR(d.imu[k].w_IB_B[0], 1.0, 1e-12);
     EXPECT_NEAR(d.imu[k].f_B[2], 9.8, 1e-12);
   }
-  // the first sample's interval is the nominal step: the median step (0.02 s here)
-  EXPECT_NEAR(d.imu[0].w_IB_B[0], 0.01 / 0.02, 1e-12);
+  // the first sample's interval is the nominal step: of steps 0.01 and 0.02 s the
+  // median is 0.02 s, their mean 0.015 s is more than 1 % away (nominalStep)
+  EXPECT_NEAR(d.imu[0].w_IB_B[0], 0.01 / 0.015, 1e-12);
+  EXPECT_NEAR(d.imu_rate_hz, 1.0 / 0.015, 1e-9);
 }
 
 TEST(ImportManifest, ALongRecordIsStreamedNotReadWhole) {

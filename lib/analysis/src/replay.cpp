@@ -509,12 +509,13 @@ void ReplayDriver::run() {
     throw Error(cfg.rawlog + ": the scenario records no IMU error model: give one with --model FILE[:NAME]");
   }
 
-  // The nominal step: the median interval of the look-ahead; time zero one step before the first sample.
+  // The nominal step: nominalStep() of the look-ahead's intervals (their median, or
+  // their mean when quantised or alternating stamps move the median); time zero one
+  // step before the first sample.
   {
     std::vector<double> steps(imuQ_.size() - 1);
     for (std::size_t k = 1; k < imuQ_.size(); ++k) steps[k - 1] = imuQ_[k].t - imuQ_[k - 1].t;
-    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-    med_ = steps[steps.size() / 2];
+    med_ = nominalStep(std::move(steps));
     const double dt0 = imuQ_[1].t - imuQ_[0].t;
     dt_ = std::abs(dt0 - med_) <= 0.01 * med_ ? dt0 : med_;
   }

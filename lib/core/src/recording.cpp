@@ -1,6 +1,7 @@
 // Physical ranges of a recording's records (see recording.hpp).
 #include "navimpact/core/recording.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "navimpact/core/format.hpp"
@@ -94,6 +95,24 @@ std::string recordProblem(const ReferenceRecord& r) {
       if (!(r.sigma_att->coeff(i) > 0.0 && r.sigma_att->coeff(i) <= M_PI))
         return "reference attitude sigma " + g(r.sigma_att->coeff(i)) + " rad is outside (0, pi] rad";
   return "";
+}
+
+double nominalStep(std::vector<double> steps) {
+  if (steps.empty()) return 0.0;
+  std::vector<double> sorted = steps;
+  const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+  std::nth_element(sorted.begin(), mid, sorted.end());
+  const double med = *mid;
+  if (!(med > 0.0)) return med;
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (double h : steps)
+    if (h > 0.0 && h < 1.75 * med) {  // between quantised steps (<= 1.5 medians) and one lost sample (2)
+      sum += h;
+      ++n;
+    }
+  const double mean = sum / static_cast<double>(n);  // n >= 1: the median itself counts
+  return std::abs(mean - med) > 0.01 * med ? mean : med;
 }
 
 }  // namespace navimpact

@@ -330,12 +330,6 @@ Eigen::Quaterniond quatRpy(double roll, double pitch, double yaw) {
       .normalized();
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 
 }  // namespace
@@ -411,18 +405,18 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     const Eigen::Matrix3d C_FtoB = axesMatrix(k, n["axes"], "imu.axes");
     const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
     if (tab.rows() < 2) throw fileError(s.file, tab.line[0], "the IMU stream needs at least 2 samples");
-    // the nominal step: the rate, or the median time step (the default gap limit is 1.5 of it)
+    // the nominal step: the rate, or nominalStep() of the time steps (the default gap limit is 1.5 of it)
     std::vector<double> t;
     if (s.time_column) {
       std::vector<double> raw(tab.rows());
       for (std::size_t i = 0; i < raw.size(); ++i) raw[i] = tab.columns[tc][i] * s.time_factor;
       std::vector<double> steps(raw.size() - 1);
       for (std::size_t i = 1; i < raw.size(); ++i) steps[i - 1] = raw[i] - raw[i - 1];
-      const double med = median(steps);
-      if (!(med > 0.0))
+      const double nominal = nominalStep(std::move(steps));
+      if (!(nominal > 0.0))
         throw fileError(s.file, tab.line[0], "column '" + printable(s.column) + "' (key imu.time.column): the median time step is not > 0");
-      if (s.max_gap_s == 0.0) s.max_gap_s = 1.5 * med;
-      d.imu_rate_hz = 1.0 / med;
+      if (s.max_gap_s == 0.0) s.max_gap_s = 1.5 * nominal;
+      d.imu_rate_hz = 1.0 / nominal;
     } else {
       d.imu_rate_hz = s.rate_hz;
     }

@@ -110,4 +110,14 @@ std::string recordProblem(const GnssFix& r);
 std::string recordProblem(const BaroSample& r);
 std::string recordProblem(const ReferenceRecord& r);
 
+/// The nominal interval of IMU time stamps from their successive @p steps [s]
+/// (at least one): the median step, which a gap cannot move; but when the
+/// steps shorter than 1.75 medians (no lost sample among them: steps of
+/// quantised stamps reach 1.5 medians, one lost sample makes 2) average more
+/// than 1 % away from it, their mean. Stamps quantised coarser than the
+/// step (400 Hz at 1 ms: 2, 3, 2, 3 ms) or alternating (9, 11 ms) have a
+/// median of one of their values (333 or 500 Hz; 91 or 111 Hz) but the mean
+/// of the true rate (400 Hz; 100 Hz). Not > 0 when the median is not.
+double nominalStep(std::vector<double> steps);
+
 }  // namespace navimpact
