@@ -3,7 +3,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <fstream>
 
 #include "navimpact/core/error.hpp"
@@ -195,4 +197,81 @@ TEST(OutputSet, StaleStagingOfDeadRunsIsRemoved) {
   fs::last_write_time(foreign, fs::file_time_type::clock::now() - std::chrono::hours(24 * 8));
   EXPECT_EQ(OutputSet::removeStaleStaging(base), 1);
   EXPECT_FALSE(fs::exists(foreign));
+}
+
+TEST(OutputSet, AStagingFolderWhoseLockIsHeldIsAliveWhateverItsPid) {
+  // A job in another PID namespace: its pid names no process here (found by a
+  // probe: a second run removed the live staging folder, the first committed
+  // without solution.csv). The lock tells, not the pid.
+  const fs::path base = test::tempDir();
+  std::optional<OutputSet> job(std::in_place, base / "job");
+  fs::path staging;
+  for (const auto& e : fs::directory_iterator(base)) staging = e.path();
+  const std::string name = staging.filename().string(), prefix = OutputSet::kStagingPrefix;
+  const fs::path foreignPid = base / (prefix + "2147483646" + name.substr(name.find('_', prefix.size())));
+  fs::rename(staging, foreignPid);  // the lock moves with the folder
+  EXPECT_EQ(OutputSet::removeStaleStaging(base), 0);
+  job.reset();  // the job ends: its lock is released
+  EXPECT_EQ(OutputSet::removeStaleStaging(base), 1);
+}
+
+TEST(OutputSet, AStagingFolderRemovedUnderTheJobFailsItInsteadOfCommittingPart) {
+  const fs::path base = test::tempDir();
+  {
+    OutputSet out(base / "a");
+    out.writeText("solution.csv", "1\n");
+    fs::remove_all(out.stagingDir());
+    EXPECT_THROW(out.writeText("summary.json", "{}\n"), Error);  // not made again
+    EXPECT_THROW(out.commit(), Error);
+  }
+  {
+    OutputSet out(base / "b");
+    out.writeText("solution.csv", "1\n");
+    out.writeText("summary.json", "{}\n");
+    fs::remove(out.stagingDir() / "solution.csv");
+    try {
+      out.commit();
+      ADD_FAILURE() << "committed without solution.csv";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("solution.csv vanished"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_FALSE(fs::exists(base / "a"));
+  EXPECT_FALSE(fs::exists(base / "b"));
+  EXPECT_EQ(stagingCount(base), 0);
+}
+
+TEST(OutputSet, NamesUpToTheFileSystemLimitAndNoStagingLookalikes) {
+  const fs::path base = test::tempDir();
+  const std::string longName(255, 'e');  // a name the file system holds
+  OutputSet out(base / longName);
+  out.writeText("x.txt", "1\n");
+  out.commit();
+  EXPECT_TRUE(fs::exists(base / longName / "x.txt"));
+  OutputSet file = OutputSet::singleFile(base / (longName.substr(0, 250) + ".yaml"));
+  std::ofstream(file.stagedFile()) << "1\n";
+  file.commit();
+  EXPECT_TRUE(fs::exists(base / (longName.substr(0, 250) + ".yaml")));
+  // an output named like a staging folder would be removed by a later run
+  EXPECT_THROW(OutputSet(base / (std::string(OutputSet::kStagingPrefix) + "1_0123456789abcdef_0123456789abcdef_x")),
+               Error);
+}
+
+TEST(OutputSet, OverwriteNeverReplacesAFolderHoldingAnInputOfTheRun) {
+  const fs::path base = test::tempDir();
+  touch(base / "old" / "config.yaml");
+  touch(base / "old2" / "model.yaml");
+  noteInput(base / "old" / "config.yaml");  // read before the output is made
+  try {
+    OutputSet out(base / "old", Overwrite::Replace);
+    ADD_FAILURE() << "replaced a folder holding an input";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("an input of this run"), std::string::npos) << e.what();
+  }
+  OutputSet late(base / "old2", Overwrite::Replace);
+  late.writeText("x.txt", "1\n");
+  noteInput(base / "old2" / "model.yaml");  // read during the job
+  EXPECT_THROW(late.commit(), Error);
+  EXPECT_TRUE(fs::exists(base / "old" / "config.yaml"));
+  EXPECT_TRUE(fs::exists(base / "old2" / "model.yaml"));
 }

@@ -527,6 +527,7 @@ json readShardJson(const std::string& dir, const std::string& file, const std::s
   const std::string path = dir + "/" + file;
   std::ifstream f(path);
   if (!f) throw Error(path + ": cannot open (is " + dir + " a folder written by navimpact " + writer + "?)");
+  noteInput(path);  // the merged output must not replace a shard (output.hpp)
   json j;
   try {
     f >> j;

@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/output.hpp"
 
 namespace navimpact {
 
@@ -28,6 +29,7 @@ GzInput::GzInput(std::string path) : path_(std::move(path)), z_(std::make_unique
   struct stat st {};
   if (::stat(path_.c_str(), &st) != 0) throw Error(path_ + ": " + (errno == ENOENT ? "file not found" : std::strerror(errno)));
   if (S_ISDIR(st.st_mode)) throw Error(path_ + ": is a folder, not a file");
+  noteInput(path_);  // an output replaced whole must not hold it (output.hpp)
   f_ = std::fopen(path_.c_str(), "rb");
   if (!f_) throw Error(path_ + ": cannot open (" + std::strerror(errno) + ")");
   fileSize_ = S_ISREG(st.st_mode) ? static_cast<std::uint64_t>(st.st_size) : 0;

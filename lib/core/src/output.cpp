@@ -3,6 +3,8 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -10,7 +12,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <mutex>
 #include <random>
+#include <set>
 
 #include "navimpact/core/error.hpp"
 
@@ -47,6 +51,22 @@ bool deeperThanOneLevel(const fs::path& folder) {
   return static_cast<bool>(ec);
 }
 
+std::mutex g_inputsMutex;
+std::set<fs::path>& inputs() {
+  static std::set<fs::path> s;
+  return s;
+}
+
+/// An input of this run inside @p d (canonical), or "".
+std::string inputInside(const fs::path& d) {
+  std::lock_guard<std::mutex> lock(g_inputsMutex);
+  for (const auto& in : inputs()) {
+    const auto rel = in.lexically_relative(d);
+    if (!rel.empty() && *rel.begin() != ".." && rel != ".") return in.string();
+  }
+  return {};
+}
+
 bool isEmptyDir(const fs::path& p) {
   std::error_code ec;
   return fs::is_empty(p, ec) && !ec;
@@ -64,10 +84,29 @@ std::string refuseReplace(const fs::path& dest) {
   if (!rel.empty() && *rel.begin() != "..") return "refusing to replace the current folder or a folder containing it";
   if (deeperThanOneLevel(d))
     return "it holds folders of folders, which no navimpact output does; remove it yourself if it is meant";
+  if (const std::string in = inputInside(d); !in.empty())
+    return "it holds " + in + ", an input of this run (write the output elsewhere)";
   return {};
 }
 
+/// True when a process holds the lock of staging folder @p p (a live job).
+bool lockedByLiveJob(const fs::path& p) {
+  const int fd = ::open(p.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool held = ::flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::close(fd);  // releases the lock if this call took it
+  return held;
+}
+
 }  // namespace
+
+void noteInput(const fs::path& path) {
+  std::error_code ec;
+  const fs::path c = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  if (ec || c.empty()) return;
+  std::lock_guard<std::mutex> lock(g_inputsMutex);
+  inputs().insert(c);
+}
 
 int OutputSet::removeStaleStaging(const fs::path& folder) {
   static const std::string self = hostTag();
@@ -88,8 +127,10 @@ int OutputSet::removeStaleStaging(const fs::path& folder) {
     if (host.find_first_not_of("0123456789abcdef") != std::string::npos) continue;
     bool dead = false;
     if (host == self) {
+      // its lock free (no job holds it, whatever its PID namespace) and its pid gone
+      // (a job of an older build that took no lock)
       const long pid = std::strtol(rest.substr(0, u1).c_str(), nullptr, 10);
-      dead = pid > 0 && kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+      dead = pid > 0 && kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH && !lockedByLiveJob(e.path());
     } else {  // another machine sharing this folder: only when clearly abandoned
       const auto age = fs::file_time_type::clock::now() - fs::last_write_time(e.path(), ec);
       dead = !ec && age > std::chrono::hours(24 * 7);
@@ -153,15 +194,32 @@ OutputSet::OutputSet(fs::path dest, Overwrite ow, Kind kind) : dest_(std::move(d
         if (ow_ == Overwrite::Refuse) throw Error(shown + ": output file exists (pass --overwrite to replace it)");
       }
     }
+    if (abs.filename().string().compare(0, std::strlen(kStagingPrefix), kStagingPrefix) == 0)
+      throw Error(shown + ": an output name starting with " + kStagingPrefix +
+                  " is a staging folder's, which later runs remove (choose another name)");
+    if (ow_ == Overwrite::Replace && fs::exists(st))
+      if (const std::string in = inputInside(fs::weakly_canonical(abs, ec)); !in.empty())
+        throw Error(shown + ": --overwrite: it holds " + in + ", an input of this run (write the output elsewhere)");
     std::random_device rd;
     const std::uint64_t r = (static_cast<std::uint64_t>(rd()) << 32) ^ rd();
     static const std::string host = hostTag();
-    staging_ = parent / (std::string(kStagingPrefix) + std::to_string(getpid()) + "_" + hex16(r) + "_" + host +
-                         "_" + abs.filename().string());
+    // at most 250 bytes (a file name holds 255; ".old" is added while replacing):
+    // the destination's name is only a hint in it
+    std::string name = std::string(kStagingPrefix) + std::to_string(getpid()) + "_" + hex16(r) + "_" + host + "_" +
+                       abs.filename().string();
+    if (name.size() > 250) name.resize(250);
+    staging_ = parent / name;
     if (!fs::create_directory(staging_, ec) || ec)
       throw Error(parent.string() + ": cannot create the staging folder for " + shown + " (" +
                   (ec ? ec.message() : std::string("exists")) + ")");
+    stagingFd_ = ::open(staging_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (stagingFd_ < 0 || ::flock(stagingFd_, LOCK_EX | LOCK_NB) != 0)
+      throw Error(staging_.string() + ": cannot lock the staging folder (" + std::strerror(errno) + ")");
   } catch (...) {
+    if (!staging_.empty()) {
+      fs::remove_all(staging_, ec);
+      releaseStaging();
+    }
     staging_.clear();
     removeCreatedParents();
     throw;
@@ -173,21 +231,43 @@ OutputSet::OutputSet(OutputSet&& o) noexcept
     : dest_(std::move(o.dest_)),
       target_(std::move(o.target_)),
       staging_(std::move(o.staging_)),
+      stagingFd_(o.stagingFd_),
       createdParents_(std::move(o.createdParents_)),
       names_(std::move(o.names_)),
       ow_(o.ow_),
       kind_(o.kind_),
       committed_(o.committed_) {
   o.staging_.clear();
+  o.stagingFd_ = -1;
   o.createdParents_.clear();
   o.committed_ = true;
 }
 
 OutputSet::~OutputSet() {
-  if (committed_ || staging_.empty()) return;
+  if (!committed_ && !staging_.empty()) {
+    std::error_code ec;
+    fs::remove_all(staging_, ec);
+    removeCreatedParents();
+  }
+  releaseStaging();
+}
+
+void OutputSet::releaseStaging() noexcept {
+  if (stagingFd_ >= 0) ::close(stagingFd_);  // and its lock
+  stagingFd_ = -1;
+}
+
+void OutputSet::checkStaging() const {
+  // still the folder this job made (not removed, not replaced by another)
+  struct stat a {}, b {};
+  if (stagingFd_ < 0 || ::fstat(stagingFd_, &a) != 0 || ::stat(staging_.c_str(), &b) != 0 || a.st_dev != b.st_dev ||
+      a.st_ino != b.st_ino)
+    throw Error(dest_.string() + ": the staging folder " + staging_.filename().string() +
+                " was removed while the job ran: nothing was written");
   std::error_code ec;
-  fs::remove_all(staging_, ec);
-  removeCreatedParents();
+  for (const auto& n : names_)
+    if (!fs::is_regular_file(staging_ / n, ec))
+      throw Error(dest_.string() + ": " + n + " vanished from the staging folder while the job ran: nothing was written");
 }
 
 void OutputSet::removeCreatedParents() noexcept {
@@ -206,8 +286,13 @@ fs::path OutputSet::stage(const std::string& name) {
   names_.push_back(rel.string());
   const fs::path p = staging_ / rel;
   std::error_code ec;
-  fs::create_directories(p.parent_path(), ec);
-  if (ec) throw Error(p.parent_path().string() + ": cannot create (" + ec.message() + ")");
+  // the sub-folder only: a staging folder removed under the job is not made again
+  if (!fs::is_directory(staging_, ec))
+    throw Error(dest_.string() + ": the staging folder " + staging_.filename().string() + " was removed while the job ran");
+  if (p.parent_path() != staging_) {
+    fs::create_directory(p.parent_path(), ec);
+    if (ec) throw Error(p.parent_path().string() + ": cannot create (" + ec.message() + ")");
+  }
   return p;
 }
 
@@ -227,6 +312,7 @@ void OutputSet::writeText(const std::string& name, const std::string& content) {
 void OutputSet::commit() {
   if (committed_) throw Error(dest_.string() + ": output committed twice");
   const std::string shown = dest_.string();
+  checkStaging();
   if (kind_ == Kind::File) {
     const fs::path src = stagedFile();
     std::error_code ec;
@@ -264,6 +350,7 @@ void OutputSet::commit() {
   }
   committed_ = true;
   createdParents_.clear();
+  releaseStaging();
 }
 
 std::vector<fs::path> OutputSet::finalPaths() const {

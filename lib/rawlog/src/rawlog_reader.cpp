@@ -1,6 +1,8 @@
 // Rawlog reader: record by record (RawlogReader), or whole (readRawlog). See reader.hpp, writer.hpp.
 #include "navimpact/rawlog/reader.hpp"
 
+#include "navimpact/core/output.hpp"
+
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationGPS.h>
 #include <mrpt/obs/CObservationIMU.h>
@@ -313,6 +315,7 @@ struct RawlogReader::Impl {
 RawlogReader::RawlogReader(const std::string& path, const RawlogReadOptions& opt) : impl_(std::make_unique<Impl>()) {
   InputScope scope(path);
   if (!std::filesystem::exists(path)) throw Error(path + ": rawlog not found");
+  noteInput(path);  // an output replaced whole must not hold it (output.hpp)
   Impl& m = *impl_;
   m.path = path;
   m.head.source = path;

@@ -16,8 +16,17 @@
  * OutputSet is created, before any work, unless Overwrite::Replace is given:
  * then it is replaced whole (old files cannot survive beside the new ones).
  * Replace refuses the file-system root, the home folder, the current folder
- * or a folder containing it, and a folder that holds anything but files and
- * folders of files (navimpact outputs are at most one level deep).
+ * or a folder containing it, a folder that holds anything but files and
+ * folders of files (navimpact outputs are at most one level deep), and a
+ * folder that holds an input of the run (noteInput(): the readers note every
+ * file they open; checked when the OutputSet is made and again at commit()).
+ *
+ * A run holds an exclusive flock() on its staging folder while it lives, so
+ * a staging folder is stale only when no process holds its lock (a run in
+ * another PID namespace, whose pid means nothing here, holds it too) and its
+ * pid is gone. commit() checks that the staging folder is still the one the
+ * run made and holds every file staged: a folder removed under a running job
+ * fails the job instead of committing what it wrote after.
  */
 #pragma once
 
@@ -26,6 +35,10 @@
 #include <vector>
 
 namespace navimpact {
+
+/// Note @p path as an input of this process (readers call it when they open a
+/// file): Overwrite::Replace refuses a destination that holds one. Thread-safe.
+void noteInput(const std::filesystem::path& path);
 
 /// What to do when the destination exists and is not empty.
 enum class Overwrite { Refuse, Replace };
@@ -69,10 +82,13 @@ class OutputSet {
   enum class Kind { Directory, File };
   OutputSet(std::filesystem::path dest, Overwrite ow, Kind kind);
   void removeCreatedParents() noexcept;
+  void releaseStaging() noexcept;
+  void checkStaging() const;
 
   std::filesystem::path dest_;    ///< as given (messages, finalPaths)
   std::filesystem::path target_;  ///< absolute, normalised (file operations)
   std::filesystem::path staging_;
+  int stagingFd_ = -1;  ///< the staging folder, open and flock()ed while the job lives
   std::vector<std::filesystem::path> createdParents_;  ///< folders we created, deepest last
   std::vector<std::string> names_;
   Overwrite ow_ = Overwrite::Refuse;
