@@ -50,7 +50,7 @@ TEST(OneLine, KeepsPlaceAndWhatIsAcceptedWhenCut) {
   const std::string out = oneLine("f.yaml: key 'a': " + std::string(1000, 'v') + " (accepted: 1..10)");
   EXPECT_LE(out.size(), 300u);
   EXPECT_EQ(out.rfind("f.yaml: key 'a': ", 0), 0u);
-  EXPECT_NE(out.find(" ... "), std::string::npos);
+  EXPECT_NE(out.find("..."), std::string::npos);
   EXPECT_EQ(out.substr(out.size() - 17), "(accepted: 1..10)");
   EXPECT_EQ(oneLine("first\n  second\r\nthird\n"), "first; second; third");
   EXPECT_EQ(oneLine("short"), "short");
@@ -79,4 +79,20 @@ TEST(KeyError, EscapesTheKey) {
   const std::string m = keyError("c.yaml", std::string("a\x02") + std::string(500, 'k'), "unknown key").what();
   EXPECT_TRUE(isOneSafeLine(m));
   EXPECT_LT(m.size(), 200u);
+}
+
+TEST(OneLine, ALongPathIsShortenedAndTheCauseKept) {
+  // a 3000-character path printed only its start (found by a probe: the cause
+  // "output folder exists and is not empty (...)" was lost)
+  std::string path;
+  for (int k = 0; k < 15; ++k) path += "/" + std::string(199, 'd');
+  const std::string cause = "output folder exists and is not empty (pass --overwrite to replace it whole)";
+  for (const std::string& msg : {path + ": " + cause, "wv: " + path + "/x.csv: " + cause,
+                                 path + ": " + std::string(4000, 'w') + " " + cause}) {
+    const std::string out = oneLine(msg);
+    EXPECT_LE(out.size(), 300u) << out;
+    EXPECT_TRUE(isOneSafeLine(out)) << out;
+    EXPECT_EQ(out.substr(out.size() - cause.size()), cause) << out;
+    EXPECT_EQ(out.rfind(msg.substr(0, 20), 0), 0u) << out;
+  }
 }

@@ -90,12 +90,14 @@ std::string printable(std::string_view raw, std::size_t max) {
   return out;
 }
 
-std::string oneLine(std::string_view msg, std::size_t max) {
+namespace {
+
+/// @p msg flattened: line breaks (and the white space around them) become
+/// "; ", raw bytes are escaped; at most @p cap characters of @p msg are read.
+std::string flatten(std::string_view msg, std::size_t cap) {
   std::string flat;
-  flat.reserve(std::min(msg.size(), 4 * max) + 8);
-  // Line breaks (and the white space around them) become "; ".
   std::size_t i = 0;
-  while (i < msg.size() && flat.size() < 8 * max) {
+  while (i < msg.size() && i < cap) {
     if (msg[i] == '\n' || msg[i] == '\r') {
       while (!flat.empty() && (flat.back() == ' ' || flat.back() == '\t')) flat.pop_back();
       while (i < msg.size() && (msg[i] == '\n' || msg[i] == '\r' || msg[i] == ' ' || msg[i] == '\t')) ++i;
@@ -105,16 +107,57 @@ std::string oneLine(std::string_view msg, std::size_t max) {
     const std::size_t used = appendEscaped(flat, msg, i, 1, false);
     i += used ? used : 1;
   }
-  const bool cutInput = i < msg.size();
-  if (flat.size() <= max && !cutInput) return flat;
+  return flat;
+}
+
+bool continuationByte(const std::string& s, std::size_t k) {
+  return k < s.size() && (static_cast<unsigned char>(s[k]) & 0xC0) == 0x80;
+}
+
+/// Runs of more than @p longest non-blank characters (long paths) shortened
+/// to their start and end around "...", on character boundaries.
+std::string shortenLongWords(const std::string& s, std::size_t longest) {
+  std::string out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    std::size_t j = i;
+    while (j < s.size() && s[j] != ' ') ++j;
+    if (j - i > longest) {
+      std::size_t h = i + longest / 3, t = j - (longest - longest / 3 - 3);
+      while (h > i && continuationByte(s, h)) --h;
+      while (t < j && continuationByte(s, t)) ++t;
+      out.append(s, i, h - i).append("...").append(s, t, j - t);
+    } else {
+      out.append(s, i, j - i);
+    }
+    if (j < s.size()) out += ' ';
+    i = j + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string oneLine(std::string_view msg, std::size_t max) {
+  // A long message is read at its start (where) and its end (what is wrong,
+  // what is accepted); long paths in it are shortened in their middle first.
+  const std::size_t cap = 4 * max;
+  std::string flat;
+  if (msg.size() <= 2 * cap) {
+    flat = flatten(msg, msg.size());
+  } else {
+    std::size_t t = msg.size() - cap;
+    while (t < msg.size() && (static_cast<unsigned char>(msg[t]) & 0xC0) == 0x80) ++t;
+    flat = flatten(msg.substr(0, cap), cap) + " ... " + flatten(msg.substr(t), cap);
+  }
+  if (flat.size() <= max) return flat;
+  flat = shortenLongWords(flat, 80);
+  if (flat.size() <= max) return flat;
   // Keep the start (where) and the end (what is accepted); cut on character boundaries.
   const std::size_t tail = max / 4, head = max - tail - 5;
-  auto continuation = [&flat](std::size_t k) {
-    return k < flat.size() && (static_cast<unsigned char>(flat[k]) & 0xC0) == 0x80;
-  };
   std::size_t h = head, t = flat.size() - tail;
-  while (h > 0 && continuation(h)) --h;
-  while (t < flat.size() && continuation(t)) ++t;
+  while (h > 0 && continuationByte(flat, h)) --h;
+  while (t < flat.size() && continuationByte(flat, t)) ++t;
   return flat.substr(0, h) + " ... " + flat.substr(t);
 }
 
