@@ -474,3 +474,26 @@ TEST(RawlogWriter, BlocksMakeTheSameFileAsTheWholeRecording) {
     EXPECT_TRUE(bytes(p) == bytes(whole));
   }
 }
+
+// A full disk is one line naming the rawlog, exit 1 material: the write error
+// is no longer thrown through MRPT's archive, which wrapped it in its own
+// multi-line text with a call stack (exit 4 "internal error"; found by a probe
+// on a small tmpfs). /dev/full fails every write as a full disk does.
+TEST(RawlogWriter, AFullDiskIsOneClearError) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  Recording big = sample();
+  const Recording one = sample();
+  while (big.imu.size() < 200000) {  // more than one gzip member (4 MiB of entries)
+    const double shift = big.imu.back().t - one.imu.front().t + 0.005;
+    for (auto r : one.imu) {
+      r.t += shift;
+      big.imu.push_back(r);
+    }
+  }
+  for (const bool gzip : {true, false}) {
+    navimpact::rawlog::RawlogWriteOptions o;
+    o.gzip = gzip;
+    const std::string m = navimpact::test::errorOf([&] { navimpact::rawlog::writeRawlog("/dev/full", big, o); });
+    EXPECT_EQ(m, "/dev/full: cannot write the rawlog (disk full?)") << "gzip " << gzip;
+  }
+}

@@ -45,16 +45,22 @@ GzMemberSink::~GzMemberSink() {
 }
 
 size_t GzMemberSink::Write(const void* buf, size_t n) {
+  pos_ += n;
+  if (!failure_.empty()) return n;  // the file is lost already: failure() tells the writer
   const char* p = static_cast<const char*>(buf);
   size_t left = n;
-  while (left > 0) {
-    const size_t take = std::min(left, kBlock - block_.size());
-    block_.append(p, take);
-    p += take;
-    left -= take;
-    if (block_.size() == kBlock) submit();
+  try {
+    while (left > 0) {
+      const size_t take = std::min(left, kBlock - block_.size());
+      block_.append(p, take);
+      p += take;
+      left -= take;
+      if (block_.size() == kBlock) submit();
+    }
+  } catch (const std::exception& e) {
+    failure_ = e.what();
+    block_.clear();
   }
-  pos_ += n;
   return n;
 }
 
@@ -75,6 +81,12 @@ void GzMemberSink::writeFront() {
 }
 
 void GzMemberSink::close() {
+  if (!failure_.empty()) {
+    pending_.clear();  // (their futures wait in their destructors)
+    if (f_) std::fclose(f_);
+    f_ = nullptr;
+    throw Error(failure_);
+  }
   if (!f_) return;
   if (!block_.empty() || (pos_ == 0 && pending_.empty())) submit();  // an empty stream is one empty member
   while (!pending_.empty()) writeFront();

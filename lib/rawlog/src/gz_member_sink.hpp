@@ -30,11 +30,17 @@ class GzMemberSink : public mrpt::io::CStream {
   uint64_t getTotalBytesCount() const override { return pos_; }
   uint64_t getPosition() const override { return pos_; }
   std::string getStreamDescription() const override { return path_; }
+  /// The first write failure ("FILE: cannot write the rawlog (disk full?)"), or
+  /// "". Write() never throws through MRPT's archive (which would wrap the
+  /// message in its own multi-line text): it records the failure, drops what
+  /// follows, and the writer checks failure() after each batch; close() throws it.
+  const std::string& failure() const { return failure_; }
 
  private:
   void submit();       // hand the current block to a worker
   void writeFront();   // wait for the oldest member and write it
   std::string path_;
+  std::string failure_;
   int level_;
   std::FILE* f_ = nullptr;
   std::string block_;

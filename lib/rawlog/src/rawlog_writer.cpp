@@ -86,6 +86,7 @@ RawlogWriter::RawlogWriter(const std::string& path, const Recording& d, const Ra
     c.timestamp = stamp(w.su, 0.0);
     c.text = d.metadata;
     w.arch << c;
+    if (!w.out.failure().empty()) throw Error(w.out.failure());
   }
   w.imu.sensorLabel = "IMU";
   {  // the values are body FRD: the IMU's mounting in MRPT's vehicle frame (x forward, y left, z up)
@@ -156,6 +157,7 @@ void RawlogWriter::append(const Recording& block, double complete_until_s) {
   w.pending.gnss.swap(keep.gnss);
   w.pending.baro.swap(keep.baro);
   w.pending.reference.swap(keep.reference);
+  if (!w.out.failure().empty()) throw Error(w.out.failure());  // a full disk (gz_member_sink.hpp)
 }
 
 void RawlogWriter::close() {
