@@ -258,12 +258,15 @@ void NavRunner::start(const ins::ImuSample& first) {
   m.record(m.x0.t, 0.5 * m.dt0);
 }
 
-void NavRunner::step(const ins::ImuSample& s) {
+void NavRunner::step(const ins::ImuSample& s) { stepUnmeasured(s, 0.0, 0.0); }
+
+void NavRunner::stepUnmeasured(const ins::ImuSample& s, double psd_w, double psd_f) {
   Impl& m = *impl_;
   if (!(s.dt > 0.0) || std::abs(s.t - s.dt - m.t_prev) > 1e-6 * (1.0 + std::abs(m.t_prev)))
     throw Error("navigation run: IMU sample at " + formatNumber(s.t, 10) + " s (dt " + formatNumber(s.dt, 10) +
                 " s) does not follow the previous one at " + formatNumber(m.t_prev, 10) + " s");
   m.ekf.predict(s);
+  if (psd_w > 0.0 || psd_f > 0.0) m.ekf.addSensorNoise(s.dt, psd_w, psd_f);
   ++m.res.steps;
   m.applyAids(s);
   m.applyAiding(s.t, 0.5 * s.dt);

@@ -230,7 +230,12 @@ class ReplayDriver {
   double med_ = 0.0, dt_ = 0.0;
   double prevT_ = 0.0;               // time of the last IMU record turned into samples
   std::size_t produced_ = 0;         // samples produced (gap fillers included)
-  std::deque<ins::ImuSample> samples_;
+  struct Sample {
+    ins::ImuSample s;
+    double psd_w = 0.0, psd_f = 0.0;  // unmeasured (in a gap): the rates' uncertainty (nextSample)
+  };
+  std::deque<Sample> samples_;
+  std::deque<ImuRecord> recent_;     // the last kRecentImu records (a gap's rate variability)
   std::size_t gaps_ = 0;
   double longest_ = 0.0, longestAt_ = 0.0;
   bool firstRecord_ = true;
@@ -270,7 +275,8 @@ class ReplayDriver {
   void fillTo(double t) {
     while (!eof_ && readT_ <= t) readOne();
   }
-  bool nextSample(ins::ImuSample& s);
+  bool nextSample(ins::ImuSample& s, double* psd_w = nullptr, double* psd_f = nullptr);
+  std::pair<double, double> gapPsd(const ImuRecord& after, double h) const;
   bool peekSample();
   void takeGnss(GnssFix f);
   void takeBaro(BaroSample b);
@@ -391,12 +397,46 @@ void ReplayDriver::takeReference(const ReferenceRecord& g) {
   }
 }
 
+/// Records kept for a gap's rate variability (20 s at 200 Hz).
+constexpr std::size_t kRecentImu = 4096;
+
+// The rates' uncertainty across an IMU gap of @p h seconds ending at @p after:
+// each rate is taken as a random walk of increment variance q per second,
+// pinned at the samples before and after the gap (a Brownian bridge; the
+// interpolated rates are its mean). Its integral over the gap, the attitude
+// (velocity) error, has variance q h^3 / 12: white noise of PSD q h^2 / 12 over
+// the gap's sub-steps gives the same. q per axis, the largest: the larger of
+// the rates' change across the gap squared over h and the mean squared change
+// over a lag of h (or the longest lag held, scaled as a random walk) in the
+// records before it (sensor noise included: conservative).
+std::pair<double, double> ReplayDriver::gapPsd(const ImuRecord& after, double h) const {
+  const ImuRecord& before = recent_.back();
+  double qw = (after.w_IB_B - before.w_IB_B).cwiseAbs2().maxCoeff() / h;
+  double qf = (after.f_B - before.f_B).cwiseAbs2().maxCoeff() / h;
+  if (recent_.size() >= 2) {
+    const std::size_t lag = std::min<std::size_t>(recent_.size() - 1,
+                                                  std::max<std::size_t>(1, std::size_t(std::llround(h / med_))));
+    Eigen::Vector3d dw = Eigen::Vector3d::Zero(), df = Eigen::Vector3d::Zero();
+    for (std::size_t k = lag; k < recent_.size(); ++k) {
+      dw += (recent_[k].w_IB_B - recent_[k - lag].w_IB_B).cwiseAbs2();
+      df += (recent_[k].f_B - recent_[k - lag].f_B).cwiseAbs2();
+    }
+    const double n = double(recent_.size() - lag), tau = recent_.back().t - recent_[recent_.size() - 1 - lag].t;
+    if (tau > 0.0) {
+      qw = std::max(qw, dw.maxCoeff() / n / tau);
+      qf = std::max(qf, df.maxCoeff() / n / tau);
+    }
+  }
+  return {qw * h * h / 12.0, qf * h * h / 12.0};
+}
+
 // The next IMU sample: IMU records in order, an interval longer than
 // kImuGapSteps nominal steps is a gap: an error unless the configuration
 // allows gaps up to max_imu_gap_s, then the filter propagates across it in
-// nominal-length sub-steps with the rates of the sample after the gap held
-// constant, and the outputs say so.
-bool ReplayDriver::nextSample(ins::ImuSample& s) {
+// nominal-length sub-steps with the rates interpolated between the samples
+// before and after it, their uncertainty (gapPsd) added to the covariance,
+// and the outputs say so.
+bool ReplayDriver::nextSample(ins::ImuSample& s, double* psd_w, double* psd_f) {
   while (samples_.empty()) {
     while (imuQ_.empty() && !eof_) readOne();
     if (imuQ_.empty()) return false;
@@ -415,10 +455,19 @@ bool ReplayDriver::nextSample(ins::ImuSample& s) {
       const auto oneGap = static_cast<std::size_t>(std::llround(cfg_.max_imu_gap_s / med_)) + 1;
       if (produced_ + m > 2 * imuRecords_ + 16 + oneGap)
         throw Error(cfg_.rawlog + ": IMU gaps hold more missing samples than the data has samples");
+      const ImuRecord& before = recent_.back();
+      const auto [pw, pf] = gapPsd(rec, h);
       double last = prevT_;
       for (std::size_t j = 1; j <= m; ++j) {
         const double t = j == m ? rec.t : prevT_ + h * static_cast<double>(j) / static_cast<double>(m);
-        samples_.push_back(ins::ImuSample::fromRates(t, t - last, rec.w_IB_B, rec.f_B));
+        if (j == m) {  // the sample after the gap: measured over its own nominal step
+          samples_.push_back({ins::ImuSample::fromRates(t, t - last, rec.w_IB_B, rec.f_B), pw, pf});
+        } else {
+          const double a = (0.5 * (t + last) - prevT_) / h;  // the sub-step's middle
+          samples_.push_back({ins::ImuSample::fromRates(t, t - last, (1.0 - a) * before.w_IB_B + a * rec.w_IB_B,
+                                                        (1.0 - a) * before.f_B + a * rec.f_B),
+                              pw, pf});
+        }
         last = t;
       }
       produced_ += m;
@@ -428,22 +477,26 @@ bool ReplayDriver::nextSample(ins::ImuSample& s) {
         longestAt_ = rec.t - r_.t_zero;
       }
     } else {
-      samples_.push_back(ins::ImuSample::fromRates(rec.t, h, rec.w_IB_B, rec.f_B));
+      samples_.push_back({ins::ImuSample::fromRates(rec.t, h, rec.w_IB_B, rec.f_B)});
       ++produced_;
     }
     firstRecord_ = false;
     prevT_ = rec.t;
+    recent_.push_back(rec);
+    if (recent_.size() > kRecentImu) recent_.pop_front();
   }
-  s = samples_.front();
+  s = samples_.front().s;
+  if (psd_w) *psd_w = samples_.front().psd_w;
+  if (psd_f) *psd_f = samples_.front().psd_f;
   samples_.pop_front();
   return true;
 }
 
 bool ReplayDriver::peekSample() {
   if (!samples_.empty()) return true;
-  ins::ImuSample s;
-  if (!nextSample(s)) return false;
-  samples_.push_front(s);
+  Sample x;
+  if (!nextSample(x.s, &x.psd_w, &x.psd_f)) return false;
+  samples_.push_front(x);
   return true;
 }
 
@@ -699,7 +752,7 @@ void ReplayDriver::run() {
 
   // The filter, fed as the records come.
   if (!peekSample()) throw Error("navigation run: no IMU samples");
-  const double dt0 = samples_.front().dt;
+  const double dt0 = samples_.front().s.dt;
   runner_.emplace(x0, dt0, hasTruth_, model, opt_);
   NavRunner& run = *runner_;
   run.keep_epochs = obs_ == nullptr;
@@ -728,7 +781,7 @@ void ReplayDriver::run() {
   if (obs_) obs_->begin(r);
   decideWindows(x0.t + dt0);
   fillTo(x0.t + 0.5 * dt0);
-  run.start(samples_.front());  // peekSample() above: the first sample is there
+  run.start(samples_.front().s);  // peekSample() above: the first sample is there
   // a negative time-offset estimate applies a fix before its own time stamp
   // (NavRunner): the records are read that far ahead
   const double fixLookahead = opt_.ekf.imu.extra.time_offset_sigma_s > 0.0 ? -limits::kTimeOffsetS.lo : 0.0;
@@ -736,14 +789,15 @@ void ReplayDriver::run() {
   // without sigma) name the rawlog whose data caused them; the reader's name it already
   try {
     ins::ImuSample s;
-    while (nextSample(s)) {
+    double psd_w = 0.0, psd_f = 0.0;
+    while (nextSample(s, &psd_w, &psd_f)) {
       if (s.t - r.t_zero > stopAfter_) {
         while (!eof_) readOne();  // what depends on the whole data (reference content, data end) as in a full replay
         break;
       }
       decideWindows(s.t + s.dt);
       fillTo(s.t + 0.5 * s.dt + fixLookahead);
-      run.step(s);
+      run.stepUnmeasured(s, psd_w, psd_f);  // psd 0: a measured sample (run.step)
     }
     r.run = run.finish();
   } catch (const Error& e) {

@@ -583,6 +583,16 @@ void ErrorStateEkf::flushPropagation() {
   applyTransition();
 }
 
+void ErrorStateEkf::addSensorNoise(double dt, double psd_w, double psd_f) {
+  if (!(dt > 0.0 && std::isfinite(dt) && psd_w >= 0.0 && std::isfinite(psd_w) && psd_f >= 0.0 &&
+        std::isfinite(psd_f)))
+    throw Error("sensor noise at t = " + formatNumber(state().t, 9) + " s: dt > 0 and finite PSDs >= 0 expected");
+  flushPropagation();
+  // Qd = G Qc G' dt with G = C_BtoN on psi and dv (Groves 14.80, first order)
+  P_.diagonal().segment<3>(kVel).array() += psd_f * dt;
+  P_.diagonal().segment<3>(kAtt).array() += psd_w * dt;
+}
+
 void ErrorStateEkf::checkP(const char* where) const {
   const auto d = P_.diagonal();
   const double scale = d.cwiseAbs().maxCoeff();

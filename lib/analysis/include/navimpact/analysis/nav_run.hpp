@@ -221,6 +221,10 @@ class NavRunner {
   void start(const ins::ImuSample& first);
   /// One IMU sample (contiguous with the previous one).
   void step(const ins::ImuSample& s);
+  /// A sample the IMU did not measure (in a gap, rates interpolated): step(s),
+  /// plus white rate and force noise of PSDs @p psd_w, @p psd_f over its
+  /// interval (ErrorStateEkf::addSensorNoise).
+  void stepUnmeasured(const ins::ImuSample& s, double psd_w, double psd_f);
   /// The result; the runner is done.
   NavRunResult finish();
 

@@ -209,6 +209,16 @@ class ErrorStateEkf {
   /// Apply any pending (accumulated) covariance propagation now.
   void flushPropagation();
 
+  /**
+   * Sensor uncertainty the error model does not hold, over the last sample's
+   * interval @p dt: white angular-rate and specific-force noise of PSD
+   * @p psd_w [(rad/s)^2/Hz] and @p psd_f [(m/s^2)^2/Hz] on every axis, to
+   * first order in dt (P_psi += psd_w dt I, P_v += psd_f dt I; C I C' = I).
+   * For samples the IMU did not measure (a gap crossed with interpolated
+   * rates); call it after their predict(). Flushes the pending propagation.
+   */
+  void addSensorNoise(double dt, double psd_w, double psd_f);
+
   // ---- measurement updates ----------------------------------------------
   /**
    * GNSS position of the antenna (Groves 14.? loosely coupled, lever arm 14.110).
