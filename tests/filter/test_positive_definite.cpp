@@ -181,3 +181,30 @@ TEST(PositiveDefinite, AnIndefiniteCovarianceIsRefusedNamingTimeAndState) {
   EXPECT_EQ(near.pdFirstRepairTime(), x0.t);
   EXPECT_GE(floorCorrelationMin(near.P(), near.varianceFloor()), -1e-12);
 }
+
+// Sensor noise the model does not hold (samples of an IMU gap): after the
+// pending propagation, P_psi grows by psd_w dt and P_v by psd_f dt on each axis
+// (Qd = C diag(psd) C' dt = psd dt I), nothing else changes; bad values refused.
+TEST(PositiveDefinite, AddedSensorNoiseIsPsdTimesDtOnAttitudeAndVelocity) {
+  const stochastic::ImuModel m = ftest::model({Process::wn(1e-4), Process::rw(1e-6)}, {Process::wn(1e-3)}, 100.0);
+  const ins::NavState x0 = ftest::staticState();
+  filter::EkfConfig c;
+  c.propagate_every = 7;  // a propagation is pending when the noise comes
+  filter::ErrorStateEkf a(x0, 0.01 * filter::Matrix9d::Identity(), m, c), b = a;
+  for (const auto& s : ftest::simulateStatic(x0, m, 13, 5)) {
+    a.predict(s);
+    b.predict(s);
+  }
+  const double dt = 0.01, pw = 3e-7, pf = 2e-4;
+  a.addSensorNoise(dt, pw, pf);
+  b.flushPropagation();
+  Eigen::MatrixXd added = Eigen::MatrixXd::Zero(a.size(), a.size());
+  for (int i = 0; i < 3; ++i) {
+    added(3 + i, 3 + i) = pf * dt;
+    added(6 + i, 6 + i) = pw * dt;
+  }
+  EXPECT_LE((a.P() - b.P() - added).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_THROW(a.addSensorNoise(0.0, pw, pf), Error);
+  EXPECT_THROW(a.addSensorNoise(dt, -1.0, pf), Error);
+  EXPECT_THROW(a.addSensorNoise(dt, pw, NAN), Error);
+}
