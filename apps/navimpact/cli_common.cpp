@@ -34,6 +34,26 @@ CLI::Validator within(const limits::Range& r, bool hi_open) {
       text);
 }
 
+CLI::Validator parsedBy(std::function<void(const std::string&)> parse, std::string text) {
+  return CLI::Validator(
+      [parse](std::string& s) -> std::string {
+        try {
+          parse(s);
+          return std::string();
+        } catch (const Error& e) {
+          // "--flag: what" -> "what"; "--flag 'value': what" -> "'value': what" (CLI11 names the flag)
+          std::string m = e.what();
+          if (m.rfind("--", 0) == 0) {
+            const auto end = m.find_first_of(" :");
+            if (end != std::string::npos && m.compare(end, 2, ": ") == 0) m = m.substr(end + 2);
+            else if (end != std::string::npos && m.compare(end, 2, " '") == 0) m = m.substr(end + 1);
+          }
+          return m;
+        }
+      },
+      std::move(text));
+}
+
 CLI::Validator seedValue() {
   return CLI::Validator(
       [](std::string& s) -> std::string {

@@ -53,6 +53,13 @@ inline constexpr limits::Range kAlpha{0.0, 0.5, true, ""};
 /// Worker threads --threads: 0 (all cores) .. 1024, as monte_carlo.threads.
 inline constexpr limits::Range kThreads{0.0, 1024.0, false, ""};
 
+/// A flag's text checked by the library's own parser @p parse (which throws
+/// navimpact::Error on a bad value) when the command line is read, so that a
+/// value it refuses is a command-line error (exit 2, "see --help") like a
+/// number out of its range; the parser's message is kept, without a leading
+/// "FLAG: " (CLI11 names the flag). @p text is the value's form in --help.
+CLI::Validator parsedBy(std::function<void(const std::string&)> parse, std::string text);
+
 /// A seed: an integer 0 .. 2^64 - 1 in decimal digits (CLI11 read "-1" as
 /// 2^64 - 1, a silent wrap), the same seeds as a configuration's seed keys.
 CLI::Validator seedValue();

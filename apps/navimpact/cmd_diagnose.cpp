@@ -269,7 +269,9 @@ navimpact::cli::Registrar reg(
            ->check(CLI::IsMember({"geodetic"}))
            ->capture_default_str();
        app.add_option("--outage", o->outages,
-                      "GNSS outage START:DURATION [s from the trajectory start] (repeatable)");
+                      "GNSS outage START:DURATION [s from the trajectory start] (repeatable)")
+           ->check(navimpact::cli::parsedBy([](const std::string& s) { navimpact::parseOutage(s, "--outage"); },
+                                            "START:DURATION"));
        app.add_option("--nav-runs", o->nav_runs,
                       "paired navigation runs (recording windows x GNSS/baro noise), >= 2")
            ->capture_default_str()

@@ -47,6 +47,34 @@ std::pair<double, double> range(const std::string& flag, const std::string& v) {
   }
 }
 
+/// --causes a,b,...: the causes' names (analysis::causeName).
+std::vector<na::Cause> parseCauses(const std::string& text) {
+  std::vector<na::Cause> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    bool ok = false;
+    for (int c = 0; c <= static_cast<int>(na::Cause::Outliers); ++c)
+      if (item == na::causeName(static_cast<na::Cause>(c))) {
+        out.push_back(static_cast<na::Cause>(c));
+        ok = true;
+      }
+    if (!ok)
+      throw navimpact::Error("--causes: unknown cause '" + navimpact::printable(item, 40) +
+                             "' (white_noise, quantization_noise, random_walk, drift, gauss_markov, sinusoid, "
+                             "level_shift, outliers)");
+  }
+  return out;
+}
+
+/// --rate LO:HI within the documented IMU rates.
+void checkRateRange(const std::string& v) {
+  const auto [a, b] = range("--rate", v);
+  if (!(a >= navimpact::limits::kImuRateHz.lo && b <= navimpact::limits::kImuRateHz.hi))
+    throw navimpact::Error("--rate '" + navimpact::printable(v, 60) + "': rates must be in " +
+                           navimpact::limits::describe(navimpact::limits::kImuRateHz));
+}
+
 int run(const Opts& o) {
   navimpact::OutputSet out(o.out, navimpact::cli::overwriteMode(o.overwrite));
   pw::PowerOptions p;
@@ -64,19 +92,7 @@ int run(const Opts& o) {
     p.ranges.min_samples = static_cast<std::size_t>(a);
     p.ranges.max_samples = static_cast<std::size_t>(b);
   }
-  if (!o.causes.empty()) {
-    std::stringstream ss(o.causes);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-      bool ok = false;
-      for (int c = 0; c <= static_cast<int>(na::Cause::Outliers); ++c)
-        if (item == na::causeName(static_cast<na::Cause>(c))) {
-          p.causes.push_back(static_cast<na::Cause>(c));
-          ok = true;
-        }
-      if (!ok) throw navimpact::Error("--causes: unknown cause '" + item + "' (white_noise, quantization_noise, random_walk, drift, gauss_markov, sinusoid, level_shift, outliers)");
-    }
-  }
+  if (!o.causes.empty()) p.causes = parseCauses(o.causes);
   if (!(o.alpha > 0 && o.alpha < 0.5)) throw navimpact::Error("--alpha must be in (0, 0.5)");
   p.seed = o.seed;
   p.alpha = o.alpha;
@@ -116,11 +132,22 @@ navimpact::cli::Registrar reg(
        app.add_option("--null-runs", o->null_runs, "null records (six channels, drawn from the model)")
            ->capture_default_str()
            ->check(navimpact::cli::within(counts));
-       app.add_option("--snr", o->snr, "effect size as multiples of the detection limit, drawn log-uniform LO:HI")->capture_default_str();
-       app.add_option("--rate", o->rate, "sampling rate range LO:HI [Hz], log-uniform")->capture_default_str();
-       app.add_option("--duration-h", o->duration_h, "record duration range LO:HI [h], log-uniform (e.g. 0.5:10; overrides --samples)");
-       app.add_option("--samples", o->samples, "record length range LO:HI [samples], log-uniform")->capture_default_str();
-       app.add_option("--causes", o->causes, "comma-separated causes (default: all eight)");
+       auto lohi = [](const char* flag) {
+         return navimpact::cli::parsedBy([flag](const std::string& s) { range(flag, s); }, "LO:HI");
+       };
+       app.add_option("--snr", o->snr, "effect size as multiples of the detection limit, drawn log-uniform LO:HI")
+           ->capture_default_str()
+           ->check(lohi("--snr"));
+       app.add_option("--rate", o->rate, "sampling rate range LO:HI [Hz], log-uniform")
+           ->capture_default_str()
+           ->check(navimpact::cli::parsedBy(checkRateRange, "LO:HI"));
+       app.add_option("--duration-h", o->duration_h, "record duration range LO:HI [h], log-uniform (e.g. 0.5:10; overrides --samples)")
+           ->check(lohi("--duration-h"));
+       app.add_option("--samples", o->samples, "record length range LO:HI [samples], log-uniform")
+           ->capture_default_str()
+           ->check(lohi("--samples"));
+       app.add_option("--causes", o->causes, "comma-separated causes (default: all eight)")
+           ->check(navimpact::cli::parsedBy([](const std::string& s) { parseCauses(s); }, "CAUSE,..."));
        app.add_option("--seed", o->seed, "root seed")->capture_default_str()->check(navimpact::cli::seedValue());
        app.add_option("--alpha", o->alpha, "family-wise level of each diagnosis")
            ->capture_default_str()

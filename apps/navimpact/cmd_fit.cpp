@@ -88,7 +88,8 @@ navimpact::cli::Registrar reg({
                      "GM/RW ridges) or asymptotic (delta method)");
       app.add_option("--weights", o->fit.weights,
                      "GMWM weights: r (default, the R package's 1/(CI_hi-CI_lo)^2), model (iterated "
-                     "model-based diagonal) or efficient (inverse of the full WV covariance)");
+                     "model-based diagonal) or efficient (inverse of the full WV covariance)")
+          ->check(CLI::IsMember({"r", "model", "efficient"}));
       auto* robust = app.add_flag("--robust", o->fit.robust,
                    "robust GMWM: replace isolated spikes, then fit the robust WV (Tukey biweight M-scale, "
                    "Guerrier, Molinari & Victoria-Feser 2014) with its own CI and weights; for records with outliers");

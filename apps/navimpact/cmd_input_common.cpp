@@ -60,10 +60,23 @@ void addInputOptions(CLI::App& app, InputOpts& o) {
   app.add_option("--rate", o.rate_hz,
                  "sampling rate [Hz]; required for CSV without a time column, checked for rawlog")
       ->check(within(limits::kImuRateHz));
+  auto unitOf = [](units::Quantity q) {
+    return parsedBy(
+        [q](const std::string& u) {
+          try {
+            units::toSiFactor(q, u);
+          } catch (const Error&) {
+            throw Error("'" + printable(u, 40) + "' is not a known unit (accepted: " + joined(units::acceptedUnits(q)) + ")");
+          }
+        },
+        "UNIT");
+  };
   app.add_option("--gyro-unit", o.gyro_unit,
-                 "CSV gyroscope unit: rad/s, deg/s, deg/h, mrad/s (default: from the header)");
+                 "CSV gyroscope unit: rad/s, deg/s, deg/h, mrad/s (default: from the header)")
+      ->check(unitOf(units::Quantity::AngularRate));
   app.add_option("--acc-unit", o.acc_unit,
-                 "CSV accelerometer unit: m/s2, g, mg, ug (default: from the header)");
+                 "CSV accelerometer unit: m/s2, g, mg, ug (default: from the header)")
+      ->check(unitOf(units::Quantity::SpecificForce));
   app.add_option("--axes", o.axes,
                  "sensor-to-body FRD axes, e.g. x,-y,-z for a forward-left-up sensor");
   app.add_option("--label", o.label, "rawlog sensor label of the IMU observations")

@@ -36,10 +36,14 @@ navimpact::cli::Registrar reg({
                      "IMU error model of the filter, FILE[:NAME] (default: the model recorded in the rawlog)");
       app.add_option("--outage", o->outages,
                      "GNSS outage START:DURATION [s] from the start of the IMU data; repeatable; "
-                     "replaces the configuration's outages");
+                     "replaces the configuration's outages")
+          ->check(navimpact::cli::parsedBy([](const std::string& s) { navimpact::parseOutage(s, "--outage"); },
+                                           "START:DURATION"));
       app.add_option("--outages-every", o->outages_every,
                      "GNSS outages all along the run, PERIOD:DURATION [s]: each after PERIOD - DURATION s of "
-                     "GNSS from the filter start; added to the other outages");
+                     "GNSS from the filter start; added to the other outages")
+          ->check(navimpact::cli::parsedBy([](const std::string& s) { navimpact::parseOutagePattern(s); },
+                                           "PERIOD:DURATION"));
       app.add_option("--propagate-every", o->propagate_every,
                      "propagate the covariance every k IMU samples (default 10)")
           ->check(CLI::Range(1, navimpact::limits::kMaxPropagateEvery));

@@ -92,7 +92,9 @@ navimpact::cli::Registrar regStudy({"study",
                                           ->check(CLI::Range(0, 1024));
                                       app.add_option("--shard", o->shard,
                                                      "K/N: run only the run indices i with i % N == K-1 and write "
-                                                     "partial results for study-merge");
+                                                     "partial results for study-merge")
+                                          ->check(navimpact::cli::parsedBy(
+                                              [](const std::string& s) { an::parseShard(s); }, "K/N"));
                                       return [o]() -> int { return runStudyCmd(*o); };
                                     }});
 

@@ -261,7 +261,8 @@ navimpact::cli::Registrar regSweep(
            ->check(CLI::Range(0, 1024));
        app.add_option("--shard", o->shard,
                       "K/N: run only the run indices i with i % N == K-1 (in every column) and write partial "
-                      "results for sweep-merge");
+                      "results for sweep-merge")
+           ->check(navimpact::cli::parsedBy([](const std::string& s) { an::parseShard(s); }, "K/N"));
        navimpact::cli::addOverwriteFlag(app, o->overwrite);
        app.add_flag("--allow-large", o->allow_large,
                     "run above the work and memory budgets (IMU steps, workers' memory; README \"Ranges and budgets\"); "

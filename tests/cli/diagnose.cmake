@@ -85,12 +85,12 @@ navimpact_cli_fail(cli_diagnose_recording_shorter_than_trajectory EXIT 1 NOOUT $
 # Detection-power sweep: a tiny run writes its table and records every run;
 # bad flags fail before any work.
 navimpact_cli_check(cli_diagnose_power_small CHECK diagnose_power DEFINES OUT=${_dg_out}/power)
-navimpact_cli_fail(cli_diagnose_power_bad_cause EXIT 1 NOOUT ${_dg_out}/bad10
+navimpact_cli_fail(cli_diagnose_power_bad_cause EXIT 2 NOOUT ${_dg_out}/bad10
   ARGS diagnose-power --out ${_dg_out}/bad10 --causes sinusoid,wobble
-  REGEX "^navimpact: --causes: unknown cause 'wobble'")
-navimpact_cli_fail(cli_diagnose_power_bad_snr EXIT 1 NOOUT ${_dg_out}/bad11
+  REGEX "^navimpact: --causes: unknown cause 'wobble' .*\\(see 'navimpact diagnose-power --help'\\)$")
+navimpact_cli_fail(cli_diagnose_power_bad_snr EXIT 2 NOOUT ${_dg_out}/bad11
   ARGS diagnose-power --out ${_dg_out}/bad11 --snr 5
-  REGEX "^navimpact: --snr '5': expected LO:HI")
+  REGEX "^navimpact: --snr: '5': expected LO:HI")
 # diagnose-power's counts, rates and record lengths have ranges and budgets,
 # checked before any record is drawn (found by a bad-input probe: --runs 1e9
 # held 11.6 GB within 30 s, --samples 1e12 ended in "out of memory" (exit 3),
@@ -98,7 +98,7 @@ navimpact_cli_fail(cli_diagnose_power_bad_snr EXIT 1 NOOUT ${_dg_out}/bad11
 # NAME|EXIT|ARGS|REGEX: library checks are exit 1 ("diagnose-power: ..."), flag ranges exit 2 naming the flag
 foreach(_case "range_samples|1|--samples 1000000000000:1000000000000|diagnose-power: the records would need about [0-9.e+]+ simulated samples .* or pass --allow-large$"
               "range_memory|1|--samples 100000000:100000000 --runs 1 --null-runs 1|diagnose-power: the records held at once would need about .* MB .* lower --samples or --threads, or pass --allow-large$"
-              "range_rate|1|--rate 1e-300:1e-300|diagnose-power: --rate must lie in \\[1, 10000\\] Hz"
+              "range_rate|2|--rate 1e-300:1e-300|--rate: '1e-300:1e-300': rates must be in \\[1, 10000\\] Hz \\(see 'navimpact diagnose-power --help'\\)$"
               "range_nothing|1|--runs 0 --null-runs 0|diagnose-power: --runs and --null-runs are both 0: no record to diagnose$"
               "range_twice|1|--causes random_walk,random_walk|diagnose-power: --causes: 'random_walk' is listed twice$"
               "flag_runs|2|--runs 1000000000|--runs: must be in \\[0, 1e\\+06\\], got 1000000000 \\(see 'navimpact diagnose-power --help'\\)$"
@@ -174,6 +174,11 @@ navimpact_cli_fail(cli_diagnose_simulations_budget EXIT 1 NOOUT ${_dg_out}/bud4
 navimpact_cli_fail(cli_diagnose_run_realisations_range EXIT 2 NOOUT ${_dg_out}/bud5
   ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --realisations 100000000 --out ${_dg_out}/bud5
   REGEX "^navimpact: --realisations: must be in \\[2, 1e\\+06\\], got 100000000 \\(see 'navimpact diagnose --help'\\)$")
+# The run's memory, estimated before its replays: the run and 1000 workers of
+# 1000 realisations (52,000 samples x (120 + 180 x 1000) bytes, 9.4 GB)
+navimpact_cli_fail(cli_diagnose_run_memory_budget EXIT 1 NOOUT ${_dg_out}/bud6
+  ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --realisations 1000 --threads 1000 --out ${_dg_out}/bud6
+  REGEX "^navimpact: [^ ]*uav_flight_260s_ref.rawlog: diagnose --run would need about [0-9.e+]+ MB \\([0-9.e+]+ samples x \\(120 \\+ 180 x 1000 workers\\) bytes\\), above the budget of 2e\\+03 MB: lower --threads or diagnose an excerpt of the run, or pass --allow-large$")
 # --durations: a handful, each once, each in [0.1 ms, 7 days] (2000 durations held 1.3 GB and ran on)
 navimpact_cli_fail(cli_diagnose_run_durations_twice EXIT 1 NOOUT ${_dg_out}/dur1
   ARGS diagnose --run ${_dg_rawlog} --model ${_dg_ref} --durations 30,30 --out ${_dg_out}/dur1

@@ -26,6 +26,23 @@ navimpact_cli_fail(cli_error_cli_required EXIT 2 ARGS replay
   REGEX "^navimpact: --out is required \\(see 'navimpact replay --help'\\)$")
 navimpact_cli_fail(cli_error_cli_conversion EXIT 2 ARGS wv --input x.csv --eff abc --out ${_erd}/o3
   REGEX "--eff.*abc.*see 'navimpact wv --help'")
+# A flag's text that the library's parser refuses is a command-line error too
+# (exit 2, found by a probe: these exited 1 without pointing at --help).
+foreach(_case
+    "replay_outage|replay|--outage|10:-5|DURATION"
+    "replay_outages_every|replay|--outages-every|1e-300:1e-300|"
+    "diagnose_outage|diagnose|--outage|abc|"
+    "study_shard|study|--shard|3/2|"
+    "sweep_shard|sweep|--shard|0/2|"
+    "power_rate|diagnose-power|--rate|0.5:10|rates must be in"
+    "power_snr|diagnose-power|--snr|5:1|LO:HI"
+    "power_causes|diagnose-power|--causes|gm|unknown cause 'gm'"
+    "wv_gyro_unit|wv|--gyro-unit|furlong|'furlong' is not a known unit"
+    "fit_weights|fit|--weights|bogus|bogus")
+  navimpact_cli_case("${_case}" _n _cmd _flag _val _re)
+  navimpact_cli_fail(cli_error_flag_value_${_n} EXIT 2 ARGS ${_cmd} ${_flag} ${_val} --out ${_erd}/fv_${_n}
+    REGEX "^navimpact: ${_flag}[^\n]*${_re}[^\n]*\\(see 'navimpact ${_cmd} --help'\\)$")
+endforeach()
 navimpact_cli_fail(cli_error_cli_unknown_command EXIT 2 ARGS frobnicate
   REGEX "^navimpact: unknown command 'frobnicate' \\(commands: covariance, diagnose, .*\\)$")
 

@@ -39,12 +39,12 @@ navimpact_cli_fail(cli_replay_outages_every_bad
   REGEX "PERIOD > DURATION" NOOUT ${_rdir}/everybad)
 # the flags have the configuration's ranges (durations [0.1 ms, 7 days]): a
 # period of 1e-300 s made windows that never advanced (8 GB in 14 s)
-navimpact_cli_fail(cli_replay_outages_every_tiny
+navimpact_cli_fail(cli_replay_outages_every_tiny EXIT 2
   ARGS replay --rawlog ${_rlog} --outages-every 1e-300:1e-301 --out ${_rdir}/everytiny
-  REGEX "^navimpact: outages every '1e-300:1e-301': PERIOD and DURATION must be in \\[0.0001, 604800\\] s, PERIOD > DURATION" NOOUT ${_rdir}/everytiny)
-navimpact_cli_fail(cli_replay_outage_tiny
+  REGEX "^navimpact: --outages-every: outages every '1e-300:1e-301': PERIOD and DURATION must be in \\[0.0001, 604800\\] s, PERIOD > DURATION" NOOUT ${_rdir}/everytiny)
+navimpact_cli_fail(cli_replay_outage_tiny EXIT 2
   ARGS replay --rawlog ${_rlog} --outage 25:0.00001 --out ${_rdir}/outagetiny
-  REGEX "^navimpact: --outage '25:0.00001': START must be in \\[0, 1e\\+10\\] s and DURATION in \\[0.0001, 604800\\] s$" NOOUT ${_rdir}/outagetiny)
+  REGEX "^navimpact: --outage: '25:0.00001': START must be in \\[0, 1e\\+10\\] s and DURATION in \\[0.0001, 604800\\] s \\(see 'navimpact replay --help'\\)$" NOOUT ${_rdir}/outagetiny)
 # a period whose windows exceed the most outages of one run (1e6) is refused
 # when the count passes it, naming the rawlog (1.3e6 windows over 260 s)
 navimpact_cli_fail(cli_replay_outages_every_too_many

@@ -37,7 +37,7 @@ _study_bad(missing_model "study|--config|${_sdir}/bad_model.yaml|--out|${_sdir}/
 _study_bad(unreadable "study|--config|${_sdir}/no_such_file.yaml|--out|${_sdir}/out_unreadable"
            "no_such_file.yaml")
 _study_bad(bad_shard "study|--config|${_sdir}/short.yaml|--out|${_sdir}/out_bad_shard|--shard|3/2"
-           "--shard '3/2'")
+           "--shard: '3/2': expected K/N")
 _study_bad(merge_missing "study-merge|${_sdir}/no_such_shard|--out|${_sdir}/out_merge_missing"
            "no_such_shard/shard.json")
 # work and memory are estimated before the first run (found by a bad-input

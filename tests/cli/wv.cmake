@@ -59,7 +59,7 @@ file(WRITE ${_wv_dir}/tiny.csv "gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n${_tiny_
 wv_expect_fail(underflow "^navimpact: .*tiny\\.csv: channel gyro_x: wavelet variance is 0 at every scale \\(the samples reach only .x. = 2e-300: their squares underflow; is the unit right\\?\\)$"
                --input ${_wv_dir}/tiny.csv --rate 100 --gyro-unit rad/s --acc-unit m/s2)
 wv_expect_fail(unknown_unit
-               "adis16405_static_excerpt\\.csv\\.gz: --acc-unit 'furlong' is not a known unit"
+               "^navimpact: --acc-unit: 'furlong' is not a known unit \\(accepted: m/s2, .*\\) \\(see 'navimpact wv --help'\\)$"
                --input ${_wv_data} --rate 100 --gyro-unit deg/s --acc-unit furlong)
 wv_expect_fail(rawlog_label
                "imu_label_xsens\\.rawlog: no CObservationIMU with label 'IMU' \\(labels found: 'XSENS'"

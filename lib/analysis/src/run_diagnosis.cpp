@@ -1055,8 +1055,15 @@ void diagnoseCauses(const RunDiagnosisOptions& opt, const rawlog::RawlogRecords&
 /// Most outage durations of one run diagnosis (each is a replay of the run per realisation).
 constexpr std::size_t kMaxRunDurations = 16;
 
-RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
+/// Memory of diagnose --run per IMU sample of the run: the run read and its
+/// measured replays, and per worker a realisation's errors, emulation and
+/// filter runs (peak resident size measured at 200 and 2000 Hz with 1 and 2
+/// workers: 89 MB + n x (115 + 180 x workers) bytes).
+constexpr double kRunBytesPerSample = 120.0, kRunBytesPerSampleAndWorker = 180.0;
+
+RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt_in) {
   const auto wall0 = std::chrono::steady_clock::now();
+  RunDiagnosisOptions opt = opt_in;  // its threads set by the memory budget below
   if (opt.durations_s.empty()) throw Error("diagnose --run: give at least one outage duration (--durations)");
   // a handful of durations, each once, each a duration (limits::kDurationS); 2000 durations held 1.3 GB and ran on
   if (opt.durations_s.size() > kMaxRunDurations)
@@ -1088,6 +1095,25 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt) {
   if (opt.replay.rawlog.empty()) throw Error("replay: no rawlog given (--rawlog or 'rawlog:' in the configuration)");
   const rawlog::RawlogRecords data =
       rawlog::readRawlogRecords(opt.replay.rawlog, {opt.replay.imu_label, opt.replay.gnss_label});
+  {
+    // Memory, estimated before the replays (README "Ranges and budgets"); all
+    // cores (--threads 0) means as many workers as the budget holds, at least one.
+    const double n = double(data.data.imu.size());
+    const double budget = limits::kDefaultMemoryBudgetBytes;
+    unsigned workers = workerThreads(static_cast<unsigned>(std::max(opt.threads, 0)), std::size_t(opt.realisations));
+    if (opt.threads == 0) {
+      const double fit = std::floor((budget / std::max(n, 1.0) - kRunBytesPerSample) / kRunBytesPerSampleAndWorker);
+      workers = static_cast<unsigned>(std::max(1.0, std::min(double(workers), fit)));
+    }
+    opt.threads = static_cast<int>(workers);
+    const double bytes = n * (kRunBytesPerSample + kRunBytesPerSampleAndWorker * workers);
+    limits::checkBudget({{opt.replay.rawlog, "diagnose --run", bytes / 1e6, budget / 1e6, "MB",
+                          formatNumber(n, 3) + " samples x (" + formatNumber(kRunBytesPerSample) + " + " +
+                              formatNumber(kRunBytesPerSampleAndWorker) + " x " + std::to_string(workers) +
+                              " workers) bytes",
+                          "lower --threads or diagnose an excerpt of the run"}},
+                        opt.allow_large);
+  }
 
   RunDiagnosis out;
   out.rawlog = opt.replay.rawlog;
