@@ -49,7 +49,10 @@ navimpact::cli::Registrar reg({
         if (!rep.gnss_file.empty())
           std::printf("GNSS %zu fixes (%s, %s) from %s\n", d.gnss.size(),
                       d.gnss.front().v_N ? "with velocity" : "position only",
-                      d.gnss.front().cov_pos_N ? "with sigma" : "no sigma", rep.gnss_file.c_str());
+                      !d.gnss.front().cov_pos_N                               ? "no sigma"
+                      : d.gnss.front().v_N && !d.gnss.front().cov_vel_N       ? "with position sigma, velocity without: replay needs noise.sigma_vel_*"
+                                                                              : "with sigma",
+                      rep.gnss_file.c_str());
         if (!rep.baro_file.empty()) std::printf("BARO %zu samples from %s\n", d.baro.size(), rep.baro_file.c_str());
         if (!rep.reference_file.empty())
           std::printf("reference %zu samples (%s) from %s\n", d.reference.size(),

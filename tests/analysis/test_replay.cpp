@@ -223,6 +223,47 @@ TEST(Replay, AcrossAnAllowedImuGapTheErrorsStayWithinTheirSigmas) {
   }
 }
 
+// A GNSS velocity without sigma (import accepts it: the manifest's velocity
+// sigma is optional) is refused naming the keys that give it, not "no
+// covariance" (found by a probe: the fix had a position sigma); without the
+// velocity in the filter it is not needed.
+TEST(Replay, AVelocityWithoutSigmaNamesTheKeysThatGiveIt) {
+  auto d = emulate60("none");
+  ASSERT_TRUE(d.gnss.front().v_N.has_value());
+  for (auto& f : d.gnss) f.cov_vel_N.reset();
+  an::ReplayConfig c = refReplay(writtenRawlog(d, "novelsigma.rawlog"));
+  const std::string m = errorOf(c);
+  EXPECT_NE(m.find("has a velocity without sigma: set noise.sigma_vel_h_mps and noise.sigma_vel_v_mps"),
+            std::string::npos) << m;
+  c.use_gnss_velocity = false;
+  EXPECT_EQ(errorOf(c), "");
+  c.use_gnss_velocity = true;
+  c.sigma_vel_h_mps = 0.1;
+  c.sigma_vel_v_mps = 0.2;
+  EXPECT_EQ(errorOf(c), "");
+}
+
+// Streams that start together (a complete reference entry at the first IMU
+// sample, none a step before it, as a logger writes them): the filter starts
+// from the reference at that sample instead of waiting for an alignment that
+// never comes (found by a probe: "waiting for the reference's yaw at t = 0 s").
+TEST(Replay, AReferenceAtTheFirstImuSampleStartsTheFilter) {
+  auto d = emulate60("none");
+  const double dt = d.imu[1].t - d.imu[0].t;
+  const double tRef1 = d.reference.at(1).t;  // the reference's second entry, 0.1 s in
+  while (d.imu.front().t < tRef1 - 0.5 * dt) d.imu.erase(d.imu.begin());
+  ASSERT_NEAR(d.imu.front().t, tRef1, 1e-9);
+  an::ReplayConfig c = refReplay(writtenRawlog(d, "together.rawlog"));
+  const auto r = an::runReplay(c);
+  EXPECT_NEAR(r.t_zero, tRef1, 1e-9);
+  EXPECT_NEAR(r.run.epochs.front().t, tRef1, 1e-9);
+  EXPECT_EQ(r.run.steps, d.imu.size() - 1);  // the first sample's increment lies before the start
+  bool said = false;
+  for (const auto& n : r.notices) said = said || n.find("the reference starts at the first IMU sample") != std::string::npos;
+  EXPECT_TRUE(said);
+  EXPECT_LT(r.run.epochs.back().err.head<3>().norm(), 3.0);
+}
+
 // A GNSS fix recorded twice (a random one; seed logged) is refused by the
 // reader, naming the entry and the earlier one, instead of being applied twice.
 TEST(Replay, DuplicatedGnssRecordIsAnError) {

@@ -29,9 +29,9 @@ navimpact_cli_fail(cli_diagnose_bad_structure EXIT 1 NOOUT ${_dg_out}/bad2
 navimpact_cli_fail(cli_diagnose_outage_without_trajectory EXIT 1 NOOUT ${_dg_out}/bad3
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --outage 100:30 --out ${_dg_out}/bad3
   REGEX "^navimpact: --outage needs --trajectory")
-navimpact_cli_fail(cli_diagnose_bad_outage EXIT 1 NOOUT ${_dg_out}/bad4
+navimpact_cli_fail(cli_diagnose_bad_outage EXIT 2 NOOUT ${_dg_out}/bad4
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --trajectory ${_dg_data} --outage abc --out ${_dg_out}/bad4
-  REGEX "^navimpact: --outage 'abc': expected START:DURATION")
+  REGEX "^navimpact: --outage: 'abc': expected START:DURATION")
 navimpact_cli_fail(cli_diagnose_missing_unit EXIT 1 NOOUT ${_dg_out}/bad5
   ARGS diagnose --input ${_dg_data} --rate 100 --model fit:WN --out ${_dg_out}/bad5
   REGEX "^navimpact: .*unit")

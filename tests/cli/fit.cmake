@@ -62,9 +62,9 @@ navimpact_cli_check(cli_fit_weights_efficient_json CHECK fit_weights DEFINES DIR
 set_tests_properties(cli_fit_weights_efficient_json PROPERTIES FIXTURES_REQUIRED fit_eff)
 
 # an unknown weighting is a one-line error before any output
-navimpact_cli_fail(cli_fit_bad_weights
+navimpact_cli_fail(cli_fit_bad_weights EXIT 2
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --weights optimal --out ${_fdir}/badw
-  REGEX "^navimpact: --weights: expected 'r', 'model' or 'efficient', got 'optimal'" NOOUT ${_fdir}/badw)
+  REGEX "^navimpact: --weights: optimal not in {r,model,efficient} \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/badw)
 
 # A term pushed to its lower bound is reported, not hidden: on gyro_x of the
 # excerpt, WN+GM+RW+DR puts the white noise into a GM with T < 1 sample and

@@ -425,4 +425,22 @@ TEST(ImportManifest, ALongRecordIsStreamedNotReadWhole) {
 }
 
 }  // namespace
+// time_zero_unix_s is read as written: its fraction is not a double's
+// neighbour of 1.4e9 s, which holds 0.917 only to 2.4e-7 s (a probe saw every
+// time one 100 ns tick late after the rawlog's rounding).
+TEST(ImportManifest, TimeZeroKeepsItsFractionExactly) {
+  const fs::path dir = test::tempDir();
+  writeFile(dir / "m.yaml", std::string(kManifest) + "time_zero_unix_s: 1448546404.917\n");
+  writeFile(dir / "imu.csv", kImu);
+  writeFile(dir / "gnss.csv", kGnss);
+  const Recording d = import::importManifest((dir / "m.yaml").string());
+  EXPECT_EQ(d.start_unix_s, 1448546404);
+  const Recording plain = [&] {
+    writeFile(dir / "m.yaml", kManifest);
+    return import::importManifest((dir / "m.yaml").string());
+  }();
+  ASSERT_EQ(d.imu.size(), plain.imu.size());
+  for (std::size_t k = 0; k < d.imu.size(); ++k) EXPECT_NEAR(d.imu[k].t, 0.917 + plain.imu[k].t, 1e-12) << k;
+}
+
 }  // namespace navimpact

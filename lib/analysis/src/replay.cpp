@@ -348,8 +348,13 @@ void ReplayDriver::takeGnss(GnssFix f) {
   if (cfg_.sigma_pos_v_m) sp[2] = *cfg_.sigma_pos_v_m;
   if (cfg_.sigma_vel_h_mps) sv.head<2>().setConstant(*cfg_.sigma_vel_h_mps);
   if (cfg_.sigma_vel_v_mps) sv[2] = *cfg_.sigma_vel_v_mps;
-  if (!sp.allFinite() || (f.v_N && !sv.allFinite()))
-    throw Error(cfg_.rawlog + ": GNSS fix at t = " + formatNumber(f.t, 10) + " s has no covariance: set the noise.* sigmas");
+  if (!sp.allFinite())
+    throw Error(cfg_.rawlog + ": GNSS fix at t = " + formatNumber(f.t, 10) +
+                " s has no position sigma: set noise.sigma_pos_h_m and noise.sigma_pos_v_m in the replay configuration");
+  if (f.v_N && !sv.allFinite() && cfg_.use_gnss_velocity)
+    throw Error(cfg_.rawlog + ": GNSS fix at t = " + formatNumber(f.t, 10) +
+                " s has a velocity without sigma: set noise.sigma_vel_h_mps and noise.sigma_vel_v_mps in the replay "
+                "configuration (or filter.use_gnss_velocity: false)");
   f.cov_pos_N = Eigen::Matrix3d(sp.cwiseAbs2().asDiagonal());
   if (sv.allFinite()) f.cov_vel_N = Eigen::Matrix3d(sv.cwiseAbs2().asDiagonal());
   if (runner_) {
@@ -574,6 +579,24 @@ void ReplayDriver::run() {
   }
   r.imu_rate_hz = 1.0 / dt_;
   r.t_zero = imuQ_.front().t - dt_;
+  // Streams that start together: a complete reference entry at the first IMU
+  // sample and none one step before it. The filter then starts at that sample
+  // (time zero), whose increment, over the step before it, is left out.
+  if (cfg.use_reference && imuQ_.size() > 2) {
+    const double t1 = imuQ_.front().t;
+    bool atFirst = false, before = false;
+    for (const auto& g : refQ_) {
+      atFirst = atFirst || (std::abs(g.t - t1) <= 0.5 * dt_ && g.v_N && g.q_BtoN);
+      before = before || std::abs(g.t - r.t_zero) <= 0.5 * dt_;
+    }
+    if (atFirst && !before) {
+      r.t_zero = t1;
+      imuQ_.pop_front();
+      r.notices.push_back("the reference starts at the first IMU sample (t = " + g10(t1) +
+                          " s in the rawlog): the filter starts there, that sample's increment (over the step "
+                          "before it) left out");
+    }
+  }
   prevT_ = r.t_zero;
 
   // Outages in rawlog time (their end against the data's end is checked when it is known).

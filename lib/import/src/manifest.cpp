@@ -351,7 +351,24 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       if (o[names[i]]) offset[i] = k.number(o[names[i]], std::string("time_offset_s.") + names[i], -1e6, 1e6, "s");
   }
   std::optional<double> zeroUnix;
-  if (root["time_zero_unix_s"]) zeroUnix = k.number(root["time_zero_unix_s"], "time_zero_unix_s", 0.0, 1e10, "s");
+  // its whole seconds and their fraction, exactly as written ("1448546404.917"):
+  // a double near 1.4e9 s holds 0.917 only to 2.4e-7 s, a tick of the rawlog's
+  // 100 ns clock lost (found by a probe)
+  long long zeroWhole = 0;
+  double zeroFraction = 0.0;
+  if (root["time_zero_unix_s"]) {
+    zeroUnix = k.number(root["time_zero_unix_s"], "time_zero_unix_s", 0.0, 1e10, "s");
+    const std::string text = root["time_zero_unix_s"].asText();
+    const auto dot = text.find('.');
+    if (text.find_first_not_of("0123456789.") == std::string::npos && dot != std::string::npos && dot > 0 &&
+        text.find('.', dot + 1) == std::string::npos) {
+      zeroWhole = std::stoll(text.substr(0, dot));
+      zeroFraction = dot + 1 < text.size() ? std::stod("0." + text.substr(dot + 1)) : 0.0;
+    } else {
+      zeroWhole = static_cast<long long>(std::floor(*zeroUnix));
+      zeroFraction = *zeroUnix - static_cast<double>(zeroWhole);
+    }
+  }
 
   Recording d;
   d.source = manifestPath;
@@ -582,8 +599,8 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     if (!d.gnss.empty()) earliest = std::min(earliest, d.gnss.front().t);
     if (!d.baro.empty()) earliest = std::min(earliest, d.baro.front().t);
     if (!d.reference.empty()) earliest = std::min(earliest, d.reference.front().t);
-    d.start_unix_s = static_cast<long long>(std::floor(*zeroUnix + earliest));
-    const double shift = *zeroUnix - static_cast<double>(d.start_unix_s);
+    d.start_unix_s = zeroWhole + static_cast<long long>(std::floor(zeroFraction + earliest));
+    const double shift = static_cast<double>(zeroWhole - d.start_unix_s) + zeroFraction;  // small: exact enough
     for (auto& x : d.imu) x.t += shift;
     for (auto& x : d.gnss) x.t += shift;
     for (auto& x : d.baro) x.t += shift;
