@@ -80,7 +80,8 @@ void addInputOptions(CLI::App& app, InputOpts& o) {
   app.add_option("--axes", o.axes,
                  "sensor-to-body FRD axes, e.g. x,-y,-z for a forward-left-up sensor");
   app.add_option("--label", o.label, "rawlog sensor label of the IMU observations")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.label_given = true; });
   app.add_option("--time-column", o.time_column,
                  "CSV: name of the time column in seconds (default: t, time_s or time)");
   app.add_option("--start", o.start_s,
@@ -102,6 +103,8 @@ ImuSeries loadInput(const InputOpts& o, InputFormat* format) {
     return s;
   };
   if (!raw) {
+    if (o.label_given)
+      throw Error(o.input + ": --label applies to rawlog input; a CSV's columns are named by its header");
     CsvImuOptions c;
     c.rate_hz = o.rate_hz;
     c.gyro_unit = o.gyro_unit;

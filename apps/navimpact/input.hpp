@@ -21,6 +21,7 @@ struct InputOpts {
   std::string acc_unit;           ///< CSV accelerometer unit ("" = from the header)
   std::string axes;               ///< sensor -> body FRD remap, e.g. "x,-y,-z"
   std::string label = "IMU";      ///< rawlog sensor label
+  bool label_given = false;       ///< --label on the command line (it applies to a rawlog only)
   std::string time_column;        ///< CSV time column name ("" = t, time_s or time)
   std::optional<double> start_s;  ///< window start [s from the record's first sample]
   std::optional<double> end_s;    ///< window end (exclusive) [s from the record's first sample]

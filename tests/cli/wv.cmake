@@ -61,6 +61,11 @@ wv_expect_fail(underflow "^navimpact: .*tiny\\.csv: channel gyro_x: wavelet vari
 wv_expect_fail(unknown_unit
                "^navimpact: --acc-unit: 'furlong' is not a known unit \\(accepted: m/s2, .*\\) \\(see 'navimpact wv --help'\\)$"
                --input ${_wv_data} --rate 100 --gyro-unit deg/s --acc-unit furlong)
+# flags that do not apply, or no time: one line naming the input
+wv_expect_fail(csv_label "^navimpact: .*adis16405_static_excerpt\\.csv\\.gz: --label applies to rawlog input; a CSV's columns are named by its header$"
+               --input ${_wv_data} --rate 100 --gyro-unit deg/s --acc-unit g --label XSENS)
+wv_expect_fail(end_inf "^navimpact: .*adis16405_static_excerpt\\.csv\\.gz: --end inf s must be a finite time \\(the record has"
+               --input ${_wv_data} --rate 100 --gyro-unit deg/s --acc-unit g --end inf)
 wv_expect_fail(rawlog_label
                "imu_label_xsens\\.rawlog: no CObservationIMU with label 'IMU' \\(labels found: 'XSENS'"
                --input ${CMAKE_SOURCE_DIR}/tests/data/imu_label_xsens.rawlog)

@@ -260,7 +260,9 @@ TEST(ImuSeriesWindow, KeepsTheSamplesInsideTheWindow) {
     }
     return std::string();
   };
-  EXPECT_EQ(err(-1, std::nullopt), "rec.csv: --start -1 s must be a time >= 0 (the record has 1000 samples, 0 to 10 s at 100 Hz)");
+  EXPECT_EQ(err(-1, std::nullopt), "rec.csv: --start -1 s must be a finite time >= 0 (the record has 1000 samples, 0 to 10 s at 100 Hz)");
+  EXPECT_EQ(err(0, std::numeric_limits<double>::infinity()),
+            "rec.csv: --end inf s must be a finite time (the record has 1000 samples, 0 to 10 s at 100 Hz)");
   EXPECT_NE(err(10, std::nullopt).find("--start 10 s is not before the end of the record"), std::string::npos);
   EXPECT_NE(err(2, 1.0).find("--end 1 s must be after --start"), std::string::npos);
   EXPECT_NE(err(2, 10.5).find("--end 10.5 s is beyond the end of the record"), std::string::npos);

@@ -1,7 +1,6 @@
 #include "navimpact/core/imu_series.hpp"
 
 #include <cmath>
-#include <sstream>
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
@@ -35,17 +34,15 @@ void cutWindow(ImuSeries& s, double start_s, std::optional<double> end_s) {
   const std::size_t n = s.size();
   const double duration = static_cast<double>(n) / s.rate_hz;
   auto fail = [&](const std::string& flag, double v, const std::string& why) {
-    std::ostringstream os;
-    os.precision(10);
-    os << s.source << ": " << flag << " " << v << " s " << why << " (the record has " << n << " samples, 0 to "
-       << duration << " s at " << s.rate_hz << " Hz)";
-    return Error(os.str());
+    return Error(s.source + ": " + flag + " " + formatNumber(v, 10) + " s " + why + " (the record has " +
+                 std::to_string(n) + " samples, 0 to " + formatNumber(duration, 10) + " s at " +
+                 formatNumber(s.rate_hz, 10) + " Hz)");
   };
-  if (!std::isfinite(start_s) || start_s < 0.0) throw fail("--start", start_s, "must be a time >= 0");
+  if (!std::isfinite(start_s) || start_s < 0.0) throw fail("--start", start_s, "must be a finite time >= 0");
   if (!(start_s < duration)) throw fail("--start", start_s, "is not before the end of the record");
   if (end_s) {
-    if (!std::isfinite(*end_s) || !(*end_s > start_s))
-      throw fail("--end", *end_s, "must be after --start " + formatNumber(start_s, 10) + " s");
+    if (!std::isfinite(*end_s)) throw fail("--end", *end_s, "must be a finite time");
+    if (!(*end_s > start_s)) throw fail("--end", *end_s, "must be after --start " + formatNumber(start_s, 10) + " s");
     if (*end_s > duration * (1.0 + 1e-12)) throw fail("--end", *end_s, "is beyond the end of the record");
   }
   // First index k with k / rate >= start, first index beyond the window (exclusive).
