@@ -289,3 +289,12 @@ TEST(Config, AnInputFileThatCannotBeReadNamesTheConfigurationAndTheKey) {
   EXPECT_EQ(errorOf([&] { ConfigNode::load(d + "fifo"); }), d + "fifo: cannot open (not a regular file)");
   EXPECT_EQ(errorOf([&] { ConfigNode::readText(d + "folder"); }), d + "folder: cannot open (Is a directory)");
 }
+
+// A value just outside its range is printed with the digits that make it
+// outside (0.1000001 was "got 0.1" beside "[-0.1, 0.1]"); others as %g.
+TEST(Config, AValueOutOfRangeIsPrintedAsItIs) {
+  EXPECT_EQ(errorOf([] { limits::check("f.yaml", "offset_s", 0.1000001, limits::kTimeOffsetS); }),
+            "f.yaml: key 'offset_s': must be in " + limits::describe(limits::kTimeOffsetS) + ", got 0.1000001");
+  EXPECT_NE(errorOf([] { limits::check("f.yaml", "rate_hz", 1e9, limits::kImuRateHz); }).find(", got 1e+09"),
+            std::string::npos);
+}

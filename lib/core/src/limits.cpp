@@ -1,6 +1,7 @@
 #include "navimpact/core/limits.hpp"
 
 #include <cmath>
+#include <cstdlib>
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/format.hpp"
@@ -9,6 +10,13 @@ namespace navimpact::limits {
 
 namespace {
 std::string g(double v) { return formatNumber(v, 6); }  // %g
+
+/// A value refused, as %g when that reads back as it, else every digit it
+/// needs (0.1000001 outside [-0.1, 0.1] printed as "got 0.1").
+std::string gotText(double v) {
+  const std::string s = g(v);
+  return !std::isfinite(v) || std::strtod(s.c_str(), nullptr) == v ? s : formatExact(v);
+}
 }  // namespace
 
 std::string describe(const Range& r) {
@@ -17,7 +25,7 @@ std::string describe(const Range& r) {
 
 double check(const std::string& file, const std::string& key, double v, const Range& r) {
   const bool ok = std::isfinite(v) && (r.lo_open ? v > r.lo : v >= r.lo) && v <= r.hi;
-  if (!ok) throw keyError(file, key, "must be in " + describe(r) + ", got " + g(v));
+  if (!ok) throw keyError(file, key, "must be in " + describe(r) + ", got " + gotText(v));
   return v;
 }
 
