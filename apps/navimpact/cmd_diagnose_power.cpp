@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "cli_common.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/analysis/diagnose_power.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
@@ -40,7 +41,8 @@ std::pair<double, double> range(const std::string& flag, const std::string& v) {
     if (c == std::string::npos) throw std::invalid_argument("no colon");
     std::size_t p1 = 0, p2 = 0;
     const double a = std::stod(v.substr(0, c), &p1), b = std::stod(v.substr(c + 1), &p2);
-    if (p1 != c || p2 != v.size() - c - 1 || !(a > 0) || !(b >= a)) throw std::invalid_argument("bad");
+    if (p1 != c || p2 != v.size() - c - 1 || !(a > 0) || !(b >= a) || !std::isfinite(b))
+      throw std::invalid_argument("bad");
     return {a, b};
   } catch (const std::exception&) {
     throw navimpact::Error(flag + " '" + navimpact::printable(v, 60) + "': expected LO:HI with 0 < LO <= HI");
@@ -65,6 +67,14 @@ std::vector<na::Cause> parseCauses(const std::string& text) {
                              "level_shift, outliers)");
   }
   return out;
+}
+
+/// FLAG LO:HI with both ends in [lo, hi] (what: the ends' name and unit).
+void checkRange(const char* flag, const std::string& v, double lo, double hi, const std::string& what) {
+  const auto [a, b] = range(flag, v);
+  if (!(a >= lo && b <= hi))
+    throw navimpact::Error(std::string(flag) + " '" + navimpact::printable(v, 60) + "': " + what + " must be in [" +
+                           navimpact::formatNumber(lo) + ", " + navimpact::formatNumber(hi) + "]");
 }
 
 /// --rate LO:HI within the documented IMU rates.
@@ -132,20 +142,21 @@ navimpact::cli::Registrar reg(
        app.add_option("--null-runs", o->null_runs, "null records (six channels, drawn from the model)")
            ->capture_default_str()
            ->check(navimpact::cli::within(counts));
-       auto lohi = [](const char* flag) {
-         return navimpact::cli::parsedBy([flag](const std::string& s) { range(flag, s); }, "LO:HI");
+       auto lohi = [](const char* flag, double lo, double hi, const char* what) {
+         return navimpact::cli::parsedBy([=](const std::string& s) { checkRange(flag, s, lo, hi, what); }, "LO:HI");
        };
        app.add_option("--snr", o->snr, "effect size as multiples of the detection limit, drawn log-uniform LO:HI")
            ->capture_default_str()
-           ->check(lohi("--snr"));
+           ->check(lohi("--snr", 0.0, 1000.0, "multiples of the limit"));
        app.add_option("--rate", o->rate, "sampling rate range LO:HI [Hz], log-uniform")
            ->capture_default_str()
            ->check(navimpact::cli::parsedBy(checkRateRange, "LO:HI"));
        app.add_option("--duration-h", o->duration_h, "record duration range LO:HI [h], log-uniform (e.g. 0.5:10; overrides --samples)")
-           ->check(lohi("--duration-h"));
+           ->check(lohi("--duration-h", navimpact::limits::kDurationS.lo / 3600.0, navimpact::limits::kDurationS.hi / 3600.0,
+                        "durations [h]"));
        app.add_option("--samples", o->samples, "record length range LO:HI [samples], log-uniform")
            ->capture_default_str()
-           ->check(lohi("--samples"));
+           ->check(lohi("--samples", 4096.0, 1e12, "record lengths (a wavelet variance of 12 scales needs 4096)"));
        app.add_option("--causes", o->causes, "comma-separated causes (default: all eight)")
            ->check(navimpact::cli::parsedBy([](const std::string& s) { parseCauses(s); }, "CAUSE,..."));
        app.add_option("--seed", o->seed, "root seed")->capture_default_str()->check(navimpact::cli::seedValue());
@@ -154,7 +165,10 @@ navimpact::cli::Registrar reg(
            ->check(navimpact::cli::within(navimpact::cli::kAlpha, true));
        app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel in each diagnosis")
            ->capture_default_str()
-           ->check(navimpact::cli::within(counts));
+           ->check(navimpact::cli::within(counts))
+           ->check(CLI::Validator(
+               [](std::string& s) { return s == "1" ? std::string("must be 0 (the closed forms) or at least 2") : std::string(); },
+               ""));
        app.add_option("--threads", o->threads, "worker threads over records (0 = all cores)")
            ->check(navimpact::cli::within(navimpact::cli::kThreads));
        app.add_flag("--allow-large", o->allow_large, "run above the work and memory budgets (README \"Ranges and budgets\")");

@@ -58,7 +58,7 @@ navimpact::cli::Registrar reg({
           std::printf("reference %zu samples (%s) from %s\n", d.reference.size(),
                       d.reference.front().q_BtoN ? "with attitude" : "position only", rep.reference_file.c_str());
         std::printf("time: t = %.6f .. %.6f s after Unix %lld%s\n", t0, t1, d.start_unix_s,
-                    d.start_unix_s == 0 ? " (no time_zero_unix_s: the files' own time)" : "");
+                    rep.time_base_known ? "" : " (no time_zero_unix_s: the files' own time)");
         std::printf("wrote %s (%.2f MB%s)\n", o->out.c_str(), bytes / 1e6, wo.gzip ? ", gzip" : "");
         return 0;
       };

@@ -83,7 +83,10 @@ int runList(const Opts& o) {
 
 int runConvert(const Opts& o) {
   std::optional<navimpact::OutputSet> set;
-  if (!o.out.empty()) set.emplace(navimpact::OutputSet::singleFile(o.out, navimpact::cli::overwriteMode(o.overwrite)));
+  if (!o.out.empty()) {
+    set.emplace(navimpact::OutputSet::singleFile(o.out, navimpact::cli::overwriteMode(o.overwrite)));
+    set->mayReplaceAnInput();  // convert --out onto its own model file: read whole first
+  }
   const st::ImuModel m = st::loadImuModel(o.spec);
   const st::ImuModel c = st::convertRate(m, o.rate_hz);
   const std::string note = "converted from " + formatNumber(m.rate_hz) + " Hz to " + formatNumber(o.rate_hz) + " Hz";

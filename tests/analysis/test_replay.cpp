@@ -236,11 +236,11 @@ TEST(Replay, AVelocityWithoutSigmaNamesTheKeysThatGiveIt) {
   EXPECT_NE(m.find("has a velocity without sigma: set noise.sigma_vel_h_mps and noise.sigma_vel_v_mps"),
             std::string::npos) << m;
   c.use_gnss_velocity = false;
-  EXPECT_EQ(errorOf(c), "");
+  EXPECT_EQ(errorOf(c), "(no error)");
   c.use_gnss_velocity = true;
   c.sigma_vel_h_mps = 0.1;
   c.sigma_vel_v_mps = 0.2;
-  EXPECT_EQ(errorOf(c), "");
+  EXPECT_EQ(errorOf(c), "(no error)");
 }
 
 // Streams that start together (a complete reference entry at the first IMU

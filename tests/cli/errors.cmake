@@ -143,7 +143,7 @@ foreach(_case
     "seed_negative|study|--config|${_study}|--seed|-1|--seed: must be an integer seed in 0..18446744073709551615, got '-1'"
     "runs_negative|study|--config|${_study}|--runs|-1|--runs: .*not in range 1 to 1000000"
     "propagate_zero|replay|--rawlog|${_r}|--propagate-every|0|--propagate-every: .*not in range 1 to 1000"
-    "gap_nan|replay|--rawlog|${_r}|--max-imu-gap|nan|--max-imu-gap: must be in \\[0, 60\\] s, got nan"
+    "gap_nan|replay|--rawlog|${_r}|--max-imu-gap|nan|--max-imu-gap: must be in \\[0, 2\\] s, got nan"
     "durations_tiny|diagnose|--run|${_r}|--model|${_m}:ref|--durations|10,1e-308|--durations: must be in \\[0.0001, 604800\\] s, got 1e-308")
   string(REPLACE "|" ";" _p "${_case}")
   list(GET _p 0 _n)

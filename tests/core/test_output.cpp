@@ -275,3 +275,23 @@ TEST(OutputSet, OverwriteNeverReplacesAFolderHoldingAnInputOfTheRun) {
   EXPECT_TRUE(fs::exists(base / "old" / "config.yaml"));
   EXPECT_TRUE(fs::exists(base / "old2" / "model.yaml"));
 }
+
+TEST(OutputSet, AnOutputFileNeverReplacesAnInputUnlessTheCommandSaysSo) {
+  // import --out onto its own manifest replaced it with the rawlog (a probe)
+  const fs::path base = test::tempDir();
+  touch(base / "manifest.yaml", "imu: {}\n");
+  noteInput(base / "manifest.yaml");
+  {
+    OutputSet out = OutputSet::singleFile(base / "manifest.yaml", Overwrite::Replace);
+    std::ofstream(out.stagedFile()) << "rawlog";
+    EXPECT_THROW(out.commit(), Error);
+  }
+  std::ifstream in(base / "manifest.yaml");
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()), "imu: {}\n");
+  // model convert --out onto its own model file: read whole first, allowed
+  OutputSet conv = OutputSet::singleFile(base / "manifest.yaml", Overwrite::Replace);
+  conv.mayReplaceAnInput();
+  std::ofstream(conv.stagedFile()) << "converted\n";
+  conv.commit();
+  EXPECT_TRUE(fs::exists(base / "manifest.yaml"));
+}

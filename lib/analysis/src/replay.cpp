@@ -237,6 +237,7 @@ class ReplayDriver {
   std::deque<Sample> samples_;
   std::deque<ImuRecord> recent_;     // the last kRecentImu records (a gap's rate variability)
   std::size_t gaps_ = 0;
+  std::string startNotice_;          // the filter starts at the first IMU sample (streams that start together)
   double longest_ = 0.0, longestAt_ = 0.0;
   bool firstRecord_ = true;
 
@@ -592,9 +593,9 @@ void ReplayDriver::run() {
     if (atFirst && !before) {
       r.t_zero = t1;
       imuQ_.pop_front();
-      r.notices.push_back("the reference starts at the first IMU sample (t = " + g10(t1) +
-                          " s in the rawlog): the filter starts there, that sample's increment (over the step "
-                          "before it) left out");
+      startNotice_ = "the reference starts at the first IMU sample (t = " + g10(t1) +
+                     " s in the rawlog): the filter starts there, that sample's increment (over the step before it) "
+                     "left out";
     }
   }
   prevT_ = r.t_zero;
@@ -840,11 +841,13 @@ void ReplayDriver::run() {
     throw Error(cfg.rawlog + ": the reference (GT) has no entry inside the IMU data");
   // notices in one order: the reader's, gaps, the reference, the alignment, the outages, the model
   r.notices = header().notices;
+  if (!startNotice_.empty()) r.notices.push_back(startNotice_);
   if (gaps_ > 0)
     r.notices.push_back(std::to_string(gaps_) + " IMU gap(s) longer than " + g10(kImuGapSteps) +
                         " nominal steps accepted (longest " + g10(longest_) + " s, ending at t = " + g10(longestAt_) +
                         " s; filter.max_imu_gap_s = " + g10(cfg.max_imu_gap_s) +
-                        " s): the filter propagated across each with the rates of the sample after it held constant");
+                        " s): the filter propagated across each with the rates interpolated between the samples "
+                        "around it and their uncertainty added");
   if (!refNotice.empty()) r.notices.push_back(refNotice);
   if (ignoredRef_ > 0)
     r.notices.push_back(std::to_string(ignoredRef_) + " reference (GT) entries ignored: the reference starts after the "

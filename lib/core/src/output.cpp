@@ -236,7 +236,8 @@ OutputSet::OutputSet(OutputSet&& o) noexcept
       names_(std::move(o.names_)),
       ow_(o.ow_),
       kind_(o.kind_),
-      committed_(o.committed_) {
+      committed_(o.committed_),
+      mayReplaceInput_(o.mayReplaceInput_) {
   o.staging_.clear();
   o.stagingFd_ = -1;
   o.createdParents_.clear();
@@ -319,6 +320,12 @@ void OutputSet::commit() {
     if (!fs::exists(src, ec)) throw Error(shown + ": nothing was written");
     if (ow_ == Overwrite::Refuse && fs::exists(fs::symlink_status(target_, ec)))
       throw Error(shown + ": output file appeared while the job ran (pass --overwrite to replace it)");
+    if (!mayReplaceInput_ && fs::exists(target_, ec)) {
+      const fs::path t = fs::weakly_canonical(target_, ec);
+      std::lock_guard<std::mutex> lock(g_inputsMutex);
+      if (inputs().count(t))
+        throw Error(shown + ": --overwrite: it is an input of this run (write the output elsewhere)");
+    }
     if (std::rename(src.c_str(), target_.c_str()) != 0)
       throw Error(shown + ": cannot move the output into place (" + std::strerror(errno) + ")");
     fs::remove_all(staging_, ec);

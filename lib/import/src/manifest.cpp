@@ -456,6 +456,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     rep.imu_file = s.file;
     rep.imu_rate_hz = d.imu_rate_hz;
     rep.imu_max_gap_s = maxGap;
+    rep.time_base_known = zeroUnix.has_value();
   }
 
   // --- GNSS -----------------------------------------------------------------

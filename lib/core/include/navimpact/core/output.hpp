@@ -68,6 +68,10 @@ class OutputSet {
   void writeText(const std::string& name, const std::string& content);
   /// Move the staged output into place in one rename. Throws navimpact::Error on failure.
   void commit();
+  /// A single-file output may replace an input of the run (model convert
+  /// --out onto its own model file: read whole before); by default a file
+  /// the run read is never replaced (import --out onto its manifest was).
+  void mayReplaceAnInput() { mayReplaceInput_ = true; }
   /// Destination (folder, or the file of a singleFile() output).
   const std::filesystem::path& dir() const { return dest_; }
   /// Final paths of the files staged so far (sorted).
@@ -94,6 +98,7 @@ class OutputSet {
   Overwrite ow_ = Overwrite::Refuse;
   Kind kind_ = Kind::Directory;
   bool committed_ = false;
+  bool mayReplaceInput_ = false;
 };
 
 }  // namespace navimpact

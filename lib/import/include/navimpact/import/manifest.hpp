@@ -25,6 +25,7 @@ struct ImportReport {
   std::string imu_file, gnss_file, baro_file, reference_file;  ///< resolved paths ("" when absent)
   double imu_rate_hz = 0.0;                                     ///< nominal IMU rate [Hz]
   double imu_max_gap_s = 0.0;                                   ///< largest IMU time step [s]
+  bool time_base_known = false;                                 ///< time_zero_unix_s given
 };
 
 /**
