@@ -37,6 +37,8 @@ foreach(_case
     "power_rate|diagnose-power|--rate|0.5:10|rates must be in"
     "power_snr|diagnose-power|--snr|5:1|LO:HI"
     "power_causes|diagnose-power|--causes|gm|unknown cause 'gm'"
+    "power_snr_high|diagnose-power|--snr|5:2000|must be in \\[0, 1000\\]"
+    "power_simulations_one|diagnose-power|--simulations|1|at least 2"
     "wv_gyro_unit|wv|--gyro-unit|furlong|'furlong' is not a known unit"
     "fit_weights|fit|--weights|bogus|bogus")
   navimpact_cli_case("${_case}" _n _cmd _flag _val _re)

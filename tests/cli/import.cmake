@@ -139,3 +139,10 @@ navimpact_cli_check(cli_replay_katwijk_gate_locks_out CHECK run_json
   DEFINES OUT=${_idir}/katwijk_gate_locked JSON_FILE=summary.json
   JSON "readmitted_updates=^0$" "reference_errors/horizontal_rms_m=^[1-9][0-9][0-9]+\\.")
 set_tests_properties(cli_replay_katwijk_gate_locks_out PROPERTIES FIXTURES_REQUIRED import_katwijk)
+
+# --overwrite never replaces an input of the run: import --out onto its own
+# manifest replaced it with the rawlog (found by a probe); a copy of the run
+file(COPY ${_kat}/ DESTINATION ${_idir}/own_input)
+navimpact_cli_fail(cli_import_out_onto_its_manifest EXIT 1
+  ARGS import --manifest ${_idir}/own_input/manifest.yaml --out ${_idir}/own_input/manifest.yaml --overwrite
+  REGEX "^navimpact: [^ ]*own_input/manifest.yaml: --overwrite: it is an input of this run \\(write the output elsewhere\\)$")
