@@ -184,8 +184,9 @@ TEST(Replay, ImuGapIsAnErrorUnlessAllowedThenPropagatedAcross) {
 // its variance from the rates' own changes) is added, so the errors after the
 // gap stay within a few predicted sigmas (found by a probe: a 0.5 s gap of the
 // UAV run coasted with held rates and no added uncertainty left pitch 1.4 deg
-// off with sigma 0.02 deg, NEES 1.3e5). Gaps drawn over (0.05, 1] s anywhere in
-// [10, 45] s of the flight (seeded, logged); perfect IMU, reference model filter.
+// off with sigma 0.02 deg, NEES 1.3e5). Gaps drawn over the whole accepted
+// range, from one missing sample to kMaxImuGapS, anywhere in [10, 45] s of the
+// flight (seeded, logged); perfect IMU, reference model filter.
 TEST(Replay, AcrossAnAllowedImuGapTheErrorsStayWithinTheirSigmas) {
   const std::uint64_t seed = 1513;
   std::mt19937_64 rng(seed);
@@ -194,14 +195,16 @@ TEST(Replay, AcrossAnAllowedImuGapTheErrorsStayWithinTheirSigmas) {
   const double dt = d0.imu[1].t - d0.imu[0].t;
   for (int trial = 0; trial < 6; ++trial) {
     auto d = d0;
-    const double len = 0.05 + 0.95 * U(rng), at = 10.0 + 35.0 * U(rng);
+    // a gap of missing + 1 steps, at most kMaxImuGapS
+    const auto most = static_cast<std::size_t>(std::floor(an::kMaxImuGapS / dt + 1e-9)) - 1;
+    const auto missing = 1 + static_cast<std::size_t>(U(rng) * double(most));
+    const double at = 10.0 + 35.0 * U(rng);
     const auto first = static_cast<std::size_t>(at / dt);
-    const auto missing = std::max<std::size_t>(2, static_cast<std::size_t>(len / dt));
     const double gapEnd = d.imu[first + missing].t;
     d.imu.erase(d.imu.begin() + static_cast<std::ptrdiff_t>(first),
                 d.imu.begin() + static_cast<std::ptrdiff_t>(first + missing));
     an::ReplayConfig c = refReplay(writtenRawlog(d, "gap" + std::to_string(trial) + ".rawlog"));
-    c.max_imu_gap_s = 1.1;
+    c.max_imu_gap_s = an::kMaxImuGapS;
     const auto r = an::runReplay(c);
     ASSERT_EQ(r.imu_gaps, 1u);
     double worst = 0.0, worstT = 0.0;
