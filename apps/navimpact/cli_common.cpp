@@ -54,6 +54,20 @@ CLI::Validator parsedBy(std::function<void(const std::string&)> parse, std::stri
       std::move(text));
 }
 
+CLI::Validator knownUnit(units::Quantity q) {
+  return parsedBy(
+      [q](const std::string& u) {
+        try {
+          units::toSiFactor(q, u);
+        } catch (const Error&) {
+          std::string accepted;
+          for (const auto& a : units::acceptedUnits(q)) accepted += (accepted.empty() ? "" : ", ") + a;
+          throw Error("'" + printable(u, 40) + "' is not a known unit (accepted: " + accepted + ")");
+        }
+      },
+      "UNIT");
+}
+
 CLI::Validator seedValue() {
   return CLI::Validator(
       [](std::string& s) -> std::string {

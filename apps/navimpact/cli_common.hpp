@@ -9,6 +9,7 @@
 
 #include "navimpact/core/limits.hpp"
 #include "navimpact/core/output.hpp"
+#include "navimpact/core/units.hpp"
 
 namespace navimpact::cli {
 
@@ -59,6 +60,10 @@ inline constexpr limits::Range kThreads{0.0, 1024.0, false, ""};
 /// number out of its range; the parser's message is kept, without a leading
 /// "FLAG: " (CLI11 names the flag). @p text is the value's form in --help.
 CLI::Validator parsedBy(std::function<void(const std::string&)> parse, std::string text);
+
+/// A unit name of quantity @p q that units::toSiFactor knows (--gyro-unit deg/h):
+/// "'furlong/s' is not a known unit (accepted: rad/s, deg/s, ...)".
+CLI::Validator knownUnit(units::Quantity q);
 
 /// A seed: an integer 0 .. 2^64 - 1 in decimal digits (CLI11 read "-1" as
 /// 2^64 - 1, a silent wrap), the same seeds as a configuration's seed keys.

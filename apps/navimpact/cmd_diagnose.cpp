@@ -230,8 +230,10 @@ navimpact::cli::Registrar reg(
            ->needs(runOpt);
        app.add_option("--static-rate", o->static_rate, "--static: sampling rate [Hz] of a CSV without time column")
            ->check(navimpact::cli::within(navimpact::limits::kImuRateHz));
-       app.add_option("--static-gyro-unit", o->static_gyro_unit, "--static: gyroscope unit");
-       app.add_option("--static-acc-unit", o->static_acc_unit, "--static: accelerometer unit");
+       app.add_option("--static-gyro-unit", o->static_gyro_unit, "--static: gyroscope unit")
+           ->check(navimpact::cli::knownUnit(navimpact::units::Quantity::AngularRate));
+       app.add_option("--static-acc-unit", o->static_acc_unit, "--static: accelerometer unit")
+           ->check(navimpact::cli::knownUnit(navimpact::units::Quantity::SpecificForce));
        app.add_option("--static-axes", o->static_axes, "--static: sensor-to-body FRD axes");
        app.add_option("--durations", o->durations, "--run: outage durations [s], comma separated")
            ->delimiter(',')

@@ -70,19 +70,14 @@ std::vector<na::Cause> parseCauses(const std::string& text) {
 }
 
 /// FLAG LO:HI with both ends in [lo, hi] (what: the ends' name and unit).
-void checkRange(const char* flag, const std::string& v, double lo, double hi, const std::string& what) {
+/// FLAG LO:HI within @p r: "--rate '0.5:10': rates must be in [1, 10000] Hz".
+void checkRange(const char* flag, const std::string& v, const navimpact::limits::Range& r, const std::string& what) {
   const auto [a, b] = range(flag, v);
-  if (!(a >= lo && b <= hi))
-    throw navimpact::Error(std::string(flag) + " '" + navimpact::printable(v, 60) + "': " + what + " must be in [" +
-                           navimpact::formatNumber(lo) + ", " + navimpact::formatNumber(hi) + "]");
-}
-
-/// --rate LO:HI within the documented IMU rates.
-void checkRateRange(const std::string& v) {
-  const auto [a, b] = range("--rate", v);
-  if (!(a >= navimpact::limits::kImuRateHz.lo && b <= navimpact::limits::kImuRateHz.hi))
-    throw navimpact::Error("--rate '" + navimpact::printable(v, 60) + "': rates must be in " +
-                           navimpact::limits::describe(navimpact::limits::kImuRateHz));
+  if (!(a >= r.lo && b <= r.hi)) {
+    std::string text = navimpact::limits::describe(r);
+    while (!text.empty() && text.back() == ' ') text.pop_back();
+    throw navimpact::Error(std::string(flag) + " '" + navimpact::printable(v, 60) + "': " + what + " must be in " + text);
+  }
 }
 
 int run(const Opts& o) {
@@ -142,21 +137,22 @@ navimpact::cli::Registrar reg(
        app.add_option("--null-runs", o->null_runs, "null records (six channels, drawn from the model)")
            ->capture_default_str()
            ->check(navimpact::cli::within(counts));
-       auto lohi = [](const char* flag, double lo, double hi, const char* what) {
-         return navimpact::cli::parsedBy([=](const std::string& s) { checkRange(flag, s, lo, hi, what); }, "LO:HI");
+       auto lohi = [](const char* flag, navimpact::limits::Range r, const char* what) {
+         return navimpact::cli::parsedBy([=](const std::string& s) { checkRange(flag, s, r, what); }, "LO:HI");
        };
        app.add_option("--snr", o->snr, "effect size as multiples of the detection limit, drawn log-uniform LO:HI")
            ->capture_default_str()
-           ->check(lohi("--snr", 0.0, 1000.0, "multiples of the limit"));
+           ->check(lohi("--snr", {0.0, 1000.0, false, ""}, "multiples of the limit"));
        app.add_option("--rate", o->rate, "sampling rate range LO:HI [Hz], log-uniform")
            ->capture_default_str()
-           ->check(navimpact::cli::parsedBy(checkRateRange, "LO:HI"));
+           ->check(lohi("--rate", navimpact::limits::kImuRateHz, "rates"));
        app.add_option("--duration-h", o->duration_h, "record duration range LO:HI [h], log-uniform (e.g. 0.5:10; overrides --samples)")
-           ->check(lohi("--duration-h", navimpact::limits::kDurationS.lo / 3600.0, navimpact::limits::kDurationS.hi / 3600.0,
-                        "durations [h]"));
+           ->check(lohi("--duration-h",
+                        {navimpact::limits::kDurationS.lo / 3600.0, navimpact::limits::kDurationS.hi / 3600.0, false, "h"},
+                        "durations"));
        app.add_option("--samples", o->samples, "record length range LO:HI [samples], log-uniform")
            ->capture_default_str()
-           ->check(lohi("--samples", 4096.0, 1e12, "record lengths (a wavelet variance of 12 scales needs 4096)"));
+           ->check(lohi("--samples", {4096.0, 1e12, false, ""}, "record lengths (a wavelet variance of 12 scales needs 4096)"));
        app.add_option("--causes", o->causes, "comma-separated causes (default: all eight)")
            ->check(navimpact::cli::parsedBy([](const std::string& s) { parseCauses(s); }, "CAUSE,..."));
        app.add_option("--seed", o->seed, "root seed")->capture_default_str()->check(navimpact::cli::seedValue());

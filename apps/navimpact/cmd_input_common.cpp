@@ -15,22 +15,6 @@ namespace navimpact::cli {
 
 namespace {
 
-std::string joined(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s;
-}
-
-void checkUnit(const InputOpts& o, units::Quantity q, const std::string& unit, const char* flag) {
-  if (unit.empty()) return;
-  try {
-    units::toSiFactor(q, unit);
-  } catch (const Error&) {
-    throw Error(o.input + ": " + flag + " '" + unit + "' is not a known unit (accepted: " +
-                joined(units::acceptedUnits(q)) + ")");
-  }
-}
-
 bool isSi(units::Quantity q, const std::string& unit) {
   return unit.empty() || units::toSiFactor(q, unit) == 1.0;
 }
@@ -60,23 +44,12 @@ void addInputOptions(CLI::App& app, InputOpts& o) {
   app.add_option("--rate", o.rate_hz,
                  "sampling rate [Hz]; required for CSV without a time column, checked for rawlog")
       ->check(within(limits::kImuRateHz));
-  auto unitOf = [](units::Quantity q) {
-    return parsedBy(
-        [q](const std::string& u) {
-          try {
-            units::toSiFactor(q, u);
-          } catch (const Error&) {
-            throw Error("'" + printable(u, 40) + "' is not a known unit (accepted: " + joined(units::acceptedUnits(q)) + ")");
-          }
-        },
-        "UNIT");
-  };
   app.add_option("--gyro-unit", o.gyro_unit,
                  "CSV gyroscope unit: rad/s, deg/s, deg/h, mrad/s (default: from the header)")
-      ->check(unitOf(units::Quantity::AngularRate));
+      ->check(knownUnit(units::Quantity::AngularRate));
   app.add_option("--acc-unit", o.acc_unit,
                  "CSV accelerometer unit: m/s2, g, mg, ug (default: from the header)")
-      ->check(unitOf(units::Quantity::SpecificForce));
+      ->check(knownUnit(units::Quantity::SpecificForce));
   app.add_option("--axes", o.axes,
                  "sensor-to-body FRD axes, e.g. x,-y,-z for a forward-left-up sensor");
   app.add_option("--label", o.label, "rawlog sensor label of the IMU observations")
@@ -91,8 +64,6 @@ void addInputOptions(CLI::App& app, InputOpts& o) {
 }
 
 ImuSeries loadInput(const InputOpts& o, InputFormat* format) {
-  checkUnit(o, units::Quantity::AngularRate, o.gyro_unit, "--gyro-unit");
-  checkUnit(o, units::Quantity::SpecificForce, o.acc_unit, "--acc-unit");
   if (!std::filesystem::exists(o.input)) throw Error(o.input + ": file not found");
   if (std::filesystem::is_directory(o.input)) throw Error(o.input + ": is a directory, not a file");
   if (std::filesystem::file_size(o.input) == 0) throw Error(o.input + ": empty file");

@@ -396,8 +396,7 @@ unsigned powerThreads(const PowerOptions& opt) {
   const double hw = std::max(1u, std::thread::hardware_concurrency());
   const DrawRanges& r = opt.ranges;
   const double nMax = r.max_duration_s > 0 ? r.max_duration_s * r.max_rate_hz : double(r.max_samples);
-  const double fit = std::floor(limits::kDefaultMemoryBudgetBytes / (std::max(nMax, 1.0) * kPowerBytesPerSample));
-  return static_cast<unsigned>(std::max(1.0, std::min(hw, fit)));
+  return limits::budgetWorkers(hw, nMax, 0.0, kPowerBytesPerSample);
 }
 
 void checkPowerOptions(const PowerOptions& opt) {

@@ -574,7 +574,7 @@ void ReplayDriver::run() {
   {
     std::vector<double> steps(imuQ_.size() - 1);
     for (std::size_t k = 1; k < imuQ_.size(); ++k) steps[k - 1] = imuQ_[k].t - imuQ_[k - 1].t;
-    med_ = nominalStep(std::move(steps));
+    med_ = nominalStep(steps);
     const double dt0 = imuQ_[1].t - imuQ_[0].t;
     dt_ = std::abs(dt0 - med_) <= 0.01 * med_ ? dt0 : med_;
   }

@@ -1101,10 +1101,8 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt_in) {
     const double n = double(data.data.imu.size());
     const double budget = limits::kDefaultMemoryBudgetBytes;
     unsigned workers = workerThreads(static_cast<unsigned>(std::max(opt.threads, 0)), std::size_t(opt.realisations));
-    if (opt.threads == 0) {
-      const double fit = std::floor((budget / std::max(n, 1.0) - kRunBytesPerSample) / kRunBytesPerSampleAndWorker);
-      workers = static_cast<unsigned>(std::max(1.0, std::min(double(workers), fit)));
-    }
+    if (opt.threads == 0)
+      workers = limits::budgetWorkers(double(workers), n, kRunBytesPerSample, kRunBytesPerSampleAndWorker);
     opt.threads = static_cast<int>(workers);
     const double bytes = n * (kRunBytesPerSample + kRunBytesPerSampleAndWorker * workers);
     limits::checkBudget({{opt.replay.rawlog, "diagnose --run", bytes / 1e6, budget / 1e6, "MB",

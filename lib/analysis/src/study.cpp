@@ -340,8 +340,7 @@ StudyWork studyWork(const StudyPlan& p, const Shard& shard, unsigned threads) {
 unsigned studyThreads(const StudyPlan& p, const Shard& shard, unsigned requested) {
   if (requested > 0) return requested;
   const StudyWork w = studyWork(p, shard, 0);
-  const double fit = std::floor((limits::kDefaultMemoryBudgetBytes / std::max(w.samples, 1.0) - 100.0) / 120.0);
-  return static_cast<unsigned>(std::max(1.0, std::min(w.workers, fit)));
+  return limits::budgetWorkers(w.workers, w.samples, 100.0, 120.0);
 }
 
 void checkStudyBudget(const std::string& command, const StudyWork& w, bool allow_large) {

@@ -1,5 +1,6 @@
 #include "navimpact/core/limits.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -27,6 +28,12 @@ double check(const std::string& file, const std::string& key, double v, const Ra
   const bool ok = std::isfinite(v) && (r.lo_open ? v > r.lo : v >= r.lo) && v <= r.hi;
   if (!ok) throw keyError(file, key, "must be in " + describe(r) + ", got " + gotText(v));
   return v;
+}
+
+unsigned budgetWorkers(double most, double samples, double fixed_bytes_per_sample, double worker_bytes_per_sample) {
+  const double fit = std::floor((kDefaultMemoryBudgetBytes / std::max(samples, 1.0) - fixed_bytes_per_sample) /
+                                worker_bytes_per_sample);
+  return static_cast<unsigned>(std::max(1.0, std::min(most, fit)));
 }
 
 void checkBudget(const std::initializer_list<BudgetEstimate>& estimates, bool allow_large) {

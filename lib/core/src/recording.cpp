@@ -97,7 +97,7 @@ std::string recordProblem(const ReferenceRecord& r) {
   return "";
 }
 
-double nominalStep(std::vector<double> steps) {
+double nominalStep(const std::vector<double>& steps) {
   if (steps.empty()) return 0.0;
   std::vector<double> sorted = steps;
   const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);

@@ -164,6 +164,15 @@ struct BudgetEstimate {
  */
 void checkBudget(const std::initializer_list<BudgetEstimate>& estimates, bool allow_large);
 
+/**
+ * The one rule for "all cores" within the memory budget: as many workers as
+ *   floor((kDefaultMemoryBudgetBytes / n - fixed) / per_worker)
+ * bytes per sample allow, at most @p most and at least one, for a run holding
+ * @p samples samples of @p fixed_bytes_per_sample shared and
+ * @p worker_bytes_per_sample per worker (README "Ranges and budgets").
+ */
+unsigned budgetWorkers(double most, double samples, double fixed_bytes_per_sample, double worker_bytes_per_sample);
+
 /// Text of a range, e.g. "(0, 1e+04] m".
 std::string describe(const Range& r);
 

@@ -118,6 +118,6 @@ std::string recordProblem(const ReferenceRecord& r);
 /// step (400 Hz at 1 ms: 2, 3, 2, 3 ms) or alternating (9, 11 ms) have a
 /// median of one of their values (333 or 500 Hz; 91 or 111 Hz) but the mean
 /// of the true rate (400 Hz; 100 Hz). Not > 0 when the median is not.
-double nominalStep(std::vector<double> steps);
+double nominalStep(const std::vector<double>& steps);
 
 }  // namespace navimpact
