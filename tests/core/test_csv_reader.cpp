@@ -149,6 +149,31 @@ TEST(CsvReader, TextTheLinesCannotBeReadFromIsNamedAndTinyValuesAreZero) {
   EXPECT_EQ(readImuCsv(writeFile("crlf.csv", "gyro_x,acc_x\r\n1,2\r\n3,4\r\n"), o).size(), 2u);  // CR LF is fine
 }
 
+// Found by the intake probe: a bzip2, xz or zstd file was "zero bytes or a
+// UTF-16 byte-order mark". Each packed format is named with its unpacker;
+// a text that merely starts with "BZh" is still read as text.
+TEST(CsvReader, PackedFilesAreNamedWithTheirUnpacker) {
+  const CsvImuOptions o = degG();
+  const struct {
+    std::string bytes, format, tool;
+  } packed[] = {
+      {std::string("BZh91AY&SY\x12\x00\x9a", 13), "bzip2-compressed", "bunzip2 -k FILE"},
+      {std::string("\xFD" "7zXZ\0\0\x04", 8), "xz-compressed", "unxz -k FILE"},
+      {std::string("\x28\xB5\x2F\xFD\x24\x00", 6), "zstd-compressed", "unzstd FILE"},
+      {std::string("PK\x03\x04\x14\x00", 6), "a zip archive", "unzip FILE"},
+      {std::string("7z\xBC\xAF\x27\x1C\x00", 7), "a 7-Zip archive", "7z x FILE"},
+      {std::string("\x04\x22\x4D\x18\x64", 5), "lz4-compressed", "unlz4 FILE"},
+  };
+  int k = 0;
+  for (const auto& p : packed) {
+    const auto f = writeFile("packed" + std::to_string(k++) + ".csv", p.bytes);
+    EXPECT_EQ(errorOf(f, o), f + ":1: the file is " + p.format + ": navimpact reads plain text or gzip; unpack it first (" +
+                                 p.tool + ")");
+  }
+  const auto text = writeFile("bzh.csv", "BZh_gyro,acc_x\n1,2\n");  // "BZh" then no block-size digit: a header
+  EXPECT_EQ(errorOf(text, o).find("the file is"), std::string::npos) << errorOf(text, o);
+}
+
 TEST(CsvReader, ReadsTheFullStaticRecording) {
   const ImuSeries s = readImuCsv(test::dataPath("adis16405_static_1.csv.gz"), degG());
   ASSERT_EQ(s.size(), 1000000u);

@@ -252,6 +252,18 @@ TEST(OutputSet, NamesUpToTheFileSystemLimitAndNoStagingLookalikes) {
   std::ofstream(file.stagedFile()) << "1\n";
   file.commit();
   EXPECT_TRUE(fs::exists(base / (longName.substr(0, 250) + ".yaml")));
+  // one byte more fails when the output is set up, before any work, and leaves nothing
+  for (const bool folder : {true, false}) {
+    try {
+      if (folder) OutputSet(base / (longName + "e"));
+      else OutputSet::singleFile(base / (longName + "e"));
+      ADD_FAILURE() << "a 256-byte name was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("the output name is 256 bytes long, more than the 255"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(stagingCount(base), 0);
   // an output named like a staging folder would be removed by a later run
   EXPECT_THROW(OutputSet(base / (std::string(OutputSet::kStagingPrefix) + "1_0123456789abcdef_0123456789abcdef_x")),
                Error);

@@ -3,7 +3,9 @@
 // every bad input is one error naming the file, the line and the key.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <cstdio>
 #include <fstream>
 #include <random>
@@ -152,6 +154,56 @@ std::string randomRun(std::uint64_t seed, TrueRun& run, const fs::path& dir) {
   if (run.zero_unix) m << "time_zero_unix_s: " << g17(*run.zero_unix) << "\n";
   writeFile(dir / "run.yaml", m.str());
   return (dir / "run.yaml").string();
+}
+
+// Found by the intake probe: a tab written as YAML writes it ("\t", or '\t'
+// in single quotes) was refused although `tab` was accepted. All three read
+// the same tab-separated file as the ';' file it was made from.
+TEST(ImportManifest, ATabDelimiterMaybeWrittenAsYamlWritesIt) {
+  auto slurp = [](const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  for (std::uint64_t seed = 20261130;; ++seed) {
+    const fs::path dir = test::tempDir() / ("tab" + std::to_string(seed));
+    fs::create_directories(dir);
+    TrueRun run;
+    const std::string manifest = randomRun(seed, run, dir);
+    Recording semi;
+    try {
+      semi = import::importManifest(manifest);
+    } catch (const Error&) {
+      continue;  // a stream drawn outside the IMU's span (tested above): the next seed
+    }
+    std::string ref = slurp(dir / "ref.csv"), yaml = slurp(manifest);
+    std::replace(ref.begin(), ref.end(), ';', '\t');
+    writeFile(dir / "ref.csv", ref);
+    const std::string semiKey = "delimiter: \";\"";
+    ASSERT_NE(yaml.find(semiKey), std::string::npos);
+    for (const std::string tab : {"\"\\t\"", "'\\t'", "tab"}) {
+      std::string y = yaml;
+      y.replace(y.find(semiKey), semiKey.size(), "delimiter: " + tab);
+      writeFile(manifest, y);
+      const Recording d = import::importManifest(manifest);
+      ASSERT_EQ(d.reference.size(), semi.reference.size()) << tab;
+      for (std::size_t k = 0; k < d.reference.size(); ++k) {
+        EXPECT_EQ(d.reference[k].t, semi.reference[k].t) << tab;
+        EXPECT_EQ(d.reference[k].p_L, semi.reference[k].p_L) << tab;
+      }
+    }
+    {
+      std::string y = yaml;
+      y.replace(y.find(semiKey), semiKey.size(), "delimiter: \"\\n\"");
+      writeFile(manifest, y);
+      try {
+        import::importManifest(manifest);
+        ADD_FAILURE() << "a line break accepted as delimiter";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("reference.delimiter"), std::string::npos) << e.what();
+      }
+    }
+    break;
+  }
 }
 
 TEST(ImportManifest, RandomRunsComeBackAsTheirTruth) {

@@ -80,3 +80,17 @@ TEST(RawlogBadInput, CsvWithByteOrderMarkIsNotSniffedAsRawlog) {
   std::ofstream(p, std::ios::binary) << "\xEF\xBB\xBFgyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n1,2,3,4,5,6\n";
   EXPECT_FALSE(rawlog::isRawlogFile(p));
 }
+
+// Found by the intake probe: an xz- or bzip2-compressed rawlog ("run.rawlog.xz"
+// renamed, or unpacked by a tool that did nothing) reached MRPT, which said "class
+// name has more than 120 chars". Both readers name the format and its unpacker;
+// the gzip rawlog beside it still reads.
+TEST(RawlogBadInput, APackedRawlogIsNamedWithItsUnpacker) {
+  const auto xz = (test::tempDir() / "run_xz.rawlog").string();
+  std::ofstream(xz, std::ios::binary) << std::string("\xFD" "7zXZ\0\0\x04\xE6\xD6\xB4\x46", 12);
+  expectBoth(xz, "IMU", {xz + ": the file is xz-compressed: navimpact reads plain text or gzip; unpack it first (unxz -k FILE)"});
+  const auto bz = (test::tempDir() / "run_bz.rawlog").string();
+  std::ofstream(bz, std::ios::binary) << std::string("BZh91AY&SY\x9e\x00", 12);
+  expectBoth(bz, "IMU", {bz + ": the file is bzip2-compressed"});
+  EXPECT_NO_THROW(rawlog::readRawlog(test::sourcePath("tests/data/imu_label_xsens.rawlog")));
+}

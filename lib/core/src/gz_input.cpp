@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <string_view>
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
@@ -151,6 +152,32 @@ int GzInput::peek() {
   return out_[outHead_];
 }
 
+std::string packedFormat(std::string_view head) {
+  struct Magic {
+    std::string_view bytes;
+    const char* what;
+  };
+  static constexpr Magic kMagic[] = {
+      {std::string_view("BZh", 3), "bzip2-compressed (bunzip2 -k FILE)"},
+      {std::string_view("\xFD" "7zXZ\0", 6), "xz-compressed (unxz -k FILE)"},
+      {std::string_view("\x28\xB5\x2F\xFD", 4), "zstd-compressed (unzstd FILE)"},
+      {std::string_view("PK\x03\x04", 4), "a zip archive (unzip FILE)"},
+      {std::string_view("7z\xBC\xAF\x27\x1C", 6), "a 7-Zip archive (7z x FILE)"},
+      {std::string_view("\x04\x22\x4D\x18", 4), "lz4-compressed (unlz4 FILE)"},
+  };
+  for (const Magic& m : kMagic)
+    if (head.size() >= m.bytes.size() && head.compare(0, m.bytes.size(), m.bytes) == 0 &&
+        (m.bytes != "BZh" || (head.size() > 3 && head[3] >= '1' && head[3] <= '9')))
+      return m.what;
+  return {};
+}
+
+std::string packedError(const std::string& packed) {
+  const auto open = packed.find(" (");
+  return "the file is " + packed.substr(0, open) + ": navimpact reads plain text or gzip; unpack it first" +
+         packed.substr(open);
+}
+
 LineReader::LineReader(const std::string& path, std::size_t max_line) : in_(path), maxLine_(max_line) {
   const std::uint64_t n = in_.statedSize();  // 0: not known (not a regular file)
   buf_.resize(n > 0 ? static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, n + 1)) : kChunk);
@@ -196,6 +223,8 @@ bool LineReader::next(std::string_view& line) {
         static_cast<unsigned char>(line[1]) == 0xBB && static_cast<unsigned char>(line[2]) == 0xBF)
       line.remove_prefix(3);
     // text the lines cannot be read from: named rather than read as one odd line
+    if (const std::string packed = packedFormat(line); !packed.empty())
+      throw fileError(in_.path(), 1, packedError(packed));
     if (line.find('\0') != std::string_view::npos ||
         (line.size() >= 2 && ((line[0] == '\xFF' && line[1] == '\xFE') || (line[0] == '\xFE' && line[1] == '\xFF'))))
       throw fileError(in_.path(), 1,

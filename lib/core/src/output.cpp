@@ -57,12 +57,12 @@ std::set<fs::path>& inputs() {
   return s;
 }
 
-/// An input of this run inside @p d (canonical), or "".
-std::string inputInside(const fs::path& d) {
+/// An input of this run that is @p p or lies inside it (canonical paths), or "".
+std::string inputAt(const fs::path& p) {
   std::lock_guard<std::mutex> lock(g_inputsMutex);
   for (const auto& in : inputs()) {
-    const auto rel = in.lexically_relative(d);
-    if (!rel.empty() && *rel.begin() != ".." && rel != ".") return in.string();
+    const auto rel = in.lexically_relative(p);
+    if (!rel.empty() && *rel.begin() != "..") return in.string();
   }
   return {};
 }
@@ -84,7 +84,7 @@ std::string refuseReplace(const fs::path& dest) {
   if (!rel.empty() && *rel.begin() != "..") return "refusing to replace the current folder or a folder containing it";
   if (deeperThanOneLevel(d))
     return "it holds folders of folders, which no navimpact output does; remove it yourself if it is meant";
-  if (const std::string in = inputInside(d); !in.empty())
+  if (const std::string in = inputAt(d); !in.empty())
     return "it holds " + in + ", an input of this run (write the output elsewhere)";
   return {};
 }
@@ -194,12 +194,14 @@ OutputSet::OutputSet(fs::path dest, Overwrite ow, Kind kind) : dest_(std::move(d
         if (ow_ == Overwrite::Refuse) throw Error(shown + ": output file exists (pass --overwrite to replace it)");
       }
     }
+    // a name the folder cannot hold fails here, before the work, not at commit
+    if (const long most = ::pathconf(parent.c_str(), _PC_NAME_MAX);
+        most > 0 && abs.filename().string().size() > static_cast<std::size_t>(most))
+      throw Error(shown + ": the output name is " + std::to_string(abs.filename().string().size()) +
+                  " bytes long, more than the " + std::to_string(most) + " a name in " + parent.string() + " may have");
     if (abs.filename().string().compare(0, std::strlen(kStagingPrefix), kStagingPrefix) == 0)
       throw Error(shown + ": an output name starting with " + kStagingPrefix +
                   " is a staging folder's, which later runs remove (choose another name)");
-    if (ow_ == Overwrite::Replace && fs::exists(st))
-      if (const std::string in = inputInside(fs::weakly_canonical(abs, ec)); !in.empty())
-        throw Error(shown + ": --overwrite: it holds " + in + ", an input of this run (write the output elsewhere)");
     std::random_device rd;
     const std::uint64_t r = (static_cast<std::uint64_t>(rd()) << 32) ^ rd();
     static const std::string host = hostTag();
@@ -320,12 +322,8 @@ void OutputSet::commit() {
     if (!fs::exists(src, ec)) throw Error(shown + ": nothing was written");
     if (ow_ == Overwrite::Refuse && fs::exists(fs::symlink_status(target_, ec)))
       throw Error(shown + ": output file appeared while the job ran (pass --overwrite to replace it)");
-    if (!mayReplaceInput_ && fs::exists(target_, ec)) {
-      const fs::path t = fs::weakly_canonical(target_, ec);
-      std::lock_guard<std::mutex> lock(g_inputsMutex);
-      if (inputs().count(t))
-        throw Error(shown + ": --overwrite: it is an input of this run (write the output elsewhere)");
-    }
+    if (!mayReplaceInput_ && fs::exists(target_, ec) && !inputAt(fs::weakly_canonical(target_, ec)).empty())
+      throw Error(shown + ": --overwrite: it is an input of this run (write the output elsewhere)");
     if (std::rename(src.c_str(), target_.c_str()) != 0)
       throw Error(shown + ": cannot move the output into place (" + std::strerror(errno) + ")");
     fs::remove_all(staging_, ec);

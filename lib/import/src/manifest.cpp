@@ -94,8 +94,10 @@ StreamSpec streamSpec(const Keys& k, const ConfigNode& n, const std::string& nam
   StreamSpec s;
   s.name = name;
   s.file = n.inputFile("file", "the " + name + " CSV");
-  if (n["delimiter"]) {
-    const std::size_t i = k.oneOf(n["delimiter"], name + ".delimiter", {",", ";", "tab"});
+  if (const ConfigNode d = n["delimiter"]) {
+    // a tab also as YAML writes it: "\t" (a tab) or '\t' (backslash, t)
+    const bool tab = d.isScalar() && (d.scalar() == "\t" || d.scalar() == "\\t");
+    const std::size_t i = tab ? 2 : k.oneOf(d, name + ".delimiter", {",", ";", "tab"});
     s.delimiter = i == 0 ? ',' : i == 1 ? ';' : '\t';
   }
   const std::string tk = name + ".time";
@@ -330,8 +332,6 @@ Eigen::Quaterniond quatRpy(double roll, double pitch, double yaw) {
       .normalized();
 }
 
-
-
 }  // namespace
 
 Recording importManifest(const std::string& manifestPath, ImportReport* report) {
@@ -350,14 +350,14 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     for (int i = 0; i < 4; ++i)
       if (o[names[i]]) offset[i] = k.number(o[names[i]], std::string("time_offset_s.") + names[i], -1e6, 1e6, "s");
   }
-  std::optional<double> zeroUnix;
+  const bool timeBaseKnown = static_cast<bool>(root["time_zero_unix_s"]);
   // its whole seconds and their fraction, exactly as written ("1448546404.917"):
   // a double near 1.4e9 s holds 0.917 only to 2.4e-7 s, a tick of the rawlog's
   // 100 ns clock lost (found by a probe)
   long long zeroWhole = 0;
   double zeroFraction = 0.0;
-  if (root["time_zero_unix_s"]) {
-    zeroUnix = k.number(root["time_zero_unix_s"], "time_zero_unix_s", 0.0, 1e10, "s");
+  if (timeBaseKnown) {
+    const double zeroUnix = k.number(root["time_zero_unix_s"], "time_zero_unix_s", 0.0, 1e10, "s");
     const std::string text = root["time_zero_unix_s"].asText();
     const auto dot = text.find('.');
     if (text.find_first_not_of("0123456789.") == std::string::npos && dot != std::string::npos && dot > 0 &&
@@ -365,8 +365,8 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       zeroWhole = std::stoll(text.substr(0, dot));
       zeroFraction = dot + 1 < text.size() ? std::stod("0." + text.substr(dot + 1)) : 0.0;
     } else {
-      zeroWhole = static_cast<long long>(std::floor(*zeroUnix));
-      zeroFraction = *zeroUnix - static_cast<double>(zeroWhole);
+      zeroWhole = static_cast<long long>(std::floor(zeroUnix));
+      zeroFraction = zeroUnix - static_cast<double>(zeroWhole);
     }
   }
 
@@ -429,7 +429,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       for (std::size_t i = 0; i < raw.size(); ++i) raw[i] = tab.columns[tc][i] * s.time_factor;
       std::vector<double> steps(raw.size() - 1);
       for (std::size_t i = 1; i < raw.size(); ++i) steps[i - 1] = raw[i] - raw[i - 1];
-      const double nominal = nominalStep(std::move(steps));
+      const double nominal = nominalStep(steps);
       if (!(nominal > 0.0))
         throw fileError(s.file, tab.line[0], "column '" + printable(s.column) + "' (key imu.time.column): the median time step is not > 0");
       if (s.max_gap_s == 0.0) s.max_gap_s = 1.5 * nominal;
@@ -456,7 +456,6 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     rep.imu_file = s.file;
     rep.imu_rate_hz = d.imu_rate_hz;
     rep.imu_max_gap_s = maxGap;
-    rep.time_base_known = zeroUnix.has_value();
   }
 
   // --- GNSS -----------------------------------------------------------------
@@ -595,7 +594,8 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
   }
 
   // --- time base --------------------------------------------------------------
-  if (zeroUnix) {
+  rep.time_base_known = timeBaseKnown;
+  if (timeBaseKnown) {
     double earliest = d.imu.front().t;
     if (!d.gnss.empty()) earliest = std::min(earliest, d.gnss.front().t);
     if (!d.baro.empty()) earliest = std::min(earliest, d.baro.front().t);
@@ -620,7 +620,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       << formatExact(d.origin.lat / kDeg) << YAML::Key << "lon_deg" << YAML::Value << formatExact(d.origin.lon / kDeg) << YAML::Key
       << "height_m" << YAML::Value << formatExact(d.origin.h) << YAML::EndMap;
     y << YAML::Key << "time" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "start_unix_s" << YAML::Value
-      << d.start_unix_s << YAML::Key << "time_base_known" << YAML::Value << zeroUnix.has_value() << YAML::EndMap;
+      << d.start_unix_s << YAML::Key << "time_base_known" << YAML::Value << timeBaseKnown << YAML::EndMap;
     y << YAML::Key << "imu" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "rate_hz" << YAML::Value
       << formatExact(d.imu_rate_hz) << YAML::EndMap;
     if (d.lever_arm_B) {

@@ -93,4 +93,12 @@ class LineReader {
   bool first_ = true;
 };
 
+/// The compression or archive format (not gzip, which is read directly) whose
+/// magic number starts @p head, with the command that unpacks it:
+/// "bzip2-compressed (bunzip2 -k FILE)"; "" for anything else.
+std::string packedFormat(std::string_view head);
+/// "the file is bzip2-compressed: navimpact reads plain text or gzip; unpack it
+/// first (bunzip2 -k FILE)" for a packedFormat() text.
+std::string packedError(const std::string& packed);
+
 }  // namespace navimpact
