@@ -23,6 +23,7 @@
 
 #include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/units.hpp"
 #include "navimpact/core/format.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/core/yaml_load.hpp"
@@ -463,6 +464,14 @@ bool ReplayDriver::nextSample(ins::ImuSample& s, double* psd_w, double* psd_f) {
         throw Error(cfg_.rawlog + ": IMU gaps hold more missing samples than the data has samples");
       const ImuRecord& before = recent_.back();
       const auto [pw, pf] = gapPsd(rec, h);
+      // the attitude uncertainty the bridge adds (PSD pw over h): beyond the
+      // linearised filter, the gap cannot be bridged honestly
+      if (const double sigmaAtt = std::sqrt(pw * h); !(sigmaAtt <= kMaxGapAttitudeSigmaRad))
+        throw Error(cfg_.rawlog + ": IMU gap of " + g10(h) + " s ending at t = " + g10(rec.t - r_.t_zero) +
+                    " s: the rates change too fast around it to bridge it (an attitude uncertainty of " +
+                    formatNumber(sigmaAtt / units::kDeg, 3) + " deg, 1 sigma, above the " +
+                    formatNumber(kMaxGapAttitudeSigmaRad / units::kDeg, 3) +
+                    " deg the linearised filter holds): cut the rawlog at the gap (rawlog-edit --cut) and replay the parts");
       double last = prevT_;
       for (std::size_t j = 1; j <= m; ++j) {
         const double t = j == m ? rec.t : prevT_ + h * static_cast<double>(j) / static_cast<double>(m);
