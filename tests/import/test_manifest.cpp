@@ -206,6 +206,51 @@ TEST(ImportManifest, ATabDelimiterMaybeWrittenAsYamlWritesIt) {
   }
 }
 
+// Velocity sigma columns are in the velocity's own frame order: an ENU
+// velocity's [se, sn, su] become sigmas about N, E, D (found by a probe: they
+// were read as N, E, D whatever the frame). The run's position sigma columns
+// (N, E, D) serve as velocity sigmas, listed in the frame's order; the fixes'
+// velocity covariance must be their squares about N, E, D.
+TEST(ImportManifest, VelocitySigmaColumnsFollowTheVelocitysFrame) {
+  auto slurp = [](const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  bool seen[2] = {false, false};  // NED, ENU
+  for (std::uint64_t seed = 20261130; !(seen[0] && seen[1]) && seed < 20261130 + 200; ++seed) {
+    const fs::path dir = test::tempDir() / ("vsig" + std::to_string(seed));
+    fs::create_directories(dir);
+    TrueRun run;
+    const std::string manifest = randomRun(seed, run, dir);
+    std::string yaml = slurp(manifest);
+    if (yaml.find("sigma: {columns: [sn, se, sd]") == std::string::npos) continue;  // constant position sigma
+    const bool enu = yaml.find("frame: ENU") != std::string::npos;
+    if (seen[enu]) continue;
+    const std::string unitKey = "frame: " + std::string(enu ? "ENU" : "NED") + ", unit: m/s}";
+    ASSERT_NE(yaml.find(unitKey), std::string::npos);
+    yaml.replace(yaml.find(unitKey), unitKey.size(),
+                 "frame: " + std::string(enu ? "ENU" : "NED") + ", unit: m/s, sigma: {columns: " +
+                     (enu ? "[se, sn, sd]" : "[sn, se, sd]") + ", unit: m/s}}");
+    writeFile(manifest, yaml);
+    Recording d;
+    try {
+      d = import::importManifest(manifest);
+    } catch (const Error&) {
+      continue;  // a stream drawn outside the IMU's span: the next seed
+    }
+    seen[enu] = true;
+    ASSERT_EQ(d.gnss.size(), run.sig.size());
+    for (std::size_t k = 0; k < d.gnss.size(); ++k) {
+      ASSERT_TRUE(d.gnss[k].cov_vel_N.has_value());
+      const Eigen::Vector3d var = d.gnss[k].cov_vel_N->diagonal();
+      for (int a = 0; a < 3; ++a)
+        EXPECT_NEAR(var[a], run.sig[k][a] * run.sig[k][a], 1e-12 * run.sig[k][a] * run.sig[k][a])
+            << (enu ? "ENU" : "NED") << " fix " << k << " axis " << a;
+    }
+  }
+  EXPECT_TRUE(seen[0] && seen[1]);
+}
+
 TEST(ImportManifest, RandomRunsComeBackAsTheirTruth) {
   const std::uint64_t base = 20261124;
   for (std::uint64_t s = 0; s < 24; ++s) {

@@ -325,6 +325,15 @@ std::optional<Eigen::Vector3d> velocityAt(const StreamSpec& s, const ColumnTable
   return Eigen::Vector3d(a * v.factor, b * v.factor, c * v.factor);
 }
 
+/// The velocity sigma of row i per axis N, E, D [m/s]: sigma columns are given
+/// in the velocity's own frame, so an ENU velocity's [se, sn, su] swap to N, E, D.
+Eigen::Vector3d velocitySigmaAt(const StreamSpec& s, const ColumnTable& tab, const VelocitySpec& v,
+                                const std::string& key, std::size_t i) {
+  Eigen::Vector3d sig = sigmaAt(s, tab, v.sigma, key, i);
+  if (v.enu && v.sigma.cols.size() == 3) std::swap(sig[0], sig[1]);
+  return sig;
+}
+
 /// C_BtoN from ZYX roll, pitch, yaw (yaw clockwise from true north; README conventions).
 Eigen::Quaterniond quatRpy(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
@@ -485,7 +494,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       f.pos = positionAt(s, tab, ps, *gnssUndulation, "gnss.position", i);
       f.v_N = velocityAt(s, tab, vs, "gnss.velocity", i);
       if (ss.present) f.cov_pos_N = sigmaAt(s, tab, ss, "gnss.sigma", i).cwiseAbs2().asDiagonal();
-      if (f.v_N && vs.sigma.present) f.cov_vel_N = sigmaAt(s, tab, vs.sigma, "gnss.velocity.sigma", i).cwiseAbs2().asDiagonal();
+      if (f.v_N && vs.sigma.present) f.cov_vel_N = velocitySigmaAt(s, tab, vs, "gnss.velocity.sigma", i).cwiseAbs2().asDiagonal();
       if (const std::string p = recordProblem(f); !p.empty()) throw fileError(s.file, tab.line[i], "key gnss: " + p);
     }
     rep.gnss_file = s.file;
@@ -568,7 +577,7 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
         e.q_BtoN = quatRpy(tab.columns[ac[0]][i] * aunit, tab.columns[ac[1]][i] * aunit, tab.columns[ac[2]][i] * aunit);
       }
       if (ss.present) e.sigma_p_L = sigmaAt(s, tab, ss, "reference.sigma", i);
-      if (e.v_N && vs.sigma.present) e.sigma_v_N = sigmaAt(s, tab, vs.sigma, "reference.velocity.sigma", i);
+      if (e.v_N && vs.sigma.present) e.sigma_v_N = velocitySigmaAt(s, tab, vs, "reference.velocity.sigma", i);
       if (const std::string p = recordProblem(e); !p.empty()) throw fileError(s.file, tab.line[i], "key reference: " + p);
     }
     rep.reference_file = s.file;
