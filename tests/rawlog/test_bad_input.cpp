@@ -3,6 +3,7 @@
 // regressions (a real MRPT rawlog with one field corrupted).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -92,5 +93,12 @@ TEST(RawlogBadInput, APackedRawlogIsNamedWithItsUnpacker) {
   const auto bz = (test::tempDir() / "run_bz.rawlog").string();
   std::ofstream(bz, std::ios::binary) << std::string("BZh91AY&SY\x9e\x00", 12);
   expectBoth(bz, "IMU", {bz + ": the file is bzip2-compressed"});
+  // inside gzip too (a gzip of the xz file), and a packed file is never sniffed as a rawlog
+  const auto gz = xz + ".gz";
+  ASSERT_EQ(std::system(("gzip -c '" + xz + "' > '" + gz + "'").c_str()), 0);
+  expectBoth(gz, "IMU", {gz + ": the file is xz-compressed"});
+  const auto xzCsv = xz.substr(0, xz.size() - 7) + ".csv";  // run_xz.csv beside it
+  fs::copy_file(xz, xzCsv);
+  EXPECT_FALSE(rawlog::isRawlogFile(xzCsv));
   EXPECT_NO_THROW(rawlog::readRawlog(test::sourcePath("tests/data/imu_label_xsens.rawlog")));
 }

@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "navimpact/core/gz_input.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/core/yaml_load.hpp"
 
@@ -185,7 +186,10 @@ ConfigNode::ConfigNode(std::shared_ptr<const Doc> doc, std::shared_ptr<const Nod
 std::string ConfigNode::readText(const std::string& file, std::size_t max_bytes) {
   const std::string why = unreadableReason(file);
   if (!why.empty()) throw Error(printable(file, 160) + ": cannot open (" + why + ")");
-  return readFileMaybeGz(file, max_bytes);
+  std::string text = readFileMaybeGz(file, max_bytes);
+  if (const std::string packed = packedFormat(text); !packed.empty())
+    throw Error(printable(file, 160) + ": " + packedError(packed));
+  return text;
 }
 
 ConfigNode ConfigNode::load(const std::string& file) { return parse(readText(file), file); }

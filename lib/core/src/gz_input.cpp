@@ -158,17 +158,20 @@ std::string packedFormat(std::string_view head) {
     const char* what;
   };
   static constexpr Magic kMagic[] = {
-      {std::string_view("BZh", 3), "bzip2-compressed (bunzip2 -k FILE)"},
       {std::string_view("\xFD" "7zXZ\0", 6), "xz-compressed (unxz -k FILE)"},
       {std::string_view("\x28\xB5\x2F\xFD", 4), "zstd-compressed (unzstd FILE)"},
       {std::string_view("PK\x03\x04", 4), "a zip archive (unzip FILE)"},
       {std::string_view("7z\xBC\xAF\x27\x1C", 6), "a 7-Zip archive (7z x FILE)"},
       {std::string_view("\x04\x22\x4D\x18", 4), "lz4-compressed (unlz4 FILE)"},
+      {std::string_view("\x1F\x8B", 2), "gzip-compressed twice (gunzip it once)"},  // only met inside gzip
   };
   for (const Magic& m : kMagic)
-    if (head.size() >= m.bytes.size() && head.compare(0, m.bytes.size(), m.bytes) == 0 &&
-        (m.bytes != "BZh" || (head.size() > 3 && head[3] >= '1' && head[3] <= '9')))
-      return m.what;
+    if (head.size() >= m.bytes.size() && head.compare(0, m.bytes.size(), m.bytes) == 0) return m.what;
+  // bzip2: "BZh", the block size 1-9, then a block's magic (pi) or the end of an empty stream (sqrt(pi))
+  if (head.size() >= 10 && head.compare(0, 3, "BZh") == 0 && head[3] >= '1' && head[3] <= '9' &&
+      (head.compare(4, 6, std::string_view("1AY&SY", 6)) == 0 ||
+       head.compare(4, 6, std::string_view("\x17\x72\x45\x38\x50\x90", 6)) == 0))
+    return "bzip2-compressed (bunzip2 -k FILE)";
   return {};
 }
 

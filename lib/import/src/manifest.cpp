@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -66,9 +67,13 @@ struct Keys {
     const std::string s = n.scalar();
     for (std::size_t i = 0; i < names.size(); ++i)
       if (n.isScalar() && s == names[i]) return i;
-    std::string list;
-    for (const auto& a : names) list += (list.empty() ? "" : ", ") + a;
-    throw err(key, "must be one of " + list + ", got " + (n.isScalar() ? "'" + printable(s) + "'" : std::string("a list or a map")));
+    std::string list;  // punctuation quoted: "',', ';', tab", not ",, ;, tab"
+    for (const auto& a : names) {
+      const bool word = std::any_of(a.begin(), a.end(), [](char c) { return std::isalpha(static_cast<unsigned char>(c)); });
+      list += (list.empty() ? "" : ", ") + (word ? a : "'" + a + "'");
+    }
+    const std::string got = n.isScalar() ? "'" + printable(s) + "'" : n.isNull() ? std::string("nothing") : std::string("a list or a map");
+    throw err(key, "must be one of " + list + ", got " + got);
   }
 };
 

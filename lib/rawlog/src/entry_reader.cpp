@@ -101,11 +101,10 @@ uint64_t GzCStream::Seek(int64_t, mrpt::io::CStream::TSeekOrigin) { throw std::r
 
 EntryReader::EntryReader(const std::string& path) : in_(path), stream_(in_), arch_(stream_) {
   mrpt::obs::registerAllClasses_mrpt_obs();
-  GzInput head(path);  // a bzip2, xz, zstd ... file is named, not parsed as entries
-  char b[8] = {};
+  GzInput head(path);  // a bzip2, xz, zstd ... file (or one inside gzip) is named, not parsed as entries
+  char b[16] = {};
   const std::size_t n = head.read(b, sizeof b);
-  if (const std::string packed = head.compressed() ? "" : packedFormat({b, n}); !packed.empty())
-    throw Error(path + ": " + packedError(packed));
+  if (const std::string packed = packedFormat({b, n}); !packed.empty()) throw Error(path + ": " + packedError(packed));
 }
 
 std::size_t EntryReader::allocationCap() const {

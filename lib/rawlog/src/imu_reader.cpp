@@ -142,11 +142,13 @@ bool isRawlogFile(const std::string& path) {
   };
   if (endsWith(".rawlog") || endsWith(".rawlog.gz")) return true;
   GzInput f(path);
-  unsigned char b[3] = {0, 0, 0};
-  const std::size_t n = f.read(b, 3);
+  unsigned char b[16] = {};
+  const std::size_t n = f.read(b, sizeof b);
   if (n == 0) return false;  // empty: not a rawlog (the CSV reader reports it)
+  // a packed file (xz, zstd, ...): the CSV reader names it, before any CSV-only flag is weighed
+  if (!packedFormat(std::string_view(reinterpret_cast<const char*>(b), n)).empty()) return false;
   // A UTF-8 byte-order mark starts a text (CSV) file.
-  if (n == 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF) return false;
+  if (n >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF) return false;
   // So does a UTF-16 one (the CSV reader says it is one).
   if (n >= 2 && ((b[0] == 0xFF && b[1] == 0xFE) || (b[0] == 0xFE && b[1] == 0xFF))) return false;
   // Serialized MRPT objects start with a header byte >= 0x80; CSV starts with text.
