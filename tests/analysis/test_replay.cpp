@@ -193,7 +193,7 @@ TEST(Replay, ImuGapIsAnErrorUnlessAllowedThenPropagatedAcross) {
 // inside a GNSS outage over [15, 45] s (seeded, logged); perfect IMU,
 // reference model filter. Each gap is either bridged with every error within
 // 4 sigma until 5 s after it (or the outage's end), or refused with the
-// attitude uncertainty it would add above kMaxGapAttitudeSigmaRad.
+// attitude uncertainty it would add above the filter's small-error range (kSmallErrorAttitudeSigmaRad).
 TEST(Replay, AcrossAnAllowedImuGapTheErrorsStayWithinTheirSigmas) {
   const std::uint64_t seed = 1513;
   std::mt19937_64 rng(seed);
@@ -229,7 +229,7 @@ TEST(Replay, AcrossAnAllowedImuGapTheErrorsStayWithinTheirSigmas) {
                 std::string::npos) << m;
       // the uncertainty it names is above the limit it names
       const auto p = m.find("uncertainty of ") + 15;
-      EXPECT_GT(std::stod(m.substr(p)), an::kMaxGapAttitudeSigmaRad / navimpact::units::kDeg) << m;
+      EXPECT_GT(std::stod(m.substr(p)), navimpact::filter::kSmallErrorAttitudeSigmaRad / navimpact::units::kDeg) << m;
       ++refused[inOutage];
       continue;
     }
@@ -701,4 +701,47 @@ TEST(Replay, ALongRunWritesEveryRowAndFiguresFromBoundedSeries) {
   w.feed(r);
   EXPECT_EQ(w.summary(r), navimpact::report::summaryJson(r));
   EXPECT_EQ(streamed.str(), navimpact::report::solutionCsv(r));
+}
+
+// A reference with positions only (the Katwijk rover's RTK): the attitude
+// errors are unknown, not "pitch 89.5 deg off with sigma 0" (found by a probe:
+// a NaN attitude read as pitch -90 deg, because std::min(1.0, NaN) is 1); the
+// attitude sigmas are the filter's, about its own attitude.
+TEST(Replay, APositionOnlyReferenceLeavesTheAttitudeErrorsUnknown) {
+  auto d = emulate60("none");
+  for (auto& g : d.reference) {
+    g.q_BtoN.reset();
+    g.v_N.reset();
+  }
+  an::ReplayConfig c = refReplay(writtenRawlog(d, "posonly.rawlog"));
+  c.outages.push_back(navimpact::Outage::fromStartDuration(30.0, 20.0));
+  const auto r = an::runReplay(c);
+  const auto j = nlohmann::json::parse(navimpact::report::summaryJson(r));
+  const auto& att = j.at("outages").at(0).at("attitude_deg");
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(att.at("roll_pitch_yaw_error_end").at(k).is_null()) << att.dump();
+    ASSERT_TRUE(att.at("roll_pitch_yaw_sigma_end").at(k).is_number()) << att.dump();
+    EXPECT_GT(att.at("roll_pitch_yaw_sigma_end").at(k).get<double>(), 0.0) << att.dump();
+  }
+  // the solution's attitude errors: not numbers; its sigmas: positive
+  std::istringstream csv(navimpact::report::solutionCsv(r));
+  std::string header, row;
+  std::getline(csv, header);
+  std::vector<std::string> h, v;
+  auto split = [](const std::string& s) {
+    std::vector<std::string> out;
+    std::istringstream a(s);
+    for (std::string f; std::getline(a, f, ',');) out.push_back(f);
+    return out;
+  };
+  h = split(header);
+  std::getline(csv, row);
+  v = split(row);
+  for (const char* name : {"err_roll_deg", "err_pitch_deg", "err_yaw_deg", "sig_pitch_deg"}) {
+    const auto at = std::find(h.begin(), h.end(), name) - h.begin();
+    ASSERT_LT(static_cast<std::size_t>(at), v.size()) << name;
+    if (name[0] == 'e') EXPECT_FALSE(std::isfinite(std::strtod(v[at].c_str(), nullptr))) << name << " = " << v[at];
+    else EXPECT_GT(std::strtod(v[at].c_str(), nullptr), 0.0) << name << " = " << v[at];
+  }
+  EXPECT_TRUE(std::isnan(navimpact::ins::rollPitchYaw(Eigen::Matrix3d::Constant(NAN))[1]));
 }

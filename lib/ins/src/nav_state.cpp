@@ -18,7 +18,9 @@ Eigen::Quaterniond quatFromRollPitchYaw(double roll, double pitch, double yaw) {
 Eigen::Vector3d rollPitchYaw(const Eigen::Matrix3d& C) {
   // Groves 2.23
   const double roll = std::atan2(C(2, 1), C(2, 2));
-  const double pitch = -std::asin(std::max(-1.0, std::min(1.0, C(2, 0))));
+  // clamped against rounding; NaN stays NaN (std::min(1.0, NaN) is 1: an
+  // unknown attitude read as pitch -90 deg, found by a probe)
+  const double pitch = std::isnan(C(2, 0)) ? C(2, 0) : -std::asin(std::max(-1.0, std::min(1.0, C(2, 0))));
   const double yaw = std::atan2(C(1, 0), C(0, 0));
   return Eigen::Vector3d(roll, pitch, yaw);
 }

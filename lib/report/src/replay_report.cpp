@@ -152,7 +152,9 @@ struct ReplayWriter::State {
   void epoch(const ReplayResult& r, const NavEpoch& e, const ins::NavState* truth, const std::vector<Outage>& windows) {
     const ins::NavState& x = e.est;
     const bool hasTruth = truth != nullptr;
-    const Eigen::Vector3d se = eulerSigma(hasTruth ? *truth : x, e.sigma.segment<3>(6)) / kDeg;
+    // Euler sigmas about the true attitude, or the estimate's where the reference has none
+    const bool truthAttitude = hasTruth && truth->q_BtoN.coeffs().allFinite();
+    const Eigen::Vector3d se = eulerSigma(truthAttitude ? *truth : x, e.sigma.segment<3>(6)) / kDeg;
     const Eigen::Vector3d ee = hasTruth ? Eigen::Vector3d(eulerError(x, *truth) / kDeg) : Eigen::Vector3d::Zero();
     // solution.csv
     if (csv) {
@@ -463,7 +465,8 @@ std::string summaryFrom(const ReplayResult& r, const ReplayWriter::State& st) {
     const std::array<double, 4>& neesB = os.neesB;
     const int n = os.n;
     const Eigen::Vector3d attEnd = eulerError(estEnd, os.endTruth) / kDeg;
-    const Eigen::Vector3d attSig = eulerSigma(os.endTruth, e.sigma.segment<3>(6)) / kDeg;
+    const Eigen::Vector3d attSig =
+        eulerSigma(os.endTruth.q_BtoN.coeffs().allFinite() ? os.endTruth : estEnd, e.sigma.segment<3>(6)) / kDeg;
     jo["end_epoch_s"] = e.t - r.t_zero;
     jo["position"] = {{"horizontal_error_end_m", e.err.head<2>().norm()},
                       {"vertical_error_end_m", std::abs(e.err[2])},

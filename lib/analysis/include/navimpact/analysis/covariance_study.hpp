@@ -123,18 +123,8 @@ struct CovarianceRun {
   double max_attitude_sigma_rad = 0.0;
 };
 
-/**
- * Largest attitude sigma [rad] (roll, pitch or yaw) within which the
- * error-state filter's covariance is a valid error bound. The filter's attitude
- * error is first order in psi (C_BtoN_est = (I + [psi x]) C_BtoN_true, and the
- * error dynamics are linearised around it): the neglected second-order part is
- * |psi|/2 of the first-order one (1 - cos psi ~ psi^2/2 against sin psi ~ psi),
- * 7.5 % at |psi| = 0.15 rad, the 3-sigma error at this limit. Beyond it the
- * sigmas are the propagated covariance of a linear model that no longer holds
- * (a 48 h static run of the Table 1 gyro_ref model reaches a yaw sigma of
- * 92 deg), not an error bound; runs say so (CovarianceRun::small_error_exceeded_s).
- */
-inline constexpr double kSmallErrorAttitudeSigmaRad = 0.05;
+/// The filter's small-error range (filter/ekf.hpp).
+using filter::kSmallErrorAttitudeSigmaRad;
 
 /// Fill run.small_error_* and max_attitude_sigma_rad from run.t and run.sigma.
 void assessSmallError(CovarianceRun& run);

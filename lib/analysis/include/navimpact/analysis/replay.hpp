@@ -33,7 +33,7 @@
  * then the filter propagates across each gap in nominal-length sub-steps with
  * the rates interpolated between the samples around it and their uncertainty
  * added (a Brownian bridge, README "No silent acceptance"), unless that
- * uncertainty is above kMaxGapAttitudeSigmaRad in attitude (an error naming
+ * uncertainty is above filter::kSmallErrorAttitudeSigmaRad in attitude (an error naming
  * the gap: the rates change too fast around it to bridge it), and a notice in
  * summary.json says how many gaps and the longest. Duplicated records (two of
  * one sensor at the same time) are refused by the rawlog reader.
@@ -100,13 +100,6 @@ constexpr double kImuGapSteps = 1.5;
 /// UAV run roll was 5.3 deg off with sigma 0.04 deg; 10-15 s diverged; up to
 /// 2 s the errors stayed within 4 sigma).
 constexpr double kMaxImuGapS = 2.0;
-/// Largest attitude uncertainty a gap may add (1 sigma of the integrated
-/// Brownian bridge, sqrt(q h^3 / 12)) [rad]: the error-state filter drops terms
-/// of order psi^2, at 3 sigma = 0.15 rad a twentieth of psi is second order.
-/// A probe on the UAV run, gaps of up to 2 s inside a 30 s GNSS outage: gaps
-/// that added at most 3 deg kept every error within 3.1 sigma to the outage's
-/// end; from 5 deg on roll and pitch ended up to 65 sigma off.
-constexpr double kMaxGapAttitudeSigmaRad = 0.05;
 
 /// Replay options (see the file comment for the YAML form).
 struct ReplayConfig {

@@ -55,6 +55,21 @@ Discretization parseDiscretization(const std::string& s);
 inline constexpr double kMinGateProbability = 0.5;
 
 /**
+ * Largest attitude sigma [rad] (roll, pitch or yaw) within which the
+ * error-state filter's covariance is a valid error bound. The filter's attitude
+ * error is first order in psi (C_BtoN_est = (I + [psi x]) C_BtoN_true, and the
+ * error dynamics are linearised around it): the neglected second-order part is
+ * |psi|/2 of the first-order one (1 - cos psi ~ psi^2/2 against sin psi ~ psi),
+ * 7.5 % at |psi| = 0.15 rad, the 3-sigma error at this limit. Beyond it the
+ * sigmas are the propagated covariance of a linear model that no longer holds
+ * (a 48 h static run of the Table 1 gyro_ref model reaches a yaw sigma of
+ * 92 deg), not an error bound; covariance runs say so
+ * (analysis::CovarianceRun::small_error_exceeded_s) and replay refuses an IMU gap
+ * whose bridge would add more (analysis/replay.hpp).
+ */
+inline constexpr double kSmallErrorAttitudeSigmaRad = 0.05;
+
+/**
  * Positive definiteness of the covariance, checked after every update (and so
  * before every output of a run with updates). P is judged on the correlation
  * scale, Pc = D^-1/2 P D^-1/2 with D_ii = max(P_ii, floor_i), so that states
