@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <boost/math/distributions/chi_squared.hpp>
@@ -1427,7 +1428,27 @@ RunDiagnosis diagnoseRun(const RunDiagnosisOptions& opt_in) {
     }
     out.durations.push_back(std::move(dd));
   }
-  out.verdict = out.reasons.empty() ? "adequate" : "inadequate";
+  // Could every test have said no? The half-width of its interval as a factor.
+  out.resolution_factor = 1.0;
+  const auto widen = [&](double lo, double hi) {
+    const double f = lo > 0.0 ? std::sqrt(hi / lo) : std::numeric_limits<double>::infinity();
+    out.resolution_factor = std::isnan(f) || std::isnan(out.resolution_factor) ? NAN : std::max(out.resolution_factor, f);
+  };
+  for (const auto& c : out.comparisons) widen(c.ratio_lo, c.ratio_hi);
+  for (const auto& dd : out.durations) widen(dd.anees_lo, dd.anees_hi);
+  if (!out.reasons.empty()) {
+    out.verdict = "inadequate";
+  } else if (out.resolution_factor <= kResolvableFactor) {
+    out.verdict = "adequate";
+  } else {
+    out.verdict = "undetermined";
+    const std::string size = std::isfinite(out.resolution_factor)
+                                 ? "by a factor of " + formatNumber(out.resolution_factor, 3) + " (more than " +
+                                       formatNumber(kResolvableFactor) + ")"
+                                 : "of any size";
+    out.reasons.push_back("no test rejects, but the weakest would miss a misprediction " + size +
+                          ": too few realisations (" + std::to_string(R) + ") or outages; raise --realisations");
+  }
   out.model_before = model;
   if (opt.causes) diagnoseCauses(opt, data, out, measured, simOut, sims, tr, t0, t1, model, progress);
   progress(1.0, "done");

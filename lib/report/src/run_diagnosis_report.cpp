@@ -36,6 +36,8 @@ std::string runDiagnosisJson(const RunDiagnosis& d, const std::string& input_jso
        "Bonferroni over two-sided tests of the run-level statistics (RMS outage-end error per quantity and duration, "
        "mean position NEES per duration) against their distribution over the simulated realisations "
        "(ln statistic, Student t prediction interval with R - 1 dof)"},
+      {"resolution_factor", d.resolution_factor},
+      {"resolvable_factor", analysis::kResolvableFactor},
       {"reasons", d.reasons}};
   auto findingJson = [](const analysis::RunFinding& f) {
     nlohmann::json p = nlohmann::json::object(), iv = nlohmann::json::object();
@@ -262,6 +264,8 @@ std::string runDiagnosisSummary(const RunDiagnosis& d) {
   std::ostringstream s;
   s << "run diagnosis of " << d.rawlog << " with " << d.model_source << ": " << d.verdict << " (" << d.tests
     << " tests, family-wise false-alarm rate " << formatNumber(d.alpha) << ")\n";
+  if (d.verdict == "undetermined")
+    for (const auto& r : d.reasons) s << "  " << r << "\n";
   for (const auto& c : d.comparisons)
     s << "  " << formatNumber(c.duration_s) << " s " << c.quantity << ": measured/predicted RMS " << r3(c.ratio) << " ["
       << r3(c.ratio_lo) << ", " << r3(c.ratio_hi) << "]" << (c.rejects ? " rejects" : "") << "\n";

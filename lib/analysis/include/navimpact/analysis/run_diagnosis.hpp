@@ -48,7 +48,11 @@
  * independent outages is reported beside it).
  * Verdict: "inadequate" when any of the m tests (all comparisons and all NEES
  * tests) rejects at level a = alpha / m (Bonferroni), so the family-wise
- * false-alarm rate is at most alpha; else "adequate".
+ * false-alarm rate is at most alpha; else "adequate" when every test could
+ * have said no to a model mispredicting by less than kResolvableFactor (its
+ * interval, exp(+- t_{1-a/2} sd sqrt(1 + 1/R)), lies within that factor), and
+ * "undetermined" when one could not (too few realisations: with 2 of them
+ * the intervals spanned 1e-305 to 1e305 and the verdict said "adequate").
  *
  * Causes (each fitted on training data and scored on held-out outages): the
  * run is cut into `folds` time blocks; the outages whose midpoint falls in
@@ -197,6 +201,11 @@ struct DurationDiagnosis {
   std::size_t simulated_outages = 0;       ///< realisations x outages
 };
 
+/// The widest test interval (a ratio's, or the mean NEES band's, half-width
+/// as a factor) under which a run that no test rejects is still "adequate":
+/// an order of magnitude; beyond it the verdict is "undetermined".
+constexpr double kResolvableFactor = 10.0;
+
 /// Everything a run diagnosis computed.
 struct RunDiagnosis {
   std::string rawlog;
@@ -215,8 +224,11 @@ struct RunDiagnosis {
   double test_level = 0.0;                 ///< alpha / m
   std::vector<DurationDiagnosis> durations;
   std::vector<QuantityComparison> comparisons;
-  std::string verdict;                     ///< "adequate" or "inadequate"
-  std::vector<std::string> reasons;        ///< the tests that rejected, in words
+  std::string verdict;                     ///< "adequate", "inadequate" or "undetermined"
+  std::vector<std::string> reasons;        ///< the tests that rejected, or why none could, in words
+  /// The largest half-width of the tests' intervals, as a factor (sqrt(hi / lo)):
+  /// the misprediction the weakest test could just detect.
+  double resolution_factor = 0.0;
   std::vector<std::string> notices;
   int folds = 0;                           ///< cross-validation folds used
   std::vector<CauseResult> causes;         ///< ranked by held-out gain, best first
