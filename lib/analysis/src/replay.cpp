@@ -415,7 +415,12 @@ constexpr std::size_t kRecentImu = 4096;
 // the gap's sub-steps gives the same. q per axis, the largest: the larger of
 // the rates' change across the gap squared over h and the mean squared change
 // over a lag of h (or the longest lag held, scaled as a random walk) in the
-// records before it (sensor noise included: conservative).
+// records before it (sensor noise included: conservative). The bridge misses
+// motion that is not a random walk (a rover's bumps), so the PSD is at least
+// the measured one: the mean squared error of the same interpolation over every
+// window of the gap's length in those records, integrated over the window
+// (e = sum of x dt over the window - its length x the mean of its end samples),
+// over h.
 std::pair<double, double> ReplayDriver::gapPsd(const ImuRecord& after, double h) const {
   const ImuRecord& before = recent_.back();
   double qw = (after.w_IB_B - before.w_IB_B).cwiseAbs2().maxCoeff() / h;
@@ -434,7 +439,28 @@ std::pair<double, double> ReplayDriver::gapPsd(const ImuRecord& after, double h)
       qf = std::max(qf, df.maxCoeff() / n / tau);
     }
   }
-  return {qw * h * h / 12.0, qf * h * h / 12.0};
+  double pw = qw * h * h / 12.0, pf = qf * h * h / 12.0;
+  // the measured interpolation error over windows of the gap's length
+  const std::size_t lag = std::size_t(std::llround(h / med_));
+  if (lag >= 1 && recent_.size() > lag + 1) {
+    std::vector<Eigen::Vector3d> Sw(recent_.size(), Eigen::Vector3d::Zero()), Sf(recent_.size(), Eigen::Vector3d::Zero());
+    for (std::size_t j = 1; j < recent_.size(); ++j) {
+      const double dt = recent_[j].t - recent_[j - 1].t;
+      Sw[j] = Sw[j - 1] + recent_[j].w_IB_B * dt;
+      Sf[j] = Sf[j - 1] + recent_[j].f_B * dt;
+    }
+    Eigen::Vector3d ew = Eigen::Vector3d::Zero(), ef = Eigen::Vector3d::Zero();
+    for (std::size_t k = lag; k < recent_.size(); ++k) {
+      const std::size_t a = k - lag;
+      const double len = recent_[k].t - recent_[a].t;
+      ew += (Sw[k] - Sw[a] - 0.5 * len * (recent_[a].w_IB_B + recent_[k].w_IB_B)).cwiseAbs2();
+      ef += (Sf[k] - Sf[a] - 0.5 * len * (recent_[a].f_B + recent_[k].f_B)).cwiseAbs2();
+    }
+    const double windows = double(recent_.size() - lag);
+    pw = std::max(pw, ew.maxCoeff() / windows / h);
+    pf = std::max(pf, ef.maxCoeff() / windows / h);
+  }
+  return {pw, pf};
 }
 
 // The next IMU sample: IMU records in order, an interval longer than
