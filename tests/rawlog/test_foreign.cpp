@@ -262,3 +262,48 @@ TEST(ForeignRawlog, EntriesOfOtherClassesPrintNothing) {
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "after");
   EXPECT_EQ(r.imu.size(), 200u);
 }
+
+// A foreign rawlog's records pass the physical ranges every reader applies
+// (found by a review: navimpact's own rawlogs were checked, foreign ones not):
+// an angular rate of 1e6 rad/s or a GGA latitude of 200 deg is refused naming
+// the entry and the label; the same rawlog with plausible values reads.
+TEST(ForeignRawlog, ValuesOutsideThePhysicalRangesAreRefusedNamingTheEntry) {
+  for (int bad = 0; bad < 3; ++bad) {
+    const auto p = (navimpact::test::tempDir() / ("range" + std::to_string(bad) + ".rawlog")).string();
+    {
+      mrpt::io::CFileGZOutputStream out(p);
+      auto arch = mrpt::serialization::archiveFrom(out);
+      const auto t0 = mrpt::Clock::fromDouble(1.6e9);
+      for (int k = 0; k < 4; ++k) {
+        mrpt::obs::CObservationIMU m;
+        m.sensorLabel = "IMU";
+        m.timestamp = t0 + std::chrono::milliseconds(10 * k);
+        const double w = bad == 1 && k == 2 ? 1e6 : 0.1;
+        for (auto q : {mrpt::obs::IMU_WX, mrpt::obs::IMU_WY, mrpt::obs::IMU_WZ}) m.set(q, w);
+        for (auto q : {mrpt::obs::IMU_X_ACC, mrpt::obs::IMU_Y_ACC}) m.set(q, 0.0);
+        m.set(mrpt::obs::IMU_Z_ACC, 9.8);
+        arch << m;
+        if (k == 1) {
+          mrpt::obs::CObservationGPS g;
+          g.sensorLabel = "GPS";
+          g.timestamp = m.timestamp;
+          gnss::Message_NMEA_GGA gga;
+          gga.fields.latitude_degrees = bad == 2 ? 200.0 : 46.5;
+          gga.fields.longitude_degrees = 6.6;
+          gga.fields.altitude_meters = 400.0;
+          gga.fields.fix_quality = 1;
+          g.setMsg(gga);
+          arch << g;
+        }
+      }
+    }
+    const std::string m = errorOf(p, {});
+    if (bad == 0) {
+      EXPECT_EQ(m, "(no error)");
+    } else {
+      EXPECT_EQ(m.rfind(p + ": entry " + std::to_string(bad == 1 ? 3 : 2) + " (label " + (bad == 1 ? "IMU" : "GPS") + "): ", 0), 0u)
+          << m;
+      EXPECT_NE(m.find(bad == 1 ? "angular rate" : "not a place on Earth"), std::string::npos) << m;
+    }
+  }
+}

@@ -12,6 +12,7 @@
 #include "foreign_reader.hpp"
 #include "frames.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/recording.hpp"
 #include "navimpact/core/format.hpp"
 
 namespace navimpact::rawlog::detail {
@@ -79,6 +80,8 @@ Recording readForeignRawlog(EntryReader& reader, const RawlogReadOptions& opt) {
       r.w_IB_B = C * Eigen::Vector3d(m->get(mrpt::obs::IMU_WX), m->get(mrpt::obs::IMU_WY), m->get(mrpt::obs::IMU_WZ));
       r.f_B = C * Eigen::Vector3d(m->get(mrpt::obs::IMU_X_ACC), m->get(mrpt::obs::IMU_Y_ACC), m->get(mrpt::obs::IMU_Z_ACC));
       if (!r.w_IB_B.allFinite() || !r.f_B.allFinite()) throw Error(where(e, label) + ": IMU value is not finite");
+      // the physical ranges every reader applies (core/recording.hpp), on the entry that holds the record
+      if (const std::string p = recordProblem(r); !p.empty()) throw Error(where(e, label) + ": " + p);
       auto& s = imu[label];
       s.when.push_back({m->timestamp, e});
       s.rec.push_back(r);
@@ -131,6 +134,7 @@ Recording readForeignRawlog(EntryReader& reader, const RawlogReadOptions& opt) {
       }
       if (!s.lever_arm_B && (g->sensorPose.x() != 0 || g->sensorPose.y() != 0 || g->sensorPose.z() != 0))
         s.lever_arm_B = T_FLUtoFRD() * Eigen::Vector3d(g->sensorPose.x(), g->sensorPose.y(), g->sensorPose.z());
+      if (const std::string p = recordProblem(f); !p.empty()) throw Error(where(e, label) + ": " + p);
       s.when.push_back({g->timestamp, e});
       s.fix.push_back(f);
       return;
