@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <tuple>
 
@@ -206,6 +207,21 @@ TEST(StudyRuns, IndependentOfThreadsAndShardingAndPaired) {
     std::ofstream(dir / "runs.bin", std::ios::app | std::ios::binary) << std::string(1000, '\0');
     const std::string e = mergeError(dir.string());
     EXPECT_NE(e.find("runs.bin: bytes after its last run"), std::string::npos) << e;
+  }
+  {
+    // a NaN where the first run's first error is (magic, four counts, index,
+    // seed, the model's time and steps before it): no run writes it
+    const auto dir = test::tempDir() / "nan";
+    std::filesystem::copy(dirs[1], dir);
+    std::fstream f(dir / "runs.bin", std::ios::in | std::ios::out | std::ios::binary);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    f.seekp(8 + 4 * 8 + 2 * 8 + 2 * 8);
+    f.write(reinterpret_cast<const char*>(&nan), 8);
+    f.close();
+    const std::string e = mergeError(dir.string());
+    EXPECT_NE(e.find("runs.bin: run "), std::string::npos) << e;
+    EXPECT_NE(e.find("model 1: an error or sigma of epoch 0 is not finite (not as navimpact writes it)"), std::string::npos)
+        << e;
   }
 
   // Paired comparison: identical models see identical realisations.

@@ -407,6 +407,8 @@ RunRecord doRun(const StudyPlan& p, std::uint64_t index) {
     m.steps = r.steps;
     rec.models.push_back(std::move(m));
   }
+  if (const std::string why = detail::nonFinite(rec); !why.empty())
+    throw Error("study: run " + std::to_string(index) + " (seed " + std::to_string(rec.seed) + "): " + why);
   return rec;
 }
 
@@ -519,6 +521,20 @@ std::uint64_t getU64(std::istream& i, const std::string& file) {
 }
 void getD(std::istream& i, double* v, std::size_t n, const std::string& file) {
   if (!i.read(reinterpret_cast<char*>(v), static_cast<std::streamsize>(8 * n))) throw Error(file + ": truncated");
+}
+
+std::string nonFinite(const RunRecord& rec) {
+  for (std::size_t mi = 0; mi < rec.models.size(); ++mi) {
+    const RunRecord::Model& m = rec.models[mi];
+    const std::string model = "model " + std::to_string(mi + 1);
+    if (!std::isfinite(m.wall_s)) return model + ": its time is not finite";
+    for (std::size_t k = 0; k < m.epochs.size(); ++k)
+      if (k % kEpochValues < 18 && !std::isfinite(m.epochs[k]))  // errors and sigmas (a NEES may be missing)
+        return model + ": an error or sigma of epoch " + std::to_string(k / kEpochValues) + " is not finite";
+    for (std::size_t o = 0; o < m.drift.size(); ++o)
+      if (!std::isfinite(m.drift[o])) return model + ": the drift of outage " + std::to_string(o / 2) + " is not finite";
+  }
+  return {};
 }
 
 json readShardJson(const std::string& dir, const std::string& file, const std::string& marker,
@@ -657,6 +673,8 @@ StudyResults mergeShards(const std::vector<std::string>& dirs, const std::string
       getD(*in.f, m.epochs.data(), m.epochs.size(), bin);
       getD(*in.f, m.drift.data(), m.drift.size(), bin);
     }
+    if (const std::string why = detail::nonFinite(rec); !why.empty())
+      throw Error(bin + ": run " + std::to_string(i) + ": " + why + " (not as navimpact writes it)");
     res.acc.add(rec, E, O);
     res.run_indices.push_back(i);
   }

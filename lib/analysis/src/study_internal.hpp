@@ -39,6 +39,11 @@ void getD(std::istream& i, double* v, std::size_t n, const std::string& file);
 nlohmann::json readShardJson(const std::string& dir, const std::string& file, const std::string& marker,
                              const std::string& writer);
 
+/// Why a run's record holds a value no run writes (a non-finite error, sigma,
+/// drift or time; a NEES may be missing), or "": checked after each run and on
+/// each run a merge reads.
+std::string nonFinite(const RunRecord& rec);
+
 /// chi2inv(p, dof) (boost::math).
 double chi2Quantile(double p, double dof);
 
