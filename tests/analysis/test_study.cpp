@@ -220,8 +220,27 @@ TEST(StudyRuns, IndependentOfThreadsAndShardingAndPaired) {
     f.close();
     const std::string e = mergeError(dir.string());
     EXPECT_NE(e.find("runs.bin: run "), std::string::npos) << e;
-    EXPECT_NE(e.find("model 1: an error or sigma of epoch 0 is not finite (not as navimpact writes it)"), std::string::npos)
+    EXPECT_NE(e.find("model 1: an error of epoch 0 is not finite (not as navimpact writes it)"), std::string::npos)
         << e;
+  }
+  // values no run writes, though finite (found by a probe: a drift of -1e308
+  // printed a 300-digit mean, an error of 1e300 an inf RMS, a NEES of +inf
+  // counted as missing): offsets of the first run's first error, first sigma,
+  // first NEES and first drift
+  const std::size_t first = 8 + 4 * 8 + 2 * 8 + 2 * 8, E = merged.meta.epochs.size();
+  for (const auto& [offset, value, expect] : std::vector<std::tuple<std::size_t, double, std::string>>{
+           {first, 1e300, "an error of epoch 0 is not finite"},
+           {first + 9 * 8, -1.0, "a sigma of epoch 0 is not finite and >= 0"},
+           {first + 18 * 8, std::numeric_limits<double>::infinity(), "a NEES of epoch 0 is neither missing nor finite"},
+           {first + 22 * 8 * E, -1e308, "the drift of outage 0 is not finite and >= 0"}}) {
+    const auto dir = test::tempDir() / ("absurd" + std::to_string(offset));
+    std::filesystem::copy(dirs[1], dir);
+    std::fstream f(dir / "runs.bin", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(offset));
+    f.write(reinterpret_cast<const char*>(&value), 8);
+    f.close();
+    const std::string e = mergeError(dir.string());
+    EXPECT_NE(e.find("model 1: " + expect), std::string::npos) << e;
   }
 
   // Paired comparison: identical models see identical realisations.

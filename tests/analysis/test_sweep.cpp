@@ -15,6 +15,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -214,6 +216,24 @@ TEST(SweepShards, AnyPartitionMergesToTheUnshardedResultBitForBit) {
     fs::copy(b, d);
     std::ofstream(d / "sweep_runs.bin", std::ios::app | std::ios::binary) << std::string(1000, '\0');
     expectError([&] { an::mergeSweepShards({a, d.string(), c}, "B1"); }, "sweep_runs.bin: bytes after its last column");
+  }
+  // values no run writes (found by a probe: NaN, inf, 1e300 and -1 merged with
+  // exit 0 and moved the threshold): the first run's first horizontal error
+  // (after the magic, two counts and the column's count) and its NEES
+  for (const auto& [offset, value, expect] : std::vector<std::tuple<std::size_t, double, std::string>>{
+           {32, -1.0, "a horizontal error not finite and >= 0"},
+           {32, std::numeric_limits<double>::quiet_NaN(), "a horizontal error not finite and >= 0"},
+           {32, 1e300, "a horizontal error not finite and >= 0"},
+           {40, std::numeric_limits<double>::infinity(), "a position NEES neither missing nor finite and >= 0"}}) {
+    const fs::path d = dir / ("val" + std::to_string(offset) + "_" + std::to_string(expect.size()) +
+                              (std::isnan(value) ? "n" : std::to_string(value > 0)));
+    fs::copy(b, d);
+    std::fstream f(d / "sweep_runs.bin", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(offset));
+    f.write(reinterpret_cast<const char*>(&value), 8);
+    f.close();
+    expectError([&] { an::mergeSweepShards({a, d.string(), c}, "B1"); }, "sweep_runs.bin: column 1, run ");
+    expectError([&] { an::mergeSweepShards({a, d.string(), c}, "B1"); }, expect);
   }
   {
     auto cfg2 = cfg;

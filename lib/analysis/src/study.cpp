@@ -407,7 +407,7 @@ RunRecord doRun(const StudyPlan& p, std::uint64_t index) {
     m.steps = r.steps;
     rec.models.push_back(std::move(m));
   }
-  if (const std::string why = detail::nonFinite(rec); !why.empty())
+  if (const std::string why = detail::implausible(rec); !why.empty())
     throw Error("study: run " + std::to_string(index) + " (seed " + std::to_string(rec.seed) + "): " + why);
   return rec;
 }
@@ -523,16 +523,26 @@ void getD(std::istream& i, double* v, std::size_t n, const std::string& file) {
   if (!i.read(reinterpret_cast<char*>(v), static_cast<std::streamsize>(8 * n))) throw Error(file + ": truncated");
 }
 
-std::string nonFinite(const RunRecord& rec) {
+std::string implausible(const RunRecord& rec) {
+  // |value| <= kMaxValue: squares summed over every run stay finite
+  constexpr double kMaxValue = 1e100;
+  const auto size = [](double v) { return std::isfinite(v) && std::abs(v) <= kMaxValue; };
   for (std::size_t mi = 0; mi < rec.models.size(); ++mi) {
     const RunRecord::Model& m = rec.models[mi];
     const std::string model = "model " + std::to_string(mi + 1);
-    if (!std::isfinite(m.wall_s)) return model + ": its time is not finite";
-    for (std::size_t k = 0; k < m.epochs.size(); ++k)
-      if (k % kEpochValues < 18 && !std::isfinite(m.epochs[k]))  // errors and sigmas (a NEES may be missing)
-        return model + ": an error or sigma of epoch " + std::to_string(k / kEpochValues) + " is not finite";
+    if (!(size(m.wall_s) && m.wall_s >= 0.0)) return model + ": its time is not finite and >= 0";
+    for (std::size_t k = 0; k < m.epochs.size(); ++k) {
+      const std::size_t j = k % kEpochValues, epoch = k / kEpochValues;
+      const double v = m.epochs[k];
+      if (j < 9 && !size(v)) return model + ": an error of epoch " + std::to_string(epoch) + " is not finite";
+      if (j >= 9 && j < 18 && !(size(v) && v >= 0.0))
+        return model + ": a sigma of epoch " + std::to_string(epoch) + " is not finite and >= 0";
+      if (j >= 18 && !std::isnan(v) && !(size(v) && v >= 0.0))  // a NEES may be missing (NaN)
+        return model + ": a NEES of epoch " + std::to_string(epoch) + " is neither missing nor finite and >= 0";
+    }
     for (std::size_t o = 0; o < m.drift.size(); ++o)
-      if (!std::isfinite(m.drift[o])) return model + ": the drift of outage " + std::to_string(o / 2) + " is not finite";
+      if (!(size(m.drift[o]) && m.drift[o] >= 0.0))
+        return model + ": the drift of outage " + std::to_string(o / 2) + " is not finite and >= 0";
   }
   return {};
 }
@@ -673,7 +683,7 @@ StudyResults mergeShards(const std::vector<std::string>& dirs, const std::string
       getD(*in.f, m.epochs.data(), m.epochs.size(), bin);
       getD(*in.f, m.drift.data(), m.drift.size(), bin);
     }
-    if (const std::string why = detail::nonFinite(rec); !why.empty())
+    if (const std::string why = detail::implausible(rec); !why.empty())
       throw Error(bin + ": run " + std::to_string(i) + ": " + why + " (not as navimpact writes it)");
     res.acc.add(rec, E, O);
     res.run_indices.push_back(i);

@@ -39,10 +39,11 @@ void getD(std::istream& i, double* v, std::size_t n, const std::string& file);
 nlohmann::json readShardJson(const std::string& dir, const std::string& file, const std::string& marker,
                              const std::string& writer);
 
-/// Why a run's record holds a value no run writes (a non-finite error, sigma,
-/// drift or time; a NEES may be missing), or "": checked after each run and on
-/// each run a merge reads.
-std::string nonFinite(const RunRecord& rec);
+/// Why a run's record holds a value no run writes, or "": an error beyond
+/// 1e100 or not finite, a sigma, drift or time that is not finite and >= 0, a
+/// NEES that is neither missing (NaN) nor finite and >= 0. Checked after each
+/// run and on each run a merge reads.
+std::string implausible(const RunRecord& rec);
 
 /// chi2inv(p, dof) (boost::math).
 double chi2Quantile(double p, double dof);

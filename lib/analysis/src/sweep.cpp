@@ -471,6 +471,18 @@ SweepRuns mergeSweepShards(const std::vector<std::string>& dirs, const std::stri
       std::vector<double> v(n);
       if (!f.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(8 * n)))
         throw Error(bin + ": truncated");
+      // a horizontal error finite and >= 0, a NEES missing (NaN) or finite and >= 0,
+      // both at most 1e100 (their squares summed over every run stay finite)
+      const std::size_t perRun = M * res.meta.columns[c].tau_s.size() * 2;
+      for (std::size_t q = 0; q < n; ++q) {
+        const bool nees = q % 2 == 1;
+        const bool ok = (nees && std::isnan(v[q])) || (std::isfinite(v[q]) && v[q] >= 0.0 && v[q] <= 1e100);
+        if (!ok)
+          throw Error(bin + ": column " + std::to_string(c + 1) + ", run " + std::to_string(in.idx[q / perRun]) + ": " +
+                      (nees ? "a position NEES neither missing nor finite and >= 0"
+                            : "a horizontal error not finite and >= 0") +
+                      " (not as navimpact writes it)");
+      }
       in.values.push_back(std::move(v));
     }
     if (f.peek() != std::char_traits<char>::eof()) throw Error(bin + ": bytes after its last column (not as navimpact writes it)");

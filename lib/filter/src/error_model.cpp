@@ -2,6 +2,8 @@
 // position error in metres NED. Derivation notes in error_model.hpp.
 #include "navimpact/filter/error_model.hpp"
 
+#include <limits>
+
 #include <cmath>
 
 #include "navimpact/core/earth.hpp"
@@ -78,7 +80,12 @@ Vector9d navError(const ins::NavState& est, const ins::NavState& truth) {
   // C_est C_true' = I + [psi x]  (small angle), exact via the rotation vector.
   const Eigen::AngleAxisd aa(est.q_BtoN * truth.q_BtoN.conjugate());
   dx.segment<3>(6) = aa.angle() * aa.axis();
-  if (dx.segment<3>(6).hasNaN()) dx.segment<3>(6).setZero();
+  // an unknown attitude (a reference with positions only: NaN) stays unknown;
+  // a NaN from two known attitudes is the zero rotation
+  if (!truth.q_BtoN.coeffs().allFinite() || !est.q_BtoN.coeffs().allFinite())
+    dx.segment<3>(6).setConstant(std::numeric_limits<double>::quiet_NaN());
+  else if (dx.segment<3>(6).hasNaN())
+    dx.segment<3>(6).setZero();
   return dx;
 }
 

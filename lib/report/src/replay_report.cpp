@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdio>
 #include <cmath>
+#include <limits>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -113,10 +114,17 @@ struct Zoom {
   bool closed = false;
 };
 
+/// @p m = the larger of @p m and @p v over the known values (NaN: none known
+/// yet, or a part the reference does not have: it stays unknown, not 0).
+void keepMax(double& m, double v) {
+  if (!std::isnan(v) && (std::isnan(m) || v > m)) m = v;
+}
+
 /// Running statistics of one outage over its epochs (summary.json).
 struct OutageStats {
-  double maxPh = 0, maxPv = 0, maxVh = 0, maxVv = 0, neesSum = 0;
-  Eigen::Vector3d maxAtt = Eigen::Vector3d::Zero();
+  static constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
+  double maxPh = kUnknown, maxPv = kUnknown, maxVh = kUnknown, maxVv = kUnknown, neesSum = 0;
+  Eigen::Vector3d maxAtt = Eigen::Vector3d::Constant(kUnknown);
   std::array<double, 4> neesB{};
   int n = 0;
   ins::NavState endTruth;  ///< the reference at its end epoch
@@ -193,11 +201,12 @@ struct ReplayWriter::State {
       ++j;
       if (e.t <= w.start_s || !hasTruth) continue;
       const auto block = [&](int b) { return e.err.segment<3>(3 * b); };
-      st.maxPh = std::max(st.maxPh, block(0).head<2>().norm());
-      st.maxPv = std::max(st.maxPv, std::abs(block(0)[2]));
-      st.maxVh = std::max(st.maxVh, block(1).head<2>().norm());
-      st.maxVv = std::max(st.maxVv, std::abs(block(1)[2]));
-      st.maxAtt = st.maxAtt.cwiseMax(eulerError(x, *truth).cwiseAbs() / kDeg);
+      keepMax(st.maxPh, block(0).head<2>().norm());
+      keepMax(st.maxPv, std::abs(block(0)[2]));
+      keepMax(st.maxVh, block(1).head<2>().norm());
+      keepMax(st.maxVv, std::abs(block(1)[2]));
+      const Eigen::Vector3d att = eulerError(x, *truth).cwiseAbs() / kDeg;
+      for (int k = 0; k < 3; ++k) keepMax(st.maxAtt[k], att[k]);
       for (int b = 0; b < 4; ++b) st.neesB[b] += e.nees[b];
       st.neesSum += e.nees[3];
       ++st.n;
