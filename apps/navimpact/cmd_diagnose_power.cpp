@@ -69,7 +69,6 @@ std::vector<na::Cause> parseCauses(const std::string& text) {
   return out;
 }
 
-/// FLAG LO:HI with both ends in [lo, hi] (what: the ends' name and unit).
 /// FLAG LO:HI within @p r: "--rate '0.5:10': rates must be in [1, 10000] Hz".
 void checkRange(const char* flag, const std::string& v, const navimpact::limits::Range& r, const std::string& what) {
   const auto [a, b] = range(flag, v);

@@ -524,9 +524,7 @@ void getD(std::istream& i, double* v, std::size_t n, const std::string& file) {
 }
 
 std::string implausible(const RunRecord& rec) {
-  // |value| <= kMaxValue: squares summed over every run stay finite
-  constexpr double kMaxValue = 1e100;
-  const auto size = [](double v) { return std::isfinite(v) && std::abs(v) <= kMaxValue; };
+  const auto size = [](double v) { return std::isfinite(v) && std::abs(v) <= kMaxRunValue; };
   for (std::size_t mi = 0; mi < rec.models.size(); ++mi) {
     const RunRecord::Model& m = rec.models[mi];
     const std::string model = "model " + std::to_string(mi + 1);

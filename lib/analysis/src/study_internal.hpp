@@ -39,8 +39,12 @@ void getD(std::istream& i, double* v, std::size_t n, const std::string& file);
 nlohmann::json readShardJson(const std::string& dir, const std::string& file, const std::string& marker,
                              const std::string& writer);
 
+/// Largest magnitude of a value in a shard's run file (study and sweep): their
+/// squares summed over every run stay finite.
+inline constexpr double kMaxRunValue = 1e100;
+
 /// Why a run's record holds a value no run writes, or "": an error beyond
-/// 1e100 or not finite, a sigma, drift or time that is not finite and >= 0, a
+/// kMaxRunValue or not finite, a sigma, drift or time that is not finite and >= 0, a
 /// NEES that is neither missing (NaN) nor finite and >= 0. Checked after each
 /// run and on each run a merge reads.
 std::string implausible(const RunRecord& rec);

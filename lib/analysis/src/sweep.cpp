@@ -472,11 +472,11 @@ SweepRuns mergeSweepShards(const std::vector<std::string>& dirs, const std::stri
       if (!f.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(8 * n)))
         throw Error(bin + ": truncated");
       // a horizontal error finite and >= 0, a NEES missing (NaN) or finite and >= 0,
-      // both at most 1e100 (their squares summed over every run stay finite)
+      // both at most detail::kMaxRunValue
       const std::size_t perRun = M * res.meta.columns[c].tau_s.size() * 2;
       for (std::size_t q = 0; q < n; ++q) {
         const bool nees = q % 2 == 1;
-        const bool ok = (nees && std::isnan(v[q])) || (std::isfinite(v[q]) && v[q] >= 0.0 && v[q] <= 1e100);
+        const bool ok = (nees && std::isnan(v[q])) || (std::isfinite(v[q]) && v[q] >= 0.0 && v[q] <= detail::kMaxRunValue);
         if (!ok)
           throw Error(bin + ": column " + std::to_string(c + 1) + ", run " + std::to_string(in.idx[q / perRun]) + ": " +
                       (nees ? "a position NEES neither missing nor finite and >= 0"
