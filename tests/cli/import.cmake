@@ -117,6 +117,13 @@ navimpact_cli_check(cli_replay_katwijk_outages CHECK run_json
        "reference_errors/horizontal_rms_m=^0\\.0[0-9]+" "outages/0/horizontal_error_m=^[0-9.]+"
   FILES trajectory.png outage_end_error.png)
 set_tests_properties(cli_replay_katwijk_outages PROPERTIES FIXTURES_REQUIRED import_katwijk)
+# The reference has a fix every 3 s: an outage whose last reference epoch lies
+# before its end says where it was scored (outage 1 at 19 s of its 20 s).
+add_test(NAME cli_replay_katwijk_scored_epoch
+  COMMAND ${NI} replay --config ${CMAKE_SOURCE_DIR}/config/replay/katwijk.yaml --rawlog ${_idir}/katwijk.rawlog
+          --outages-every 40:20 --out ${_idir}/katwijk_replay_epoch --overwrite)
+set_tests_properties(cli_replay_katwijk_scored_epoch PROPERTIES FIXTURES_REQUIRED import_katwijk
+  PASS_REGULAR_EXPRESSION "outage 1 \\(20 s from 41\\.712 s\\)[^\n]*\\(at 19 s of it: the last reference epoch inside\\)")
 # The same with the NIS gate at 0.999: the fixes from 30.7 s on fail the gate;
 # without re-admission every later fix is rejected and the run diverges (to
 # kilometres); with it the filter takes the fourth fix with P inflated and

@@ -733,10 +733,17 @@ std::string replaySummary(const ReplayResult& r) {
     else
       std::snprintf(b, sizeof b,
                     "outage %zu (%g s from %g s): horizontal error at end %.2f m (1-sigma %.2f m), max %.2f m; "
-                    "vertical %.2f m (1-sigma %.2f m)\n",
+                    "vertical %.2f m (1-sigma %.2f m)",
                     i + 1, o.duration_s(), o.start_s, e.err.head<2>().norm(), e.sigma.head<2>().norm(),
                     w.max_drift_h, std::abs(e.err[2]), e.sigma[2]);
     s += b;
+    // a sparse reference scores the outage at its last epoch inside, which may be well before the end
+    const double into = e.t - r.t_zero - o.start_s;
+    if (r.run.has_truth && o.duration_s() - into > 0.01 * o.duration_s()) {
+      std::snprintf(b, sizeof b, " (at %.4g s of it: the last reference epoch inside)", into);
+      s += b;
+    }
+    s += '\n';
   }
   return s;
 }
