@@ -51,15 +51,9 @@ void printSummary(const an::SweepResults& r, const std::string& dir) {
     for (const auto& s : r.columns[c].sets) {
       const auto& t = s.threshold;
       if (!t.defined) continue;
-      std::cout << "  " << r.meta.columns[c].name << ", " << s.set.title << ": white noise departs from the reference from ";
-      if (t.departs_s < 0) std::cout << "> " << t.scanned_to_s << " s";
-      else std::cout << t.departs_s << " s";
-      if (t.lo_s >= 0 || t.hi_s >= 0)
-        std::cout << " (95 % " << t.lo_s << " to " << (t.hi_s < 0 ? std::string("beyond") : [&] {
-          std::ostringstream x;
-          x << t.hi_s;
-          return x.str();
-        }()) << " s)";
+      std::cout << "  " << r.meta.columns[c].name << ", " << s.set.title
+                << ": white noise departs from the reference from " << navimpact::report::thresholdText(t);
+      if (t.lo_s >= 0 || t.hi_s >= 0) std::cout << " (95 % " << navimpact::report::intervalText(t) << ")";
       std::cout << "\n";
     }
   std::cout << "report: " << dir << "/report.md\n";

@@ -39,17 +39,6 @@ const char* kThresholdRule =
     "for good count as beyond the longest outage); significantly_insufficient_from_s: where the cells' test "
     "finds it insufficient at every later epoch (needs evidence, so later with few runs)";
 
-std::string thresholdText(const WnThreshold& t) {
-  if (!t.defined) return "n/a";
-  if (t.departs_s < 0) return "> " + formatReadable(t.scanned_to_s) + " s";
-  return formatReadable(t.departs_s) + " s";
-}
-std::string intervalText(const WnThreshold& t) {
-  if (!t.defined) return "n/a";
-  auto b = [&](double v) { return v < 0 ? "> " + formatReadable(t.scanned_to_s) : formatReadable(v); };
-  return "[" + b(t.lo_s) + ", " + b(t.hi_s) + "] s";
-}
-
 json verdictJson(const CandidateVerdict& v) {
   return {{"label", v.label},
           {"states", v.states},
@@ -236,6 +225,18 @@ std::string reportMd(const SweepResults& r, const std::vector<std::string>& maps
 }
 
 }  // namespace
+
+std::string thresholdText(const WnThreshold& t) {
+  if (!t.defined) return "n/a";
+  if (t.departs_s < 0) return "> " + formatReadable(t.scanned_to_s) + " s";
+  return formatReadable(t.departs_s) + " s";
+}
+std::string intervalText(const WnThreshold& t) {
+  if (!t.defined) return "n/a";
+  auto b = [&](double v) { return v < 0 ? "> " + formatReadable(t.scanned_to_s) : formatReadable(v); };
+  return "[" + b(t.lo_s) + ", " + b(t.hi_s) + "] s";
+}
+
 
 std::string sweepJson(const SweepResults& r) {
   const auto& meta = r.meta;

@@ -14,6 +14,12 @@
 
 namespace navimpact::report {
 
+/// The white-noise threshold as a person reads it: "12 s", "> 60 s" (never
+/// departs within the scanned outage) or "n/a".
+std::string thresholdText(const analysis::WnThreshold& t);
+/// Its 95 % bootstrap interval: "[8, 15] s", "[8, > 60] s" or "n/a".
+std::string intervalText(const analysis::WnThreshold& t);
+
 /// sweep.json text (see README "Model-sufficiency sweep").
 std::string sweepJson(const analysis::SweepResults& r);
 
