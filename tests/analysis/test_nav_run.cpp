@@ -125,3 +125,4 @@ TEST(NavRun, ATimeOffsetIsReadAcrossItsRange) {
     EXPECT_LE(std::abs(est - d), (lever ? 0.1 : 0.005) * std::abs(d) + 3.0 * sd);
   }
 }
+

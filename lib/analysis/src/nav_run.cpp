@@ -156,7 +156,7 @@ struct NavRunner::Impl {
       e.t = t_now;
       e.est = ekf.state();
       e.err.setConstant(kNaN);
-      const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
+      const filter::Matrix9d P9 = ekf.navCovarianceOnTrueClock();
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
       e.P_pos = P9.topLeftCorner<3, 3>();
       e.nees.fill(kNaN);
@@ -184,7 +184,8 @@ struct NavRunner::Impl {
       // with a time-offset state: the state at IMU time t_now carried to the IMU epoch of tt + d_est
       if (offset) e.err += ekf.carry(tt + d - t_now);
       if (opt.reference_lever_B.squaredNorm() > 0.0) e.err.head<3>() += ekf.state().C_BtoN() * opt.reference_lever_B;
-      const filter::Matrix9d P9 = ekf.P().topLeftCorner<9, 9>();
+      // the scored error holds the offset's own error too: its covariance on the true clock
+      const filter::Matrix9d P9 = ekf.navCovarianceOnTrueClock();
       e.sigma = P9.diagonal().cwiseMax(0.0).cwiseSqrt();
       e.P_pos = P9.topLeftCorner<3, 3>();
       e.nees = navNees(e.err, P9);

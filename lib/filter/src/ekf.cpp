@@ -224,6 +224,17 @@ double ErrorStateEkf::timeOffsetEstimate() const { return extra(Extra::TimeOffse
 
 Vector9d ErrorStateEkf::carry(double tau) const { return stateRate() * tau; }
 
+Matrix9d ErrorStateEkf::navCovarianceOnTrueClock() const {
+  const Matrix9d Pnn = P_.topLeftCorner<9, 9>();
+  const int k = layout_.extraIndex(Extra::TimeOffset);
+  if (k < 0) return Pnn;
+  // e = dx_nav + J dd, dd = d_est - d (the same J as carryInitialStateToImuClock's, sign for sign)
+  const Vector9d J = stateRate();
+  const Vector9d Pnk = P_.block<9, 1>(0, k);
+  Matrix9d Pt = Pnn + J * Pnk.transpose() + Pnk * J.transpose() + P_(k, k) * J * J.transpose();
+  return 0.5 * (Pt + Pt.transpose());
+}
+
 void ErrorStateEkf::addExtraCouplings(const Lin& L, Eigen::Ref<MatrixXd> X, int col0) const {
   // corrected - true = -diag(true) ds + [true x] dm (state_layout.hpp), entering
   // d(psi)/dt and d(dv)/dt through C_BtoN (Groves 14.64-14.65)

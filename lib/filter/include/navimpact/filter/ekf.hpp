@@ -345,6 +345,12 @@ class ErrorStateEkf {
   /// change over @p tau of (dp NED [m], dv NED [m/s], psi [rad]): (v_N, a_N,
   /// C_BtoN w_NB_B) tau (Groves 2013 eq. 5.54 for a_N).
   Vector9d carry(double tau) const;
+  /// Covariance of the nine navigation errors against the truth at true time
+  /// (the error scored when the state is carried to the IMU epoch of t + d_est):
+  /// with the time-offset state that error is dx_nav + J (d_est - d), J the
+  /// state's rate (carry), so P_true = T P T' with T = [I_9 .. J in d's column].
+  /// Without the state, the navigation block of P.
+  Matrix9d navCovarianceOnTrueClock() const;
   /// The time-offset state's estimate d = t_IMU - t_true [s]; 0 when it is off.
   double timeOffsetEstimate() const;
   const StateLayout& layout() const { return layout_; }
