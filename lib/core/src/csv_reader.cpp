@@ -1,4 +1,5 @@
 #include "navimpact/core/csv_reader.hpp"
+#include "navimpact/core/recording.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -96,8 +97,24 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
       throw fileError(path, 1, "column '" + name + "' appears twice");
     present[idx] = static_cast<int>(c);
     const auto q = channelQuantity(name);
-    if (unit.empty())
-      unit = q == units::Quantity::AngularRate ? opt.gyro_unit : opt.acc_unit;
+    const std::string& told = q == units::Quantity::AngularRate ? opt.gyro_unit : opt.acc_unit;
+    if (!unit.empty() && !told.empty()) {
+      // both the header and the caller name the unit: they must agree (the
+      // header used to win silently while the caller recorded its own unit)
+      double fh = 0, ft = 0;
+      try {
+        fh = units::toSiFactor(q, unit);
+        ft = units::toSiFactor(q, told);
+      } catch (const Error& e) {
+        throw fileError(path, 1, "column '" + printable(name) + "': " + e.what());
+      }
+      if (fh != ft)
+        throw fileError(path, 1,
+                        "column '" + printable(name) + "' is in " + printable(unit) + " by its header, but --" +
+                            (q == units::Quantity::AngularRate ? "gyro" : "acc") + "-unit says " + printable(told) +
+                            ": drop the flag or correct the header");
+    }
+    if (unit.empty()) unit = told;
     if (unit.empty())
       throw fileError(path, 1,
                       "unit of column '" + name + "' unknown: pass --" +
@@ -189,13 +206,19 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
         throw fileError(path, k + 2, "time " + formatNumber(times[k], 10) + " s is not after the previous " +
                                          formatNumber(times[k - 1], 10) + " s");
     }
-    std::vector<double> sorted = dts;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double med = sorted[sorted.size() / 2];
-    for (std::size_t k = 0; k < dts.size(); ++k)
-      if (std::abs(dts[k] - med) > opt.max_dt_deviation * med)
+    // The nominal step (the median; the mean where quantised or alternating
+    // stamps move the median: 400 Hz stamped in ms, nominalStep). A step is
+    // regular when within max_dt_deviation of it, or when its stamp lies
+    // within half a step of the regular grid t0 + k T and its step too (stamps quantised
+    // or jittered around a regular clock); a lost sample is neither.
+    const double med = nominalStep(dts);
+    for (std::size_t k = 0; k < dts.size(); ++k) {
+      const double off = times[k + 1] - times[0] - static_cast<double>(k + 1) * med;
+      if (std::abs(dts[k] - med) > opt.max_dt_deviation * med &&
+          !(std::abs(off) < 0.5 * med && std::abs(dts[k] - med) < 0.5 * med))
         throw fileError(path, k + 3, "time step " + formatNumber(dts[k]) + " s differs from the nominal " +
                                          formatNumber(med) + " s (gap or jitter); resample or split the recording");
+    }
     const double rate = (n - 1) / (times[n - 1] - times[0]);
     // the documented range of IMU rates (a time column in the wrong unit: a step of 1e300 s or 1 ns)
     if (!(rate >= limits::kImuRateHz.lo && rate <= limits::kImuRateHz.hi))
