@@ -399,7 +399,17 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   cd.findings.insert(cd.findings.end(), left.begin(), left.end());
   // 5. The extension.
   const int added_params = extendModel(ctx, x, w, found, lines, cd);
-  cd.adequate = cd.findings.empty();
+  for (const ScaleCheck& sc : cd.scales_after) {
+    // material: a factor 2 off (a sigma off by 1.4x) or a CI width beyond the CI
+    // (an overstated slow term widens the CI far more upward than downward)
+    const bool material = std::abs(sc.ci_widths) >= 1.0 || !(sc.ratio > 0.5 && sc.ratio < 2.0);
+    if (!sc.significant || !material) continue;
+    auto& u = cd.unexplained;
+    if (u.scales++ == 0) u.tau_lo_s = sc.tau_s;
+    u.tau_hi_s = sc.tau_s;
+    if (!(std::abs(std::log(u.ratio)) >= std::abs(std::log(sc.ratio)))) u.ratio = sc.ratio;
+  }
+  cd.adequate = cd.findings.empty() && cd.unexplained.scales == 0;
   // 6. The gain, held out.
   cd.gain = heldOutGain(ctx, raw, x, w, cd.model_after, cd.model_after_half, added_params, lines.size());
   sh.tick(ctx.name + ": model extension");

@@ -127,6 +127,10 @@ std::string diagnosisJson(const Diagnosis& d, const std::string& input_json) {
     json fs = json::array();
     for (const auto& f : c.findings) fs.push_back(findingJson(f));
     cj["findings"] = fs;
+    if (c.unexplained.scales > 0)
+      cj["unexplained_misfit"] = {{"scales", c.unexplained.scales},
+                                  {"scales_s", {num(c.unexplained.tau_lo_s), num(c.unexplained.tau_hi_s)}},
+                                  {"ratio", num(c.unexplained.ratio)}};
     cj["model_before"] = modelText(c.model_before);
     cj["model_after"] = modelText(c.model_after);
     cj["model_after_first_half"] = modelText(c.model_after_half);
@@ -315,6 +319,15 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
           cause += "]";
         }
         r << "| " << c.name << " | " << cause << " | " << ps << " | " << strength(pmin) << " | " << shortAction(f0) << " |\n";
+      }
+      if (const auto& u = c.unexplained; u.scales > 0) {
+        const double f = u.ratio >= 1 ? u.ratio : 1.0 / u.ratio;
+        r << "| " << c.name << " | unexplained misfit | measured WV " << formatNumber(f, 3) << "x "
+          << (u.ratio >= 1 ? "above" : "below") << " the " << (c.findings.empty() ? "model" : "extended model")
+          << " at tau = " << formatNumber(u.tau_lo_s, 3) << "–" << formatNumber(u.tau_hi_s, 3) << " s (" << u.scales
+          << " scale(s) rejected family-wise, each a factor 2 or a CI width off) | no cause of the catalogue "
+             "reduces it | check the model's terms and units against the record"
+          << (u.ratio < 1 ? " (a term overstates the noise)" : "") << " |\n";
       }
     }
     r << "\n";
@@ -600,6 +613,7 @@ std::string diagnosisSummary(const Diagnosis& d) {
   for (const auto& c : d.channels) {
     os << "  " << c.name << ": " << (c.adequate ? "adequate" : "inadequate");
     for (const auto& f : c.findings) os << " " << causeName(f.cause);
+    if (c.unexplained.scales > 0) os << " unexplained_misfit";
     if (!c.adequate)
       os << "  (scales outside CI " << c.gain.outside_before << " -> " << c.gain.outside_after << ", "
          << c.gain.basis << ", gain " << (c.gain.significant ? "significant" : "not significant") << ")";

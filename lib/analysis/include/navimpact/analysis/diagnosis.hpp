@@ -185,6 +185,16 @@ struct ChannelDiagnosis {
   /// "gmwm (...)" or "start kept (...)"; empty when nothing was added.
   std::string refit_full, refit_half;
   std::vector<std::string> notes;       ///< e.g. candidate steps explained by a random walk
+  /// The misfit no cause explains: scales of the cleaned record against the
+  /// extension (scales_after) that the family-wise WV test rejects and that are
+  /// material: a factor 2 off or at least one CI width outside the 95 % CI
+  /// (smaller misfits are not acted on), e.g. a model overstating the noise.
+  /// Any makes the channel inadequate.
+  struct Unexplained {
+    int scales = 0;                      ///< such scales
+    double tau_lo_s = 0, tau_hi_s = 0;   ///< their range [s]
+    double ratio = 1;                    ///< measured / model at the scale farthest off
+  } unexplained;
   /// Outlier events of this channel: start [s], length [s], peak deviation [SI].
   struct OutlierSpan {
     double t_s = 0, duration_s = 0, size = 0;
