@@ -78,7 +78,8 @@ WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rat
  * (tau <~ (A / sigma)^2 / c^2); beyond, its variance enters the robust WV like
  * white noise that starts at a middle scale, which a GM takes up with a much
  * shorter T. Gaussian data keep every sample with probability >= 1 - alpha.
- * @return the number of samples replaced.
+ * The first and last samples are tested against their one neighbour.
+ * @return the number of samples replaced (each counted once).
  */
 std::size_t despike(std::vector<double>& x, double alpha = 0.01);
 
