@@ -282,7 +282,12 @@ navimpact::cli::Registrar reg(
        navimpact::cli::addOverwriteFlag(app, o->overwrite);
        app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel (0, or 2 and more)")
            ->capture_default_str()
-           ->check(navimpact::cli::within({0.0, double(navimpact::limits::kMaxMonteCarloRuns), false, ""}));
+           ->check(navimpact::cli::within({0.0, double(navimpact::limits::kMaxMonteCarloRuns), false, ""}))
+           ->check(CLI::Validator(
+               [](std::string& s) { return s.find_first_not_of(" 0") != std::string::npos && std::stod(s) == 1.0
+                                               ? std::string("must be 0 or at least 2 (one simulation has no spread), got 1")
+                                               : std::string(); },
+               "0 or >= 2"));
        app.add_option("--seed", o->seed, "root seed")->capture_default_str()->check(navimpact::cli::seedValue());
        app.add_option("--alpha", o->alpha, "family-wise level for the whole record")
            ->capture_default_str()
