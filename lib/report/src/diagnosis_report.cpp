@@ -326,8 +326,11 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
           << (u.ratio >= 1 ? "above" : "below") << " the " << (c.findings.empty() ? "model" : "extended model")
           << " at tau = " << formatNumber(u.tau_lo_s, 3) << "–" << formatNumber(u.tau_hi_s, 3) << " s (" << u.scales
           << " scale(s) rejected family-wise, each a factor 2 or a CI width off) | no cause of the catalogue "
-             "reduces it | check the model's terms and units against the record"
-          << (u.ratio < 1 ? " (a term overstates the noise)" : "") << " |\n";
+             "reduces it | "
+          << (c.findings.empty() ? std::string("check the model's terms and units against the record") +
+                                       (u.ratio < 1 ? " (a term overstates the noise)" : "")
+                                 : std::string("the extension leaves it: read the scale table below before relying on it"))
+          << " |\n";
       }
     }
     r << "\n";
