@@ -58,8 +58,8 @@ namespace detail {
 namespace {
 /// Chi-square(nu) quantile and tails where boost's incomplete gamma overflows
 /// (extreme dof or statistic): the Wilson-Hilferty cube-root normal
-/// approximation (Johnson, Kotz & Balakrishnan 1994, eq. 18.24), exact to a few
-/// per mille at the dof where boost gives up.
+/// approximation (Johnson, Kotz & Balakrishnan 1994, eq. 18.24), which is
+/// accurate for the large dof where boost gives up.
 double whZ(double nu, double x) {
   const double v = 2.0 / (9.0 * nu);
   return (std::cbrt(x / nu) - (1.0 - v)) / std::sqrt(v);
