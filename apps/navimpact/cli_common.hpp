@@ -49,10 +49,9 @@ inline Overwrite overwriteMode(bool flag) { return flag ? Overwrite::Replace : O
 /// PositiveNumber let NaN and 1e308 through and printed DBL_MAX in 309 digits.)
 /// @p hi_open excludes the upper end too (an efficiency in (0, 1)).
 CLI::Validator within(const limits::Range& r, bool hi_open = false);
-/// A family-wise level --alpha: [1e-10, 0.5) (with hi_open).
-// the family-wise level: from 1e-10 (split over causes, channels and samples a
-// smaller one underflowed to a per-test level of 0, refused deep inside with
-// wording that blamed the input)
+/// A family-wise level --alpha: [1e-10, 0.5) (with hi_open). From 1e-10: split
+/// over causes, channels and samples, a smaller one underflowed to a per-test
+/// level of 0, refused deep inside with wording that blamed the input.
 inline constexpr limits::Range kAlpha{1e-10, 0.5, false, ""};
 /// Worker threads --threads: 0 (all cores) .. 1024, as monte_carlo.threads.
 inline constexpr limits::Range kThreads{0.0, 1024.0, false, ""};

@@ -69,6 +69,28 @@ na::Diagnosis diagnoseCase(const pw::Case& c, std::uint64_t seed) {
   return na::diagnose(c.data, c.model, o);
 }
 
+/// 2^15 samples at 100 Hz of white noise (gyros 1e-3 rad/s, accelerometers
+/// 1e-2 m/s^2) from @p seed, and a model of that noise whose gyros add a
+/// random walk of @p gamma the record lacks.
+pw::Case whiteNoiseUnderGyroRandomWalk(double gamma, std::uint64_t seed) {
+  pw::Case c;
+  c.data.source = "simulated";
+  c.data.rate_hz = c.model.rate_hz = 100.0;
+  for (int k = 0; k < 6; ++k) {
+    navimpact::ImuChannel ch;
+    ch.name = navimpact::kChannelNames[k];
+    ch.quantity = navimpact::channelQuantity(ch.name);
+    ns::Model w;
+    w.rate_hz = 100.0;
+    w.terms = {ns::Process::wn(k < 3 ? 1e-3 : 1e-2)};
+    ch.x = ns::simulate(w, 1 << 15, ns::deriveSeed(seed, k));
+    c.data.channels.push_back(std::move(ch));
+    c.model.axis[k] = w;
+    if (k < 3) c.model.axis[k].terms.push_back(ns::Process::rw(gamma));
+  }
+  return c;
+}
+
 struct Tally {
   int total = 0, detected = 0, right = 0;
 };
@@ -793,37 +815,17 @@ TEST(Diagnose, AModelFarFromTheRecordGivesProbabilitiesNotAnInternalError) {
   std::mt19937_64 g(rootSeed() + 77);
   for (int trial = 0; trial < 5; ++trial) {
     const double gamma = std::pow(10.0, std::uniform_real_distribution<double>(2.0, 5.0)(g));
-    navimpact::ImuSeries s;
-    s.source = "simulated";
-    s.rate_hz = 100.0;
-    ns::ImuModel m;
-    m.rate_hz = 100.0;
-    for (int c = 0; c < 6; ++c) {
-      navimpact::ImuChannel ch;
-      ch.name = navimpact::kChannelNames[c];
-      ch.quantity = navimpact::channelQuantity(ch.name);
-      ns::Model w;
-      w.rate_hz = 100.0;
-      w.terms = {ns::Process::wn(c < 3 ? 1e-3 : 1e-2)};
-      ch.x = ns::simulate(w, 1 << 15, ns::deriveSeed(rootSeed() + trial, c));
-      s.channels.push_back(std::move(ch));
-      m.axis[c] = w;
-      if (c < 3) m.axis[c].terms.push_back(ns::Process::rw(gamma));
-    }
-    na::DiagnoseOptions o;
-    o.seed = 5 + trial;
-    o.threads = 1;
-    o.simulations = 4;
+    const pw::Case c = whiteNoiseUnderGyroRandomWalk(gamma, rootSeed() + trial);
     std::printf("trial %d: gyro model WN(1e-3) + RW(gamma=%.4g) on white noise\n", trial, gamma);
     na::Diagnosis d;
-    ASSERT_NO_THROW(d = na::diagnose(s, m, o));
-    for (int c = 0; c < 3; ++c) {
+    ASSERT_NO_THROW(d = diagnoseCase(c, 5 + trial));
+    for (int k = 0; k < 3; ++k) {
       int significant = 0;
-      for (const auto& sc : d.channels[c].scales) {
-        EXPECT_TRUE(sc.p_value >= 0.0 && sc.p_value <= 1.0) << d.channels[c].name << " tau " << sc.tau_s;
+      for (const auto& sc : d.channels[k].scales) {
+        EXPECT_TRUE(sc.p_value >= 0.0 && sc.p_value <= 1.0) << d.channels[k].name << " tau " << sc.tau_s;
         significant += sc.significant ? 1 : 0;
       }
-      EXPECT_GT(significant, 0) << d.channels[c].name;
+      EXPECT_GT(significant, 0) << d.channels[k].name;
     }
   }
 }
@@ -833,40 +835,20 @@ TEST(Diagnose, AModelFarFromTheRecordGivesProbabilitiesNotAnInternalError) {
 // 100 Hz: the measured WV 30x to 1e7x below the model at the coarsest scales):
 // a gyro channel whose WV test rejects scales a factor 2 below the model is
 // inadequate, by a finding or by the unexplained misfit the WV test leaves
-// (where the coarse scales have too few dof the test may not reject: adequate). Before, a channel whose WV test rejected was reported
-// adequate whenever no cause of the catalogue was kept (gyro_x and gyro_y of
+// (where the coarse scales have too few dof the test may not reject: adequate).
+// Before, a channel whose WV test rejected was reported adequate whenever no cause of the catalogue was kept (gyro_x and gyro_y of
 // a probe at gamma 1e-5, with 7 scales rejected at p down to 1e-19).
 TEST(Diagnose, AnOverstatedModelIsNeverAdequate) {
   std::mt19937_64 g(rootSeed() + 78);
   int checked = 0;
   for (int trial = 0; trial < 4; ++trial) {
     const double gamma = std::pow(10.0, std::uniform_real_distribution<double>(-6.0, -2.0)(g));
-    navimpact::ImuSeries s;
-    s.source = "simulated";
-    s.rate_hz = 100.0;
-    ns::ImuModel m;
-    m.rate_hz = 100.0;
-    for (int c = 0; c < 6; ++c) {
-      navimpact::ImuChannel ch;
-      ch.name = navimpact::kChannelNames[c];
-      ch.quantity = navimpact::channelQuantity(ch.name);
-      ns::Model w;
-      w.rate_hz = 100.0;
-      w.terms = {ns::Process::wn(c < 3 ? 1e-3 : 1e-2)};
-      ch.x = ns::simulate(w, 1 << 15, ns::deriveSeed(rootSeed() + 100 + trial, c));
-      s.channels.push_back(std::move(ch));
-      m.axis[c] = w;
-      if (c < 3) m.axis[c].terms.push_back(ns::Process::rw(gamma));
-    }
-    na::DiagnoseOptions o;
-    o.seed = 9 + trial;
-    o.threads = 1;
-    o.simulations = 4;
-    const na::Diagnosis d = na::diagnose(s, m, o);
+    const pw::Case c = whiteNoiseUnderGyroRandomWalk(gamma, rootSeed() + 100 + trial);
+    const na::Diagnosis d = diagnoseCase(c, 9 + trial);
     std::printf("trial %d: gyro model WN(1e-3) + RW(gamma=%.4g) on white noise:\n%s", trial, gamma,
                 navimpact::report::diagnosisSummary(d).c_str());
-    for (int c = 0; c < 3; ++c) {
-      const auto& ch = d.channels[c];
+    for (int k = 0; k < 3; ++k) {
+      const auto& ch = d.channels[k];
       int rejected = 0;  // scales the WV test rejects, a factor 2 below the model
       for (const auto& sc : ch.scales) rejected += sc.significant && sc.ratio < 0.5 ? 1 : 0;
       if (rejected > 0) {
