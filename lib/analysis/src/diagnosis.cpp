@@ -56,24 +56,29 @@ std::string channelUnit(const std::string& channel) {
 namespace detail {
 
 namespace {
-/// Chi-square(nu) quantile and tails where boost's incomplete gamma overflows
-/// (extreme dof or statistic): the Wilson-Hilferty cube-root normal
-/// approximation (Johnson, Kotz & Balakrishnan 1994, eq. 18.24), which is
-/// accurate for the large dof where boost gives up.
-double whZ(double nu, double x) {
-  const double v = 2.0 / (9.0 * nu);
-  return (std::cbrt(x / nu) - (1.0 - v)) / std::sqrt(v);
+// Wilson-Hilferty: (X/nu)^(1/3) is close to normal with mean 1 - v and
+// variance v = 2/(9 nu) (Johnson, Kotz & Balakrishnan 1994, eq. 18.24).
+double whVar(double nu) { return 2.0 / (9.0 * nu); }
+double whZ(double nu, double x) { return (std::cbrt(x / nu) - (1.0 - whVar(nu))) / std::sqrt(whVar(nu)); }
+double whX(double nu, double z) {
+  return nu * std::pow(std::max(0.0, 1.0 - whVar(nu) + z * std::sqrt(whVar(nu))), 3);
 }
+}  // namespace
+
 double chiQuantile(double nu, double p) {
   try {
     return boost::math::quantile(boost::math::chi_squared(nu), p);
   } catch (const std::exception&) {
-    const double v = 2.0 / (9.0 * nu);
-    const double z = boost::math::quantile(boost::math::normal(), p);
-    return nu * std::pow(std::max(0.0, 1.0 - v + z * std::sqrt(v)), 3);
+    return whX(nu, boost::math::quantile(boost::math::normal(), p));
   }
 }
-/// Lower and upper tail probabilities of chi-square(nu) at @p x.
+double chiUpperQuantile(double nu, double q) {
+  try {
+    return boost::math::quantile(boost::math::complement(boost::math::chi_squared(nu), q));
+  } catch (const std::exception&) {
+    return whX(nu, boost::math::quantile(boost::math::complement(boost::math::normal(), q)));
+  }
+}
 std::pair<double, double> chiTails(double nu, double x) {
   try {
     const boost::math::chi_squared chi(nu);
@@ -84,7 +89,6 @@ std::pair<double, double> chiTails(double nu, double x) {
     return {boost::math::cdf(n, z), boost::math::cdf(boost::math::complement(n, z))};
   }
 }
-}  // namespace
 
 std::vector<ScaleCheck> checkScales(const gmwm::WaveletVariance& wv, const std::vector<double>& nu_m,
                                     const std::vector<double>& dof, double p_thr,

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <sstream>
 
-#include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
 
 #include "diagnosis_internal.hpp"
@@ -188,8 +187,7 @@ bool removeShifts(const ChannelContext& ctx, const std::vector<detect::ChangePoi
   }
   const int best_k = static_cast<int>(st.accepted());
   const double boundaries = static_cast<double>(st.blocks > 1 ? st.blocks - 1 : 1);
-  const double lr_thr =
-      boost::math::quantile(boost::math::complement(boost::math::chi_squared(1.0), B.steps / boundaries));
+  const double lr_thr = chiUpperQuantile(1.0, B.steps / boundaries);
   const std::string how = "generalised likelihood ratio, every variance profiled and a random walk allowed; exact Gaussian likelihood of " +
                           std::to_string(st.blocks) + " block means of " + std::to_string(st.block) +
                           " sample(s); chi2_1 at a fixed time, Bonferroni over the " +

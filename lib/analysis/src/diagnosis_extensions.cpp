@@ -6,7 +6,6 @@
 #include <cmath>
 #include <limits>
 
-#include <boost/math/distributions/chi_squared.hpp>
 
 #include "diagnosis_internal.hpp"
 #include "navimpact/core/error.hpp"
@@ -84,10 +83,10 @@ WvTest wvTest(const WvData& d, double p_thr) {
   WvTest t;
   t.p_thr = p_thr;
   for (double eta : d.dof) {
-    boost::math::chi_squared chi(std::max(eta, 1e-6));
-    t.lo.push_back(boost::math::quantile(chi, 0.5 * p_thr) / eta);
-    t.hi.push_back(boost::math::quantile(boost::math::complement(chi, 0.5 * p_thr)) / eta);
-    t.ci95.push_back((boost::math::quantile(boost::math::complement(chi, 0.025)) - boost::math::quantile(chi, 0.025)) / eta);
+    const double nu = std::max(eta, 1e-6);
+    t.lo.push_back(chiQuantile(nu, 0.5 * p_thr) / eta);
+    t.hi.push_back(chiUpperQuantile(nu, 0.5 * p_thr) / eta);
+    t.ci95.push_back((chiUpperQuantile(nu, 0.025) - chiQuantile(nu, 0.025)) / eta);
   }
   return t;
 }
@@ -487,7 +486,7 @@ std::vector<Extension> extensions(const Model& base, const std::vector<Candidate
         const Extension& sub = out[q1];
         if (!sub.valid) continue;
         const double dp = (penalty(e.terms) - penalty(sub.terms)) / 2.0;
-        const double q = boost::math::quantile(boost::math::complement(boost::math::chi_squared(std::max(dp, 1.0)), 0.01));
+        const double q = chiUpperQuantile(std::max(dp, 1.0), 0.01);
         if (!(sub.deviance - e.deviance > q)) e.needed = false;
       }
       if (e.valid) {

@@ -38,6 +38,15 @@ using stochastic::ProcessKind;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/// Chi-square(nu) quantiles (lower at @p p; upper at @p q, P[X > x] = q) and
+/// the lower and upper tail probabilities at @p x. Where boost's incomplete
+/// gamma overflows (extreme dof or statistic) they fall back to the
+/// Wilson-Hilferty cube-root normal approximation, accurate at the large dof
+/// where that happens.
+double chiQuantile(double nu, double p);
+double chiUpperQuantile(double nu, double q);
+std::pair<double, double> chiTails(double nu, double x);
+
 // --------------------------------------------------------------------------
 // Wavelet variances of models
 

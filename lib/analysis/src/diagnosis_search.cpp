@@ -13,7 +13,6 @@
 #include <sstream>
 #include <tuple>
 
-#include <boost/math/distributions/chi_squared.hpp>
 
 #include "diagnosis_internal.hpp"
 #include "diagnosis_slow.hpp"
@@ -316,7 +315,7 @@ std::vector<std::pair<double, int>> nestedOnly(const std::vector<Extension>& ext
       const double dof_lr = std::max(1.0, (penalty(e.terms, e.terms.size() - e.added) -
                                            penalty(ext[simple].terms, ext[simple].terms.size() - ext[simple].added)) / 2.0);
       const double lr = 2.0 * (loglik[r.second] - loglik[simple]);
-      if (!(lr > boost::math::quantile(boost::math::complement(boost::math::chi_squared(dof_lr), 0.01)))) continue;
+      if (!(lr > chiUpperQuantile(dof_lr, 0.01))) continue;
     }
     kept.push_back(r);
   }
