@@ -82,35 +82,46 @@ OutlierResult detectOutliers(const std::vector<double>& x, double model_r_sd, do
 void cleanOutliers(std::vector<double>& x, const std::vector<OutlierEvent>& events,
                    const OutlierOptions& opt) {
   const std::size_t n = x.size();
+  // The statistic r is not defined at the two end samples, so a spike on one
+  // shows as an exceedance next to it, and a padded span may reach past the
+  // end: an event within max(pad, 1) samples of an end takes the end sample
+  // with it and is filled from its one kept side.
+  const std::size_t reach = std::max<std::size_t>(opt.pad, 1);
   for (const auto& e : events) {
-    const std::size_t a = e.first > opt.pad + 1 ? e.first - opt.pad - 1 : 0;  // kept
-    const std::size_t b = std::min(n - 1, e.last + opt.pad + 1);             // kept
-    if (b <= a + 1) continue;
+    if (n < 3 || e.last >= n) continue;
+    const bool open_start = e.first <= reach;
+    const bool open_end = e.last + reach >= n - 1;
+    if (open_start && open_end) continue;  // no kept sample on either side
+    // Replaced: samples lo..hi-1; kept neighbours lo-1 (unless open_start) and hi (unless open_end).
+    const std::size_t lo = open_start ? 0 : e.first - opt.pad;
+    const std::size_t hi = open_end ? n : e.last + opt.pad + 1;
+    const std::size_t len = hi - lo;
     if (!opt.local_fill) {
-      const double xa = x[a], xb = x[b];
-      for (std::size_t k = a + 1; k < b; ++k)
-        x[k] = xa + (xb - xa) * static_cast<double>(k - a) / static_cast<double>(b - a);
+      const double xa = open_start ? x[hi] : x[lo - 1], xb = open_end ? x[lo - 1] : x[hi];
+      for (std::size_t k = lo; k < hi; ++k)
+        x[k] = xa + (xb - xa) * static_cast<double>(k - lo + 1) / static_cast<double>(len + 1);
       continue;
     }
-    const std::size_t len = b - a - 1;  // samples replaced
     // The level on each side is the mean of up to len samples there (the kept
     // neighbour included): across a long span one sample's noise would be a
     // plateau of that size. The replaced samples take the deviations of the
     // len samples before (or after) from their mean, so that the span keeps
     // the short-scale variance of its neighbours instead of a noiseless line.
-    const std::size_t a0 = a + 1 >= len ? a + 1 - len : 0, b1 = std::min(n, b + len);
+    const std::size_t a0 = lo >= len ? lo - len : 0, b1 = std::min(n, hi + len);
     double ma = 0, mb = 0;
-    for (std::size_t k = a0; k <= a; ++k) ma += x[k];
-    for (std::size_t k = b; k < b1; ++k) mb += x[k];
-    ma /= static_cast<double>(a + 1 - a0);
-    mb /= static_cast<double>(b1 - b);
+    for (std::size_t k = a0; k < lo; ++k) ma += x[k];
+    for (std::size_t k = hi; k < b1; ++k) mb += x[k];
+    if (!open_start) ma /= static_cast<double>(lo - a0);
+    if (!open_end) mb /= static_cast<double>(b1 - hi);
+    if (open_start) ma = mb;
+    if (open_end) mb = ma;
     std::vector<double> dev(len, 0.0);
-    if (a + 1 - a0 == len)
+    if (lo - a0 == len)
       for (std::size_t i = 0; i < len; ++i) dev[i] = x[a0 + i] - ma;
-    else if (b1 - b == len)
-      for (std::size_t i = 0; i < len; ++i) dev[i] = x[b + i] - mb;
-    for (std::size_t k = a + 1; k < b; ++k)
-      x[k] = ma + (mb - ma) * static_cast<double>(k - a) / static_cast<double>(b - a) + dev[k - a - 1];
+    else if (b1 - hi == len)
+      for (std::size_t i = 0; i < len; ++i) dev[i] = x[hi + i] - mb;
+    for (std::size_t k = lo; k < hi; ++k)
+      x[k] = ma + (mb - ma) * static_cast<double>(k - lo + 1) / static_cast<double>(len + 1) + dev[k - lo];
   }
 }
 
