@@ -107,6 +107,44 @@ TEST(StepTest, CandidatesOfTheDetectorHoldAlphaUnderTheModel) {
   EXPECT_GE(proposed, R / 8);  // the detector did propose times to judge (not a vacuous test)
 }
 
+TEST(StepTest, HoldsAlphaWhenTheModelUnderstatesItsRandomWalk) {
+  // A fitted model can carry a random walk far below the data's (a GMWM fit
+  // that put it at gamma = 1e-65). The records are white noise plus a random
+  // walk; the model given has that walk with gamma scaled by a factor drawn
+  // log-uniformly over [1e-60, 1]. The detector, run under that model, sees
+  // the wander as steps; the test, with the walk's variance profiled, must
+  // still hold its level.
+  const double alpha = 0.05;
+  const int R = 100;
+  std::mt19937_64 g(rootSeed() + 1);
+  int alarms = 0, proposed = 0;
+  for (int r = 0; r < R; ++r) {
+    auto logU = [&](double a, double b) { return detecttest::logUniform(g, a, b); };
+    const detecttest::WhiteRecord w = detecttest::drawWhiteRecord(g, 4096, 32768);
+    Drawn d{w.model, w.n};
+    d.model.terms.push_back(ns::Process::rw(w.sigma * logU(1e-3, 3e-2)));
+    const std::uint64_t s = g();
+    const auto x = ns::simulate(d.model, d.n, s);
+    Drawn given = d;
+    given.model.terms.back().gamma *= logU(1e-60, 1.0);
+    std::vector<double> xc = x;
+    const auto cp = nd::detectChangePoints(xc, nd::haarWvOf(given.model), 0.9);
+    std::vector<std::size_t> idx;
+    for (const auto& c : cp.changes) idx.push_back(c.index);
+    if (idx.empty()) continue;
+    ++proposed;
+    const auto t = nd::testLevelShifts(x, given.model, idx, alpha);
+    if (t.accepted() > 0) {
+      ++alarms;
+      std::cout << "  alarm: " << describe(d) << " given " << describe(given) << " seed " << s << "\n";
+    }
+  }
+  std::cout << "step test, understated random walk: " << alarms << "/" << R << " records with a shift at alpha "
+            << alpha << " (" << proposed << " with candidates)\n";
+  EXPECT_LE(alarms, navimpact::test::plausibleMaxCount(R, alpha));
+  EXPECT_GE(proposed, R / 4);
+}
+
 TEST(StepTest, ShiftsAtFiveTimesTheLimitAreAcceptedAndSized) {
   const double alpha = 0.01;
   const int R = 40;

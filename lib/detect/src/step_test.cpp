@@ -58,15 +58,26 @@ StepTestResult testLevelShifts(const std::vector<double>& x, const stochastic::M
   std::vector<std::size_t> acc_boundary;  // accepted shifts, snapped (for the tests)
   std::vector<std::size_t> acc_index;     // and at their sample indices (for the sizes)
   stochastic::Model m0 = m;
-  if (opt.add_random_walk && opt.profile_variances && m0.count(stochastic::ProcessKind::RW) == 0 && nb >= 3) {
+  if (opt.add_random_walk && opt.profile_variances && nb >= 3) {
     // Start: every increment of the block means a random walk's (an upper
-    // bound); the profile scales it down as far as the data ask.
+    // bound); the profile scales it down as far as the data ask. A random walk
+    // of the model below that bound starts there too: the profile searches
+    // e^-12..e^4 around its start, so a negligible one (a fit's gamma = 1e-65)
+    // could never grow to what the data ask, and a slow wander would be taken
+    // for shifts.
     double dm = 0, v = 0;
     for (std::size_t k = 1; k < nb; ++k) dm += y[k] - y[k - 1];
     dm /= static_cast<double>(nb - 1);  // a drift's share of the increments
     for (std::size_t k = 1; k < nb; ++k) v += (y[k] - y[k - 1] - dm) * (y[k] - y[k - 1] - dm);
     v /= static_cast<double>(nb - 1);
-    if (v > 0) m0.terms.push_back(stochastic::Process::rw(std::sqrt(v / static_cast<double>(b))));
+    const double gamma_bound = std::sqrt(v / static_cast<double>(b));
+    bool has_rw = false;
+    for (auto& p : m0.terms)
+      if (p.kind == stochastic::ProcessKind::RW) {
+        has_rw = true;
+        if (v > 0 && !(p.gamma >= gamma_bound)) p.gamma = gamma_bound;
+      }
+    if (!has_rw && v > 0) m0.terms.push_back(stochastic::Process::rw(gamma_bound));
   }
   auto loglik = [&](stochastic::Model& mm, const Eigen::MatrixXd& X) {
     return opt.profile_variances ? stochastic::profileBlockLogLikelihood(mm, y, b, X) : stochastic::blockLogLikelihood(mm, y, b, X).loglik;
