@@ -65,10 +65,21 @@ OutlierResult detectOutliers(const std::vector<double>& x, double model_r_sd, do
     double ma = 0, mb = 0;
     for (std::size_t k = a0; k < a1; ++k) ma += x[k];
     for (std::size_t k = b0; k < b1; ++k) mb += x[k];
-    const bool have = a1 > a0 && b1 > b0;
-    ma = have ? ma / static_cast<double>(a1 - a0) : 0.0;
-    mb = have ? mb / static_cast<double>(b1 - b0) : 0.0;
-    const double level = 0.5 * (ma + mb);
+    const bool has_a = a1 > a0, has_b = b1 > b0, have = has_a && has_b;
+    ma = has_a ? ma / static_cast<double>(a1 - a0) : 0.0;
+    mb = has_b ? mb / static_cast<double>(b1 - b0) : 0.0;
+    const double level = have ? 0.5 * (ma + mb) : has_a ? ma : mb;
+    // r is not defined at the end samples: a spike on one shows only next to
+    // it, so an event there takes the end sample when that is further from
+    // the level.
+    if (e.first == 1 && std::abs(x[0] - level) > std::abs(x[e.peak] - level)) {
+      if (e.last == 1) e.last = 0;  // the exceedance was the spike's neighbour
+      e.first = e.peak = 0;
+    }
+    if (e.last == n - 2 && std::abs(x[n - 1] - level) > std::abs(x[e.peak] - level)) {
+      if (e.first == n - 2) e.first = n - 1;
+      e.last = e.peak = n - 1;
+    }
     e.peak_value = x[e.peak] - level;
     // r at a step of size S is +-S/2 on two samples, so |mb - ma| ~ 2 |r|; at
     // a spike or a burst it is ~0.
