@@ -2,6 +2,7 @@
 // robust (Tukey biweight) wavelet variance under contamination.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -154,4 +155,40 @@ TEST(RobustWv, BeyondBreakdownTheMadScaleHolds) {
   }
   std::printf("MAD scale used at %d scales over 12 records\n", fallbacks);
   EXPECT_GT(fallbacks, 0) << "no record broke the biweight: the fallback went untested";
+}
+
+// A record quantised below its quantum (white noise of sigma = (0.15..0.5) q
+// rounded to q, both drawn; seeded, printed) has scales where more than half
+// of the Haar coefficients are zero, so that neither the biweight nor the MAD
+// scale is defined there. The robust WV must answer at every scale, take the
+// classical WV and its CI at the scales it lists in classical_scales, and
+// stay within a factor 3 of the classical WV elsewhere (white noise, no
+// outliers: both estimate the same variance).
+TEST(RobustWv, QuantisedBelowTheQuantumTheClassicalScaleHolds) {
+  const std::size_t n = 1 << 14;
+  std::mt19937_64 g(2718);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int listed = 0;
+  for (int r = 0; r < 12; ++r) {
+    const double q = 1e-4 * std::pow(100.0, u(g)), ratio = 0.15 + 0.35 * u(g);
+    auto x = whiteNoise(n, ratio * q, 900 + r);
+    for (auto& v : x) v = q * std::round(v / q);
+    const auto cl = gmwm::waveletVariance(x.data(), n, 100.0);
+    gmwm::WaveletVariance rb;
+    ASSERT_NO_THROW(rb = gmwm::robustWaveletVariance(x.data(), n, 100.0)) << "record " << r;
+    std::printf("record %d: q %.3g, sigma/q %.3f: classical at %zu scale(s)\n", r, q, ratio, rb.classical_scales.size());
+    for (int j = 0; j < rb.scales(); ++j) {
+      const bool listed_j = std::find(rb.classical_scales.begin(), rb.classical_scales.end(), j) != rb.classical_scales.end();
+      listed += listed_j;
+      if (listed_j) {
+        EXPECT_NEAR(rb.wv[j], cl.wv[j], 1e-12 * cl.wv[j]) << "record " << r << " j=" << j + 1;
+        EXPECT_NEAR(rb.ci_low[j], cl.ci_low[j], 1e-9 * cl.wv[j]);
+        EXPECT_NEAR(rb.ci_high[j], cl.ci_high[j], 1e-9 * cl.wv[j]);
+      } else {
+        EXPECT_GT(rb.wv[j], cl.wv[j] / 3) << "record " << r << " j=" << j + 1;
+        EXPECT_LT(rb.wv[j], cl.wv[j] * 3) << "record " << r << " j=" << j + 1;
+      }
+    }
+  }
+  EXPECT_GT(listed, 0);  // the draw did reach quantised scales (not a vacuous test)
 }

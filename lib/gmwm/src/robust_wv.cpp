@@ -95,8 +95,10 @@ double robustScale(const double* w, std::size_t m, double eff) {
   return robustScale(w, m, c, consistencyA(c));
 }
 
-double robustScale(const double* w, std::size_t m, double c, double a, bool* mad_fallback) {
+double robustScale(const double* w, std::size_t m, double c, double a, bool* mad_fallback,
+                   bool* classical_fallback) {
   if (mad_fallback) *mad_fallback = false;
+  if (classical_fallback) *classical_fallback = false;
   if (m == 0) throw Error("robust scale: no values");
   if (m == 1) return w[0] * w[0];  // a single coefficient: nothing to down-weight
   // Classical variance (two-pass) to standardise.
@@ -128,7 +130,15 @@ double robustScale(const double* w, std::size_t m, double c, double a, bool* mad
     for (std::size_t i = 0; i < m; ++i) ab[i] = std::fabs(w[i]);
     std::nth_element(ab.begin(), ab.begin() + m / 2, ab.end());
     const double s = ab[m / 2] / 0.6744897501960817;
-    if (!(s > 0.0)) throw noRoot();
+    if (!(s > 1e-9 * sd)) {
+      // More than half of the coefficients are zero, to rounding (a record
+      // quantised below its quantum): no robust scale is defined, the
+      // classical one is used.
+      if (classical_fallback) *classical_fallback = true;
+      long double q = 0;
+      for (std::size_t i = 0; i < m; ++i) q += static_cast<long double>(w[i]) * w[i];
+      return static_cast<double>(q / m);
+    }
     if (mad_fallback) *mad_fallback = true;
     return s * s;
   };
@@ -232,12 +242,13 @@ WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rat
     r.tau[i] = tau;
     r.n_coef[i] = static_cast<double>(m);
     r.eta[i] = std::max(static_cast<double>(m) / tau, 1.0);
-    bool mad = false;
-    const double nu = detail::robustScale(w, m, c, a, &mad);
+    bool mad = false, classical = false;
+    const double nu = detail::robustScale(w, m, c, a, &mad, &classical);
     r.wv[i] = nu;
     if (mad) r.mad_scales.push_back(i);
+    if (classical) r.classical_scales.push_back(i);
     // The MAD scale has its own (lower) efficiency: a wider interval.
-    const double inflate = 1.0 / std::sqrt(mad ? detail::kMadEfficiency : eff);
+    const double inflate = classical ? 1.0 : 1.0 / std::sqrt(mad ? detail::kMadEfficiency : eff);
     // gmwm_formulas.md §2 (ci_eta3_robust): the classical relative half-widths,
     // inflated by 1/sqrt(eff), around the robust estimate.
     double lo1, hi1;

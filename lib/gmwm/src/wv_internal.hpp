@@ -34,7 +34,11 @@ double robustScale(const double* w, std::size_t m, double eff);
 /// breakdown point, e.g. isolated spikes spread over tau coefficients at scale tau),
 /// returns the median-absolute-value scale (median |w| / 0.6745)^2 and sets
 /// @p mad_fallback (Gaussian efficiency of that estimator: kMadEfficiency).
-double robustScale(const double* w, std::size_t m, double c, double a, bool* mad_fallback = nullptr);
+/// When that is zero too (more than half of the values are zero: a record
+/// quantised below its quantum) returns the classical mean of w^2 and sets
+/// @p classical_fallback.
+double robustScale(const double* w, std::size_t m, double c, double a, bool* mad_fallback = nullptr,
+                   bool* classical_fallback = nullptr);
 
 /// Asymptotic Gaussian efficiency of the MAD scale (Hampel et al. 1986): 0.3674.
 constexpr double kMadEfficiency = 0.3674;

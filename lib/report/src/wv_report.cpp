@@ -47,6 +47,11 @@ void writeWvOutputs(const gmwm::RecordingWv& w, const std::string& input_json, O
       for (int s : c.wv.mad_scales) t.push_back(c.wv.tau[s] / w.rate_hz);
       jc["mad_scales_tau_s"] = t;  // robust: scales where the biweight broke down and the MAD scale is used
     }
+    if (!c.wv.classical_scales.empty()) {
+      std::vector<double> t;
+      for (int s : c.wv.classical_scales) t.push_back(c.wv.tau[s] / w.rate_hz);
+      jc["classical_scales_tau_s"] = t;  // robust: scales with more than half the coefficients zero (quantised)
+    }
     if (w.allan)
       jc["allan"] = {{"tau_s", c.allan_tau_s}, {"adev", c.adev}, {"unit", units::siUnit(c.quantity)}};
     j["channels"].push_back(jc);

@@ -35,6 +35,10 @@ struct WaveletVariance {
   /// Robust: scales (indices) where the biweight broke down (more outlying
   /// coefficients than it tolerates) and the MAD scale was used instead.
   std::vector<int> mad_scales;
+  /// Robust: scales where more than half of the coefficients are zero (a
+  /// record quantised below its quantum), so that neither scale is defined
+  /// and the classical WV (no robustness, classical CI) is used.
+  std::vector<int> classical_scales;
 
   int scales() const { return static_cast<int>(tau.size()); }
   Eigen::VectorXd tauSeconds() const { return tau / rate_hz; }
@@ -60,7 +64,10 @@ WaveletVariance waveletVariance(const double* x, std::size_t n, double rate_hz,
  * Where the biweight breaks down (its scale equation has no root: isolated
  * spikes touch tau coefficients at scale tau, so their share grows with the
  * scale) the MAD scale (median |w| / 0.6745)^2 is used, CI inflated by
- * 1/sqrt(0.3674), and the scale is listed in mad_scales.
+ * 1/sqrt(0.3674), and the scale is listed in mad_scales. Where the MAD is
+ * zero too (more than half of the coefficients zero: a record quantised below
+ * its quantum) the classical WV is used and the scale is listed in
+ * classical_scales.
  */
 WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rate_hz,
                                       double eff = 0.6, double alpha = 0.05);
