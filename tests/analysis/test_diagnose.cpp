@@ -860,3 +860,60 @@ TEST(Diagnose, AnOverstatedModelIsNeverAdequate) {
   }
   EXPECT_GT(checked, 0);  // the draws reached the test's power at least once
 }
+
+TEST(Diagnose, ChannelsQuantisedBelowTheirQuantumAreNotAllOutliers) {
+  // One channel of white noise sigma = (0.15..0.35) q rounded to a quantum q
+  // drawn over 1e-4..1e-2: most samples sit on one level and each change of a
+  // quantum is a many-sigma event for Gaussian noise of the record's sd. In
+  // half of the records a spike of 20..1000 quanta sits at a sample drawn over
+  // the whole record. The channel must be diagnosed (not emptied to a
+  // constant and refused), with an outlier finding exactly when a spike was
+  // hidden, and no level shift.
+  const int R = runs(24);
+  std::mt19937_64 g(ns::deriveSeed(rootSeed(), 77));
+  std::uniform_real_distribution<double> U(0, 1);
+  auto logU = [&](double a, double b) { return a * std::pow(b / a, U(g)); };
+  int right = 0;
+  for (int r = 0; r < R; ++r) {
+    const std::uint64_t s = g();
+    pw::Case c = whiteNoiseUnderGyroRandomWalk(0.0, s);
+    const int ch = static_cast<int>(g() % 6);
+    const double q = logU(1e-4, 1e-2), ratio = 0.15 + 0.2 * U(g);
+    auto& x = c.data.channels[ch].x;
+    std::normal_distribution<double> N(0.0, ratio * q);
+    double m2 = 0;
+    for (double& v : x) {
+      v = q * std::round(N(g) / q);
+      m2 += v * v;
+    }
+    ns::Model w;
+    w.rate_hz = 100.0;
+    w.terms = {ns::Process::wn(std::max(std::sqrt(m2 / static_cast<double>(x.size())), 1e-3 * q))};
+    c.model.axis[ch] = w;
+    for (int k = 0; k < 3; ++k) c.model.axis[k].terms.resize(1);  // no random walk
+    const bool spiked = U(g) < 0.5;
+    const std::size_t at = g() % x.size();
+    if (spiked) x[at] += (U(g) < 0.5 ? -1.0 : 1.0) * q * std::round(logU(20, 1000));
+    std::string got;
+    bool ok = true;
+    try {
+      const auto d = diagnoseCase(c, s);
+      bool outliers = false, shift = false;
+      for (const auto& f : d.channels[ch].findings) {
+        got += std::string(got.empty() ? "" : "+") + na::causeName(f.cause);
+        if (f.cause == na::Cause::Outliers)
+          outliers = f.times_s.size() == 1 && std::abs(f.times_s[0] - static_cast<double>(at) / 100.0) < 0.05;
+        shift = shift || f.cause == na::Cause::LevelShift;
+      }
+      ok = outliers == spiked && !shift;
+    } catch (const std::exception& e) {
+      ok = false;
+      got = e.what();
+    }
+    right += ok;
+    std::cout << "  [seed " << s << "] " << c.data.channels[ch].name << " q " << q << " sigma/q " << ratio
+              << (spiked ? " spike at sample " + std::to_string(at) : std::string(" no spike")) << ": "
+              << (got.empty() ? "no finding" : got) << (ok ? "" : "  WRONG") << "\n";
+  }
+  EXPECT_EQ(right, R);
+}

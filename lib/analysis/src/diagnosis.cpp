@@ -384,7 +384,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   const std::vector<double> raw = withoutMean(sh.data->channels[ci].x);
   std::vector<double> x = raw;
   // 1. Outlier events.
-  removeOutliers(ctx, x, cd);
+  const bool gaussian = removeOutliers(ctx, x, cd);
   sh.tick(ctx.name + ": outliers");
   // 2. Spectral lines.
   const std::vector<detect::SpectralLine> lines = removeLines(ctx, x, cd);
@@ -393,7 +393,7 @@ ChannelDiagnosis diagnoseChannel(Shared& sh, int ci) {
   const bool outliers_or_lines = !cd.findings.empty();
   const auto wv_pre = gmwm::waveletVariance(x.data(), ctx.n, ctx.rate);
   ShiftsLeft shifts_left;
-  const bool shifts_or_knocks = removeLevelShifts(ctx, wv_pre, x, cd, shifts_left);
+  const bool shifts_or_knocks = gaussian && removeLevelShifts(ctx, wv_pre, x, cd, shifts_left);
   sh.tick(ctx.name + ": level shifts");
   // 4. The WV against the model, then the cause of the broadband misfit;
   // then the shifts a random walk took up in step 3, against what it found.

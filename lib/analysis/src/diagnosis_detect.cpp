@@ -258,13 +258,19 @@ bool removeShifts(const ChannelContext& ctx, const std::vector<detect::ChangePoi
 
 }  // namespace
 
-void removeOutliers(const ChannelContext& ctx, std::vector<double>& x, ChannelDiagnosis& cd) {
+bool removeOutliers(const ChannelContext& ctx, std::vector<double>& x, ChannelDiagnosis& cd) {
   const double rate = ctx.rate, t0 = ctx.t0;
   const std::size_t n = ctx.n;
   const std::string& unit = ctx.unit;
   const auto orr = detect::detectOutliers(x, detect::secondDifferenceSd(ctx.m0n), ctx.B.spikes);
   detect::cleanOutliers(x, orr.events);
-  if (orr.events.empty()) return;
+  if (orr.sub_quantum)
+    cd.notes.push_back("quantised below its quantum (" + formatNumber(orr.quantum, 3) + " " + unit +
+                       "): most samples sit on their neighbours' level, so each change of one quantum would be a "
+                       "many-sigma event for Gaussian noise; outliers are judged against the quantum, and level "
+                       "shifts and knocks are not tested");
+  const bool gaussian = !orr.sub_quantum;
+  if (orr.events.empty()) return gaussian;
   Finding f;
   f.channel = cd.name;
   f.cause = Cause::Outliers;
@@ -296,6 +302,7 @@ void removeOutliers(const ChannelContext& ctx, std::vector<double>& x, ChannelDi
   f.action = heavy ? "estimate the model robustly (`navimpact wv --robust`); heavy-tailed noise is not a filter state"
                    : "remove them before estimating (they were interpolated here); not a filter state";
   cd.findings.push_back(f);
+  return gaussian;
 }
 
 std::vector<detect::SpectralLine> removeLines(const ChannelContext& ctx, std::vector<double>& x,

@@ -233,8 +233,10 @@ struct ChannelContext {
 };
 
 /// 1. Outlier events (spikes, bursts such as a knock) of @p x, interpolated
-/// out: one finding for all, each event in cd.outlier_events.
-void removeOutliers(const ChannelContext& ctx, std::vector<double>& x, ChannelDiagnosis& cd);
+/// out: one finding for all, each event in cd.outlier_events. Returns false
+/// (with a note) for a channel quantised below its quantum, where the
+/// Gaussian event tests of step 3 do not hold.
+bool removeOutliers(const ChannelContext& ctx, std::vector<double>& x, ChannelDiagnosis& cd);
 
 /// 2. Spectral lines of @p x against the model's PSD, subtracted from @p x:
 /// the spectrum and line frequencies in @p cd, one finding per line (its

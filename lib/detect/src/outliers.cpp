@@ -26,10 +26,22 @@ OutlierResult detectOutliers(const std::vector<double>& x, double model_r_sd, do
   double med = 0;
   double s = madScale(sub, &med);
   if (!(s > 0)) {
-    // Heavily quantised records: the MAD may vanish; use the classical sd.
-    double q = 0;
+    // More than half of r equal: a channel quantised below its quantum (a
+    // still gyro at 0.1 deg/s resolution sits on one level). The classical sd
+    // is then set by the few level changes, which would all exceed its
+    // threshold and be cleaned out down to a constant record. Nothing finer
+    // than the quantum -- the smallest non-zero step between samples -- is
+    // resolved, so the scale is at least that.
+    double q = 0, quantum = 0;
     for (double v : sub) q += (v - med) * (v - med);
     s = std::sqrt(q / static_cast<double>(std::max<std::size_t>(1, sub.size() - 1)));
+    for (std::size_t k = 1; k < n; ++k) {
+      const double d = std::abs(x[k] - x[k - 1]);
+      if (d > 0 && (quantum == 0 || d < quantum)) quantum = d;
+    }
+    s = std::max(s, quantum);
+    out.sub_quantum = true;
+    out.quantum = quantum;
   }
   s = std::max(s, model_r_sd);
   out.scale = s;

@@ -7,7 +7,10 @@
  * (var r = integral of S(f) (1 - cos 2 pi f / fs)^2 df). Its scale is
  * s = max(model sd, 1.4826 MAD of r): the MAD is robust to the outliers
  * themselves, and the maximum keeps the null level when the model understates
- * the noise. |r_k - median| > z s is an exceedance, z for alpha by Bonferroni
+ * the noise. Where the MAD vanishes (a channel quantised below its quantum,
+ * mostly on one level) the robust part is max(classical sd of r, the smallest
+ * non-zero step between samples): a level change of one quantum is not an
+ * outlier. |r_k - median| > z s is an exceedance, z for alpha by Bonferroni
  * over the N samples (two-sided normal). Exceedances closer than @c gap
  * samples form one event (a burst of consecutive spikes, a knock) instead of
  * several findings.
@@ -41,6 +44,10 @@ struct OutlierResult {
   std::vector<OutlierEvent> events;
   double scale = 0;      ///< s [unit]
   double threshold = 0;  ///< z
+  /// The MAD of r vanished: more than half of the samples sit on their
+  /// neighbours' level, a channel quantised below its quantum.
+  bool sub_quantum = false;
+  double quantum = 0;    ///< with sub_quantum: the smallest non-zero step between samples [unit]
 };
 
 /**
