@@ -49,7 +49,9 @@ json findingJson(const Finding& f) {
   for (const auto& kv : f.params) p[kv.first] = num(kv.second);
   if (f.cause == Cause::Outliers) p["times_s"] = f.times_s;
   j["params"] = p;
-  j[f.range_key] = {num(f.range_lo), num(f.range_hi)};
+  // A range only where there is one (a finding that explains no scale outside
+  // the CI has no scales_s).
+  if (std::isfinite(f.range_lo) && std::isfinite(f.range_hi)) j[f.range_key] = {f.range_lo, f.range_hi};
   if (f.T_interval_s) j["T_interval_s"] = {num(f.T_interval_s->first), num(f.T_interval_s->second)};
   j["direction"] = f.direction;
   j["explanation"] = f.explanation;
