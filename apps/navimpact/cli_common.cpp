@@ -12,6 +12,7 @@
 
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/text_io.hpp"
+#include "navimpact/gmwm/wavelet_variance.hpp"
 
 namespace navimpact::cli {
 
@@ -66,6 +67,16 @@ CLI::Validator knownUnit(units::Quantity q) {
         }
       },
       "UNIT");
+}
+
+CLI::Validator robustEfficiency() {
+  return parsedBy(
+      [](const std::string& s) {
+        double v = 0.0;
+        if (!parseDouble(s, v)) throw Error("'" + printable(s, 40) + "' is not a number");
+        gmwm::checkRobustEfficiency(v);
+      },
+      "EFF");
 }
 
 CLI::Validator seedValue() {

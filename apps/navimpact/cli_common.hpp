@@ -71,6 +71,11 @@ CLI::Validator knownUnit(units::Quantity q);
 /// 2^64 - 1, a silent wrap), the same seeds as a configuration's seed keys.
 CLI::Validator seedValue();
 
+/// A robust WV efficiency --eff: a number the biweight reaches (about
+/// 0.0124 .. 0.999985, gmwm::checkRobustEfficiency); 0.9999999 passed a (0, 1)
+/// check and failed after the file was read, blaming the file.
+CLI::Validator robustEfficiency();
+
 /// Identity of this build: navimpact version plus an FNV-1a 64 hash of the
 /// running executable (/proc/self/exe), e.g. "0.1.0+3f2a...". Shards of a
 /// sweep record it so that a merge refuses results of another build.

@@ -260,9 +260,9 @@ navimpact::cli::Registrar reg(
            ->required();
        auto* robust = app.add_flag("--robust", o->robust,
                                    "with fit:SPEC: robust GMWM (fit the robust WV, Tukey biweight)");
-       app.add_option("--eff", o->eff, "--robust: efficiency of the robust WV at the Gaussian, in (0, 1)")
+       app.add_option("--eff", o->eff, "--robust: efficiency of the robust WV at the Gaussian, in [0.0124, 0.99998]")
            ->capture_default_str()
-           ->check(navimpact::cli::within({0.0, 1.0, true, ""}, true))
+           ->check(navimpact::cli::robustEfficiency())
            ->needs(robust);
        app.add_option("--trajectory", o->trajectory,
                       "trajectory CSV for the navigation gain (columns time_s, lat_rad, lon_rad, "

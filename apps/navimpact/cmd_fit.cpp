@@ -14,6 +14,7 @@
 
 #include "cli_common.hpp"
 #include "input.hpp"
+#include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/gmwm/channels.hpp"
 #include "navimpact/report/fit_report.hpp"
@@ -30,12 +31,18 @@ struct Opts {
   bool overwrite = false;
 };
 
+/// "gyro_x,acc_z" -> {gyro_x, acc_z}; an empty entry ("," or "gyro_x,,acc_z")
+/// is an error: "--channels ," fitted every channel without a word.
 std::vector<std::string> splitList(const std::string& s) {
   std::vector<std::string> out;
   std::stringstream ss(s);
   std::string t;
-  while (std::getline(ss, t, ','))
-    if (!t.empty()) out.push_back(t);
+  while (std::getline(ss, t, ',')) out.push_back(t);
+  if (!s.empty() && s.back() == ',') out.emplace_back();
+  for (const auto& c : out)
+    if (c.empty())
+      throw navimpact::Error("'" + navimpact::printable(s, 60) +
+                             "' has an empty entry (expected channel names separated by commas, e.g. gyro_x,acc_z)");
   return out;
 }
 
@@ -73,19 +80,28 @@ navimpact::cli::Registrar reg({
     [](CLI::App& app) {
       auto o = std::make_shared<Opts>();
       navimpact::cli::addInputOptions(app, o->in);
-      app.add_option("--channels", o->channels, "comma-separated channels to fit (default: all in the file)");
+      app.add_option("--channels", o->channels, "comma-separated channels to fit (default: all in the file)")
+          ->check(navimpact::cli::parsedBy([](const std::string& v) { splitList(v); }, "NAMES"));
       app.add_option("--structure", o->fit.structure,
                      "model structure for every channel, e.g. WN+GM+GM+DR, or 'auto' (WIC selection)")
           ->required();
       app.add_option("--max-gm", o->fit.max_gm, "auto: largest number of GM terms among the candidates (0..3)")
           ->check(navimpact::cli::within({0.0, 3.0, false, ""}));
-      app.add_option("--bootstrap", o->fit.bootstrap, "parametric bootstrap replicates for the intervals (0: asymptotic; at most 10000)")
+      auto* bootstrap = app.add_option("--bootstrap", o->fit.bootstrap, "parametric bootstrap replicates for the intervals (0: asymptotic; at most 10000)")
           ->check(navimpact::cli::within({0.0, 10000.0, false, ""}));
       app.add_flag("--allow-large", o->fit.allow_large,
                    "bootstrap above the simulated-sample budget (README \"Ranges and budgets\")");
-      app.add_option("--intervals", o->fit.intervals,
+      auto* intervals = app.add_option("--intervals", o->fit.intervals,
                      "95 % intervals without --bootstrap: profile (default; follows the objective along "
-                     "GM/RW ridges) or asymptotic (delta method)");
+                     "GM/RW ridges) or asymptotic (delta method)")
+          ->check(CLI::IsMember({"profile", "asymptotic"}));
+      // --intervals with a bootstrap was ignored without a word (the bootstrap's
+      // percentile intervals were written); one of the two, as the help says
+      app.parse_complete_callback([o, bootstrap, intervals]() {
+        if (intervals->count() > 0 && bootstrap->count() > 0 && o->fit.bootstrap > 0)
+          throw CLI::ValidationError("--intervals", "applies without --bootstrap (a bootstrap gives its own percentile "
+                                                    "intervals); drop one of the two");
+      });
       app.add_option("--weights", o->fit.weights,
                      "GMWM weights: r (default, the R package's 1/(CI_hi-CI_lo)^2), model (iterated "
                      "model-based diagonal) or efficient (inverse of the full WV covariance)")
@@ -93,9 +109,9 @@ navimpact::cli::Registrar reg({
       auto* robust = app.add_flag("--robust", o->fit.robust,
                    "robust GMWM: replace isolated spikes, then fit the robust WV (Tukey biweight M-scale, "
                    "Guerrier, Molinari & Victoria-Feser 2014) with its own CI and weights; for records with outliers");
-      app.add_option("--eff", o->fit.eff, "--robust: efficiency of the robust WV at the Gaussian, in (0, 1)")
+      app.add_option("--eff", o->fit.eff, "--robust: efficiency of the robust WV at the Gaussian, in [0.0124, 0.99998]")
           ->capture_default_str()
-          ->check(navimpact::cli::within({0.0, 1.0, true, ""}, true))
+          ->check(navimpact::cli::robustEfficiency())
           ->needs(robust);
       app.add_option("--seed", o->fit.seed, "seed of the bootstrap")->check(navimpact::cli::seedValue());
       app.add_option("--out", o->out, "output directory (model.yaml, fit.json, fit_*.png)")->required();

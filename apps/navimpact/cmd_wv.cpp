@@ -58,12 +58,13 @@ navimpact::cli::Registrar reg({"wv",
                                [](CLI::App& app) {
                                  auto o = std::make_shared<Opts>();
                                  navimpact::cli::addInputOptions(app, o->in);
-                                 app.add_flag("--robust", o->robust,
+                                 auto* robust = app.add_flag("--robust", o->robust,
                                               "robust WV (Tukey biweight M-estimator of scale)");
                                  app.add_option("--eff", o->eff,
-                                                "efficiency of the robust estimator, in (0, 1)")
+                                                "--robust: efficiency of the robust estimator at the Gaussian, in [0.0124, 0.99998]")
                                      ->capture_default_str()
-                                     ->check(navimpact::cli::within({0.0, 1.0, true, ""}, true));
+                                     ->check(navimpact::cli::robustEfficiency())
+                                     ->needs(robust);
                                  app.add_flag("--allan", o->allan,
                                               "also write overlapping Allan deviations");
                                  app.add_option("--out", o->out, "output directory")->required();

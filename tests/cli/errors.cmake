@@ -141,7 +141,7 @@ foreach(_case
     "rate_nan|wv|--input|${_x}|--rate|nan|^navimpact: --rate: must be in \\[1, 10000\\] Hz, got nan \\(see 'navimpact wv --help'\\)$"
     "rate_huge|fit|--input|${_x}|--structure|WN|--rate|1e308|--rate: must be in \\[1, 10000\\] Hz, got 1e308"
     "convert_rate|model|convert|${_m}:ref|--rate|1e308|--rate: must be in \\[1, 10000\\] Hz"
-    "eff|wv|--input|${_x}|--rate|100|--robust|--eff|1|--eff: must be in \\(0, 1\\), got 1"
+    "eff|wv|--input|${_x}|--rate|100|--robust|--eff|1|--eff: robust wavelet variance: efficiency 1 is outside what the biweight reaches"
     "seed_negative|study|--config|${_study}|--seed|-1|--seed: must be an integer seed in 0..18446744073709551615, got '-1'"
     "runs_negative|study|--config|${_study}|--runs|-1|--runs: .*not in range 1 to 1000000"
     "propagate_zero|replay|--rawlog|${_r}|--propagate-every|0|--propagate-every: .*not in range 1 to 1000"
@@ -154,8 +154,9 @@ foreach(_case
   list(REMOVE_AT _args -1)
   navimpact_cli_fail(cli_error_flag_${_n} EXIT 2 ARGS ${_args} --out ${_erd}/flag_${_n} REGEX "${_re}" NOOUT ${_erd}/flag_${_n})
 endforeach()
-# robust WV efficiency outside what the biweight reaches: the range, not the solver's exception (exit 4 before)
-navimpact_cli_fail(cli_error_eff_unreachable EXIT 1 ARGS wv --input ${_x} --rate 100 --gyro-unit deg/s --acc-unit g --robust --eff 1e-308 --out ${_erd}/eff
+# robust WV efficiency outside what the biweight reaches: the range, not the solver's
+# exception (exit 4 before), as a flag error before the file is read (exit 1 after it before)
+navimpact_cli_fail(cli_error_eff_unreachable EXIT 2 ARGS wv --input ${_x} --rate 100 --gyro-unit deg/s --acc-unit g --robust --eff 1e-308 --out ${_erd}/eff
   REGEX "efficiency 1e-308 is outside what the biweight reaches \\(0.01237 .. 0.999985" NOOUT ${_erd}/eff)
 # a model amplitude beyond any IMU (model show printed an ARW of inf), and an
 # emulation whose samples no reader would take back (replay refused its rawlog)

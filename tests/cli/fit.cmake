@@ -148,3 +148,24 @@ navimpact_cli_fail(cli_fit_bootstrap_range EXIT 2
 navimpact_cli_fail(cli_fit_channel_twice
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --channels gyro_x,gyro_x --out ${_fdir}/twice
   REGEX "^navimpact: --channels: 'gyro_x' is listed twice$" NOOUT ${_fdir}/twice)
+# flags that were ignored without a word: an empty channel entry (fitted every
+# channel), --intervals beside a bootstrap (its percentile intervals were
+# written), an unknown --intervals (exit 1 after reading), an --eff the biweight
+# does not reach (failed after reading, blaming the file)
+navimpact_cli_fail(cli_fit_channels_empty_entry EXIT 2
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --channels , --out ${_fdir}/empty_ch
+  REGEX "^navimpact: --channels: ',' has an empty entry \\(expected channel names separated by commas, e.g. gyro_x,acc_z\\) \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/empty_ch)
+navimpact_cli_fail(cli_fit_intervals_with_bootstrap EXIT 2
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --intervals asymptotic --bootstrap 5 --out ${_fdir}/int_boot
+  REGEX "^navimpact: --intervals: applies without --bootstrap .* \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/int_boot)
+navimpact_cli_fail(cli_fit_intervals_unknown EXIT 2
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --intervals foo --out ${_fdir}/int_foo
+  REGEX "^navimpact: --intervals: foo not in {profile,asymptotic} \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/int_foo)
+navimpact_cli_fail(cli_fit_eff_unreachable EXIT 2
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --robust --eff 0.001 --out ${_fdir}/eff_low
+  REGEX "^navimpact: --eff: robust wavelet variance: efficiency 0\\.001 is outside what the biweight reaches" NOOUT ${_fdir}/eff_low)
+# --bootstrap 0 with --intervals is the asymptotic path, not a conflict
+add_test(NAME cli_fit_intervals_bootstrap_zero
+  COMMAND ${NI} fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --channels gyro_x
+          --bootstrap 0 --intervals asymptotic --out ${_fdir}/int_b0 --overwrite)
+set_tests_properties(cli_fit_intervals_bootstrap_zero PROPERTIES PASS_REGULAR_EXPRESSION "gyro_x: WN\\(sigma=")

@@ -109,8 +109,11 @@ void checkRecordingFitOptions(const RecordingFitOptions& opt) {
   if (opt.bootstrap < 0 || opt.bootstrap > kMaxBootstrap)
     throw Error("--bootstrap must be in [0, " + std::to_string(kMaxBootstrap) + "], got " + std::to_string(opt.bootstrap));
   if (opt.max_gm < 0 || opt.max_gm > 3) throw Error("--max-gm must be in 0..3");
-  if (!(opt.eff > 0.0 && opt.eff < 1.0))
-    throw Error("--eff must be in (0, 1), got " + formatNumber(opt.eff));
+  try {
+    checkRobustEfficiency(opt.eff);
+  } catch (const Error& e) {
+    throw Error(std::string("--eff: ") + e.what());
+  }
   weightingOf(opt.weights);
   intervalsOf(opt.intervals);
   for (std::size_t i = 0; i < opt.channels.size(); ++i) {

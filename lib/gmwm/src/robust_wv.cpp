@@ -58,18 +58,14 @@ double biweightEfficiency(double c) {
   return 0.5 * m * m / q;
 }
 
+constexpr double kTuningLo = 0.05, kTuningHi = 60.0;  // bracket of the tuning constant c
+
 /// Tuning constant c with biweightEfficiency(c) = eff (eff increases with c).
 double biweightConstant(double eff) {
-  double lo = 0.05, hi = 60.0;
+  checkRobustEfficiency(eff);  // an efficiency the bracket does not reach is an input error, not the solver's exception
   boost::uintmax_t it = 200;
   auto f = [eff](double c) { return biweightEfficiency(c) - eff; };
-  // an efficiency the bracket does not reach is an input error, not the
-  // solver's exception (--eff 1e-308 ended in an internal error)
-  if (!(f(lo) <= 0.0 && f(hi) >= 0.0))
-    throw Error("robust wavelet variance: efficiency " + formatNumber(eff) + " is outside what the biweight reaches (" +
-                formatNumber(biweightEfficiency(lo), 4) + " .. " + formatNumber(biweightEfficiency(hi), 6) +
-                ", tuning constants 0.05 .. 60)");
-  auto r = boost::math::tools::toms748_solve(f, lo, hi, boost::math::tools::eps_tolerance<double>(50), it);
+  auto r = boost::math::tools::toms748_solve(f, kTuningLo, kTuningHi, boost::math::tools::eps_tolerance<double>(50), it);
   return 0.5 * (r.first + r.second);
 }
 
@@ -85,6 +81,13 @@ double scaleEquation(const double* x, std::size_t m, double t, double c, double 
 }
 
 }  // namespace
+
+void checkRobustEfficiency(double eff) {
+  static const double lo = biweightEfficiency(kTuningLo), hi = biweightEfficiency(kTuningHi);
+  if (!(eff >= lo && eff <= hi))
+    throw Error("robust wavelet variance: efficiency " + formatNumber(eff, 10) + " is outside what the biweight reaches (" +
+                formatNumber(lo, 4) + " .. " + formatNumber(hi, 6) + ", tuning constants 0.05 .. 60)");
+}
 
 namespace detail {
 

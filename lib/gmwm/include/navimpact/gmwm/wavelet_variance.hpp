@@ -73,6 +73,15 @@ WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rat
                                       double eff = 0.6, double alpha = 0.05);
 
 /**
+ * The efficiencies the biweight reaches with tuning constants c in
+ * [0.05, 60] (about 0.0124 .. 0.999985): what robustWaveletVariance accepts.
+ * @throws navimpact::Error "efficiency E is outside what the biweight reaches
+ *         (lo .. hi)" for any other @p eff (NaN included); a CLI checks --eff
+ *         with it before reading a file.
+ */
+void checkRobustEfficiency(double eff);
+
+/**
  * Replace isolated spikes in place, before a robust WV: the second difference
  * d_k = x_k - (x_{k-1} + x_{k+1}) / 2 against its robust scale (1.4826 x the
  * median absolute deviation, taken once), Bonferroni over the n - 2 samples
