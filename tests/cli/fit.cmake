@@ -145,6 +145,11 @@ navimpact_cli_check(cli_fit_auto_quiet CHECK run_json
 navimpact_cli_fail(cli_fit_bootstrap_range EXIT 2
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --bootstrap 1000000000 --out ${_fdir}/boot
   REGEX "^navimpact: --bootstrap: must be in \\[0, 10000\\], got 1000000000 \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/boot)
+# a "95 %" percentile interval from 5 replicates was nearly their range and
+# could exclude the estimate: 0 or at least 39 ((N + 1) * 0.025 >= 1)
+navimpact_cli_fail(cli_fit_bootstrap_too_few EXIT 2
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --bootstrap 5 --out ${_fdir}/boot5
+  REGEX "^navimpact: --bootstrap: must be 0 or at least 39 \\(a 95 % percentile interval needs \\(N \\+ 1\\) \\* 0.025 >= 1\\), got 5 \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/boot5)
 navimpact_cli_fail(cli_fit_channel_twice
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --channels gyro_x,gyro_x --out ${_fdir}/twice
   REGEX "^navimpact: --channels: 'gyro_x' is listed twice$" NOOUT ${_fdir}/twice)
@@ -156,7 +161,7 @@ navimpact_cli_fail(cli_fit_channels_empty_entry EXIT 2
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --channels , --out ${_fdir}/empty_ch
   REGEX "^navimpact: --channels: ',' has an empty entry \\(expected channel names separated by commas, e.g. gyro_x,acc_z\\) \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/empty_ch)
 navimpact_cli_fail(cli_fit_intervals_with_bootstrap EXIT 2
-  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --intervals asymptotic --bootstrap 5 --out ${_fdir}/int_boot
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --intervals asymptotic --bootstrap 40 --out ${_fdir}/int_boot
   REGEX "^navimpact: --intervals: applies without --bootstrap .* \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/int_boot)
 navimpact_cli_fail(cli_fit_intervals_unknown EXIT 2
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --intervals foo --out ${_fdir}/int_foo

@@ -221,6 +221,8 @@ TEST(RecordingFit, BadOptionsAreRefusedBeforeAnyData) {
   o = {};
   o.bootstrap = -1;
   EXPECT_NE(msg(o).find("--bootstrap"), std::string::npos);
+  o.bootstrap = 5;  // fewer than a 95 % percentile interval needs
+  EXPECT_NE(msg(o).find("--bootstrap must be 0 or at least 39"), std::string::npos) << msg(o);
   o = {};
   o.channels = {"gyro_w"};
   EXPECT_NE(msg(o).find("'gyro_w'"), std::string::npos);

@@ -525,12 +525,12 @@ TEST(GmwmFit, BootstrapIntervalsAreSeeded) {
   truth.terms = {Process::wn(0.01), Process::gm(0.003, 2.0)};
   const auto wv = simulatedWv(truth, 1u << 16, 7);
   gmwm::FitOptions o;
-  o.bootstrap = 20;
+  o.bootstrap = gmwm::kMinBootstrap;
   o.seed = 99;
   const auto a = gmwm::fit(kinds(truth), wv, o);
   const auto b = gmwm::fit(kinds(truth), wv, o);
   const auto asym = gmwm::fit(kinds(truth), wv);
-  EXPECT_EQ(a.ci_method, "bootstrap(20)");
+  EXPECT_EQ(a.ci_method, "bootstrap(39)");
   EXPECT_EQ(asym.ci_method, "asymptotic");
   for (std::size_t i = 0; i < a.ci.size(); ++i)
     for (std::size_t k = 0; k < a.ci[i].size(); ++k) {
@@ -544,6 +544,10 @@ TEST(GmwmFit, BootstrapIntervalsAreSeeded) {
   o.seed = 100;
   const auto c = gmwm::fit(kinds(truth), wv, o);
   EXPECT_NE(a.ci[1][1].low, c.ci[1][1].low);  // another seed, another bootstrap sample
+  // fewer replicates than a 95 % percentile interval needs: refused, not a
+  // "95 %" interval that is nearly the range of a handful of values
+  o.bootstrap = gmwm::kMinBootstrap - 1;
+  EXPECT_THROW(gmwm::fit(kinds(truth), wv, o), navimpact::Error);
 }
 
 namespace {

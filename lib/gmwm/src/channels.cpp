@@ -108,6 +108,9 @@ void checkRecordingFitOptions(const RecordingFitOptions& opt) {
   if (opt.structure != "auto") stochastic::parseStructure(opt.structure);
   if (opt.bootstrap < 0 || opt.bootstrap > kMaxBootstrap)
     throw Error("--bootstrap must be in [0, " + std::to_string(kMaxBootstrap) + "], got " + std::to_string(opt.bootstrap));
+  if (opt.bootstrap > 0 && opt.bootstrap < kMinBootstrap)
+    throw Error("--bootstrap must be 0 or at least " + std::to_string(kMinBootstrap) +
+                " (a 95 % percentile interval needs (N + 1) * 0.025 >= 1), got " + std::to_string(opt.bootstrap));
   if (opt.max_gm < 0 || opt.max_gm > 3) throw Error("--max-gm must be in 0..3");
   try {
     checkRobustEfficiency(opt.eff);

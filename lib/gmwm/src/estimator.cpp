@@ -1097,6 +1097,9 @@ FitResult fit(const std::vector<ProcessKind>& structure, const WaveletVariance& 
     // recompute the WV, refit from theta_hat; percentile interval.
     const std::size_t n = wv.n;
     if (n < 4) throw Error("GMWM bootstrap: the wavelet variance does not record its sample count");
+    if (opt.bootstrap < kMinBootstrap)
+      throw Error("GMWM bootstrap: " + std::to_string(opt.bootstrap) + " replicates give no 95 % percentile interval (at least " +
+                  std::to_string(kMinBootstrap) + ")");
     std::vector<Eigen::VectorXd> reps;
     for (int b = 0; b < opt.bootstrap; ++b) {
       const std::vector<double> x =

@@ -59,7 +59,7 @@ struct RecordingFitOptions {
   /// of the record with its isolated spikes replaced first (despike()).
   bool robust = false;
   double eff = 0.6;                   ///< robust: efficiency of the robust WV, in (0, 1)
-  int bootstrap = 0;                  ///< parametric bootstrap replicates, [0, 10000]
+  int bootstrap = 0;                  ///< parametric bootstrap replicates, 0 or [kMinBootstrap (39), 10000]
   std::uint64_t seed = 20190101;      ///< root seed; channel c uses deriveSeed(seed, channelIndex(c))
   bool allow_large = false;           ///< bootstrap above the simulated-sample budget (limits.hpp)
 };
