@@ -21,6 +21,11 @@ navimpact_cli_check(cli_reproducible_diagnose CHECK reproducible
   ARGS diagnose --input ${CMAKE_SOURCE_DIR}/datasets/adis16405_static_excerpt.csv.gz --rate 100 --gyro-unit deg/s
        --acc-unit g --model fit:WN --trajectory ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s.csv.gz
        --outage 200:60 --nav-runs 4 --out @OUT@)
+# without a trajectory too (it wrote no timing.json then; its wall time is there now)
+navimpact_cli_check(cli_reproducible_diagnose_no_trajectory CHECK reproducible
+  DEFINES W=${_rep}/diagnose_no_trajectory
+  ARGS diagnose --input ${CMAKE_SOURCE_DIR}/datasets/adis16405_static_excerpt.csv.gz --rate 100 --gyro-unit deg/s
+       --acc-unit g --model fit:WN --end 600 --simulations 2 --out @OUT@)
 navimpact_cli_check(cli_reproducible_diagnose_run CHECK reproducible
   DEFINES W=${_rep}/diagnose_run
   ARGS diagnose --run ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -516,6 +517,7 @@ Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
         throw Error(data.source + ": channel " + c.name + ": sample " + std::to_string(k) +
                     " is not finite");
   }
+  const auto t0 = std::chrono::steady_clock::now();
   Diagnosis d;
   d.source = data.source;
   d.rate_hz = data.rate_hz;
@@ -549,6 +551,7 @@ Diagnosis diagnose(const ImuSeries& data, const stochastic::ImuModel& model,
   }
   d.model_after.source = "diagnose";
   groupEvents(d);
+  d.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return d;
 }
 

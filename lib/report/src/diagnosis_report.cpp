@@ -606,9 +606,10 @@ std::size_t writeDiagnosisOutputs(const Diagnosis& d, const std::string& input_j
   out.writeText("diagnosis.json", diagnosisJson(d, input_json));
   out.writeText("report.md", diagnosisReport(d, figs));
   out.writeText("model_extended.yaml", stochastic::toYaml(d.model_after, model_comment));
-  if (d.navigation) {  // wall-clock figures apart, so that two identical runs give identical result files
-    writeTiming(out, {{"navigation_wall_s", d.navigation->wall_s}});
-  }
+  // wall-clock figures apart, so that two identical runs give identical result files
+  nlohmann::json timing = {{"diagnosis_wall_s", d.wall_s}};
+  if (d.navigation) timing["navigation_wall_s"] = d.navigation->wall_s;
+  writeTiming(out, timing);
   return figs.size();
 }
 

@@ -327,6 +327,7 @@ struct Diagnosis {
   std::vector<Event> events;          ///< events on two or more channels at once
   DiagnoseOptions options;
   std::optional<NavGain> navigation;  ///< with a trajectory (addNavigationGain)
+  double wall_s = 0;                  ///< wall time of diagnose() (timing.json only: never in a result file)
 };
 
 /**
