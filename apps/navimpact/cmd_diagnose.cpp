@@ -189,7 +189,7 @@ int run(const Opts& o) {
                        {"simulations", o.simulations},
                        {"alpha", o.alpha}};
   if (fmt == navimpact::cli::InputFormat::Rawlog) in["label"] = o.in.label;
-  in.update(navimpact::cli::inputSelectionJson(o.in));
+  in.update(navimpact::cli::inputSelectionJson(o.in, data));
   if (o.robust) {
     in["robust"] = true;
     in["eff"] = o.eff;

@@ -65,7 +65,7 @@ int run(Opts o) {
                                 {"units", navimpact::cli::inputUnitsNote(o.in, fmt)},
                                 {"axes", o.in.axes},
                                 {"label", o.in.label}};
-  input.update(navimpact::cli::inputSelectionJson(o.in));
+  input.update(navimpact::cli::inputSelectionJson(o.in, s));
   navimpact::report::writeFitOutputs(f, input.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), NAVIMPACT_VERSION, outs);
   outs.commit();
 

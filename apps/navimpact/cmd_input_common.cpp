@@ -107,9 +107,9 @@ ImuSeries loadInput(const InputOpts& o, InputFormat* format) {
   return window(std::move(s));
 }
 
-nlohmann::json inputSelectionJson(const InputOpts& o) {
+nlohmann::json inputSelectionJson(const InputOpts& o, const ImuSeries& s) {
   nlohmann::json j = nlohmann::json::object();
-  if (!o.time_column.empty()) j["time_column"] = o.time_column;
+  if (!s.time_column.empty()) j["time_column"] = s.time_column;
   if (o.start_s) j["start_s"] = *o.start_s;
   if (o.end_s) j["end_s"] = *o.end_s;
   return j;

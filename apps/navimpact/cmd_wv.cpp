@@ -41,7 +41,7 @@ int run(const Opts& o) {
                                         {"rate_hz", s.rate_hz},
                                         {"samples", s.size()},
                                         {"units", navimpact::cli::inputUnitsNote(o.in, fmt)}};
-  const nlohmann::json selection = navimpact::cli::inputSelectionJson(o.in);  // (items() of a temporary dangles)
+  const nlohmann::json selection = navimpact::cli::inputSelectionJson(o.in, s);  // (items() of a temporary dangles)
   for (const auto& [k, v] : selection.items()) input[k] = v;
   navimpact::report::writeWvOutputs(w, input.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), outs);
   outs.commit();

@@ -46,7 +46,9 @@ ImuSeries loadInput(const InputOpts& o, InputFormat* format = nullptr);
 std::string inputUnitsNote(const InputOpts& o, InputFormat f);
 
 /// The input options that select data (time column, window) as JSON members
-/// for the commands' "input" records: time_column, start_s, end_s when given.
-nlohmann::json inputSelectionJson(const InputOpts& o);
+/// for the commands' "input" records: time_column (the one read, the default
+/// t/time_s/time included: it was left out unless --time-column was given),
+/// start_s, end_s when given.
+nlohmann::json inputSelectionJson(const InputOpts& o, const ImuSeries& s);
 
 }  // namespace navimpact::cli

@@ -121,6 +121,13 @@ navimpact_cli_check(cli_fit_time_column CHECK run_json
   DEFINES OUT=${_fdir}/tcol JSON_FILE=fit.json
   JSON "input/rate_hz=^200(\\.0*)?$" "input/samples=^4200$" "input/time_column=^stamp$"
   FILES model.yaml)
+# the default time column is recorded too (it was left out without --time-column)
+string(REPLACE "t,stamp,gyro_x" "n,time_s,gyro_x" _tcsv_default "${_tcsv}")
+file(WRITE ${_fdir}/time_s.csv "${_tcsv_default}")
+navimpact_cli_check(cli_fit_time_column_default CHECK run_json
+  ARGS fit --input ${_fdir}/time_s.csv --structure WN --out ${_fdir}/tcol_default
+  DEFINES OUT=${_fdir}/tcol_default JSON_FILE=fit.json
+  JSON "input/rate_hz=^200(\\.0*)?$" "input/time_column=^time_s$")
 
 # Robust GMWM: the estimator is recorded; --eff needs --robust.
 navimpact_cli_check(cli_fit_robust CHECK run_json

@@ -68,6 +68,7 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
   const auto names = splitView(header, ',');
   std::vector<Column> cols(names.size());
   int timeCol = -1;
+  std::string timeName;
   int present[6] = {-1, -1, -1, -1, -1, -1};
   for (std::size_t c = 0; c < names.size(); ++c) {
     std::string_view n = trim(names[c]);
@@ -88,6 +89,7 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
                                      "': a second time column (the first is column " + std::to_string(timeCol + 1) +
                                      ")");
       timeCol = static_cast<int>(c);
+      timeName = name;
       cols[c].channel = -2;
       continue;
     }
@@ -229,6 +231,7 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
                                    " Hz disagrees with the time column (" + formatNumber(rate) + " Hz)");
     out.rate_hz = opt.rate_hz ? *opt.rate_hz : rate;
     out.t0_s = times[0];
+    out.time_column = timeName;
   } else {
     if (!opt.rate_hz)
       throw fileError(path, 1, "no time column (t, time_s, time or --time-column NAME): the sampling rate must be given (--rate HZ)");

@@ -47,6 +47,9 @@ struct ImuSeries {
   std::string source;            ///< where it came from (file path), for messages
   double rate_hz = 0.0;          ///< sampling rate [Hz], > 0
   double t0_s = 0.0;             ///< time of the first sample [s]
+  /// CSV: the header name of the time column read ("" when the rate was given
+  /// instead), recorded in the commands' "input" (t, time_s or time by default).
+  std::string time_column;
   std::vector<ImuChannel> channels;
 
   std::size_t size() const { return channels.empty() ? 0 : channels.front().x.size(); }
