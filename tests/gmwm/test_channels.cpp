@@ -196,6 +196,69 @@ TEST(WhiteNoiseNote, NamesShortGmsAndAVanishedWn) {
   EXPECT_THROW(gmwm::whiteNoiseNote(m, {}), Error);
 }
 
+// slowGmNote: a GM with T beyond the record, seen by the data, is a random walk
+// over it, RW(gamma = sigma sqrt(1 - phi^2)), when the two WVs differ by less
+// than 0.1 CI width. Over the record GM and RW WVs differ by about v (T_rec/T)
+// times 0.1 CI width for a GM of visibility v (its WV at the longest scale in
+// units of 0.1 CI width; measured: the note starts near T = 7 v records), so
+// T >= 20 v records must give the note naming that gamma and T <= 2 v records
+// must not. T drawn log-uniformly over [1, 1000] records (the fit's bound), v
+// over [1, 100] (seeded, printed). T below the record, or a GM the data cannot
+// see: no note.
+TEST(SlowGmNote, AGmBeyondTheRecordIsNamedAsItsRandomWalk) {
+  std::mt19937_64 g(2718);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto logU = [&](double lo, double hi) { return lo * std::pow(hi / lo, u(g)); };
+  stochastic::Model data;
+  data.rate_hz = 100.0;
+  data.terms = {Process::wn(1e-3), Process::rw(1e-6)};
+  const std::size_t n = std::size_t{1} << 15;
+  const std::vector<double> x = stochastic::simulate(data, n, 99);
+  const gmwm::WaveletVariance wv = gmwm::waveletVariance(x.data(), n, data.rate_hz);
+  const int J = wv.scales() - 1;
+  const double record_s = n / data.rate_hz;
+  const double width = wv.ci_high[J] - wv.ci_low[J];
+  int named = 0, kept_apart = 0;
+  for (int r = 0; r < 60; ++r) {
+    const bool beyond = r % 3 != 0;
+    const double T = record_s * (beyond ? logU(1.0, 1000.0) : logU(0.01, 0.99));
+    const double visible = logU(1.0, 100.0);
+    // gamma^2 from the RW's WV at the longest scale (linear in gamma^2)
+    const double g2 = visible * gmwm::kNegligibleFraction * width /
+                      stochastic::haarWv(Process::rw(1.0), data.rate_hz, wv.tau[J]);
+    const double sigma = std::sqrt(g2 / -std::expm1(-2.0 / (data.rate_hz * T)));
+    stochastic::Model m;
+    m.rate_hz = data.rate_hz;
+    m.terms = {Process::wn(1e-3), Process::gm(sigma, T)};
+    const std::string note = gmwm::slowGmNote(m, wv);
+    std::printf("case %d: T = %.3g records, %.3g x 0.1 CI width: %s\n", r, T / record_s, visible,
+                note.empty() ? "no note" : "note");
+    if (beyond && T >= 20.0 * visible * record_s) {
+      ++named;
+      char rw[64];
+      std::snprintf(rw, sizeof rw, "RW(gamma=%.3g)", std::sqrt(g2));
+      EXPECT_NE(note.find("GM 1 (T = "), std::string::npos) << note;
+      EXPECT_NE(note.find(rw), std::string::npos) << note << " / " << rw;
+      EXPECT_NE(note.find("is a random walk over this record"), std::string::npos) << note;
+      EXPECT_EQ(note.find("upper bound"), std::string::npos) << note;
+    } else if (!beyond || T <= 2.0 * visible * record_s) {
+      ++kept_apart;
+      EXPECT_EQ(note, "") << "T = " << T;
+    }
+    m.terms[1].sigma = sigma * 1e-3;  // a millionth of the WV: the data cannot see it
+    EXPECT_EQ(gmwm::slowGmNote(m, wv), "");
+  }
+  std::printf("%d cases named, %d kept apart, the rest between\n", named, kept_apart);
+  EXPECT_GE(named, 5);
+  EXPECT_GE(kept_apart, 25);
+  // on the fit's bound the note says so (a visible GM there: its increments as the data's RW)
+  stochastic::Model m;
+  m.rate_hz = data.rate_hz;
+  const double T = 1000.0 * record_s;
+  m.terms = {Process::wn(1e-3), Process::gm(1e-6 / std::sqrt(-std::expm1(-2.0 / (data.rate_hz * T))), T)};
+  EXPECT_NE(gmwm::slowGmNote(m, wv).find("the fit's upper bound"), std::string::npos) << gmwm::slowGmNote(m, wv);
+}
+
 TEST(RecordingFit, BadOptionsAreRefusedBeforeAnyData) {
   auto msg = [](gmwm::RecordingFitOptions o) {
     try {

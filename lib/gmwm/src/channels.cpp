@@ -10,6 +10,7 @@
 #include "navimpact/stochastic/datasheet.hpp"
 #include "navimpact/stochastic/model_text.hpp"
 #include "navimpact/stochastic/simulate.hpp"
+#include "navimpact/stochastic/theoretical_wv.hpp"
 
 namespace navimpact::gmwm {
 
@@ -97,6 +98,40 @@ std::string whiteNoiseNote(const stochastic::Model& m, const std::vector<bool>& 
   if (has_wn && wn_gone) os << ", the WN term is negligible";
   os << "; the ARW/VRW includes it, and a filter whose covariance step is longer than its T enters it as "
         "white noise of its long-run variance";
+  return os.str();
+}
+
+std::string slowGmNote(const stochastic::Model& m, const WaveletVariance& wv) {
+  const double record_s = static_cast<double>(wv.n) / m.rate_hz;
+  const double bound_s = 1000.0 * record_s;  // the estimator's upper bound on T (estimator.cpp)
+  std::ostringstream os, sig;
+  os.precision(3);
+  sig.precision(3);
+  int gm = 0, k = 0;
+  for (const auto& t : m.terms) {
+    if (t.kind != stochastic::ProcessKind::GM) continue;
+    ++gm;
+    if (!(t.T >= record_s) || wv.scales() == 0) continue;
+    // a GM's increment per sample, sqrt(1 - phi^2) sigma, is the equivalent RW's gamma
+    const double gamma = t.sigma * std::sqrt(-std::expm1(-2.0 / (m.rate_hz * t.T)));
+    const stochastic::Process rw = stochastic::Process::rw(gamma);
+    bool same = true, visible = false;  // a GM the data cannot see at all is negligible, not a walk
+    for (int j = 0; same && j < wv.scales(); ++j) {
+      const double w = kNegligibleFraction * (wv.ci_high[j] - wv.ci_low[j]);
+      const double g = stochastic::haarWv(t, m.rate_hz, wv.tau[j]);
+      same = std::abs(g - stochastic::haarWv(rw, m.rate_hz, wv.tau[j])) < w;
+      visible = visible || g >= w;
+    }
+    if (!same || !visible) continue;
+    os << (k ? ", " : "") << "GM " << gm << " (T = " << t.T << " s = " << t.T / record_s << " records"
+       << (t.T >= 0.999 * bound_s ? ", the fit's upper bound" : "") << ": RW(gamma=" << gamma << "))";
+    sig << (k++ ? ", " : "") << t.sigma;
+  }
+  if (k == 0) return "";
+  os << (k == 1 ? " is a random walk" : " are random walks")
+     << " over this record (WV within " << kNegligibleFraction
+     << " of the WV's 95 % CI width of that RW at every scale): the data fix sigma^2/T, not sigma (" << sig.str()
+     << "), which a filter takes as the initial uncertainty; RW in the structure says what the data show";
   return os.str();
 }
 
@@ -203,6 +238,7 @@ RecordingFit fitRecording(const ImuSeries& s, const RecordingFitOptions& opt,
     c.negligible = negligibleTerms(c.fit.model, c.wv);
     c.outside_ci = scalesOutsideCi(c.fit.model, c.wv);
     c.white_noise_note = whiteNoiseNote(c.fit.model, c.negligible);
+    c.slow_gm_note = slowGmNote(c.fit.model, c.wv);
     if (progress) progress(i + 1, chans.size());
   }
 

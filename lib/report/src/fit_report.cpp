@@ -156,6 +156,7 @@ std::string fitJson(const gm::RecordingFit& f, const std::string& input_json) {
     json warnings = json::array();
     if (outsideCiBeyondChance(c)) warnings.push_back(outsideCiText(c));
     if (!c.white_noise_note.empty()) warnings.push_back(c.white_noise_note);
+    if (!c.slow_gm_note.empty()) warnings.push_back(c.slow_gm_note);
     cj["warnings"] = warnings;
     if (autoSel) {
       json sel = json::array();
@@ -224,6 +225,8 @@ void writeFitOutputs(const gm::RecordingFit& f, const std::string& input_json,
   std::ostringstream comment;
   comment << "GMWM fit by navimpact " << version << " of " << f.source << ", structure "
           << structureText(f) << ", seed " << f.options.seed;
+  for (const auto& c : f.channels)  // what model.yaml alone would not say
+    if (!c.slow_gm_note.empty()) comment << "\nnote, " << c.name << ": " << c.slow_gm_note;
   out.writeText("model.yaml", st::toYaml(f.model, comment.str()));
   out.writeText("fit.json", fitJson(f, input_json));
   for (int sensor = 0; sensor < 2; ++sensor) {
@@ -263,6 +266,7 @@ std::string fitSummary(const gm::RecordingFit& f) {
     if (!c.outside_ci.empty())
       os << "    " << (outsideCiBeyondChance(c) ? "warning: " : "note: ") << outsideCiText(c) << "\n";
     if (!c.white_noise_note.empty()) os << "    note: " << c.white_noise_note << "\n";
+    if (!c.slow_gm_note.empty()) os << "    note: " << c.slow_gm_note << "\n";
     std::istringstream lines(st::formatDatasheet(channelDatasheet(c), c.quantity));
     std::string l;
     while (std::getline(lines, l)) os << "    " << l << "\n";

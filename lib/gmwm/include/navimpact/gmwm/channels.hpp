@@ -85,6 +85,8 @@ struct ChannelFit {
   /// carry white noise: which, their lag-1 correlation, their share of the
   /// noise density, and whether the WN term vanished.
   std::string white_noise_note;
+  /// Non-empty when a GM is a random walk over this record (slowGmNote).
+  std::string slow_gm_note;
   std::vector<RankedModel> ranking;  ///< auto: every candidate, best first
   std::string why;                   ///< auto: why the pick was chosen
 };
@@ -99,6 +101,22 @@ struct ChannelFit {
  * @throws navimpact::Error when @p negligible does not have one flag per term.
  */
 std::string whiteNoiseNote(const stochastic::Model& m, const std::vector<bool>& negligible);
+
+/**
+ * What a fitted model says with a GM whose T is so long against the record that
+ * over it the GM is a random walk: for each GM with T beyond the record, seen
+ * by the data (its WV at least kNegligibleFraction of the CI width at some
+ * scale), whose Haar WV and that of
+ * RW(gamma = sigma sqrt(1 - phi^2)), phi = exp(-1/(rate T)) (the GM's
+ * increment per sample), differ by less than kNegligibleFraction of the WV's
+ * 95 % CI width at every scale of @p wv, the note names the GM, its T in s and
+ * in records (and whether it sits on the fit's upper bound, 1000 records), the
+ * equivalent RW, and that the data fix sigma^2 / T, not sigma, which a filter
+ * takes as the term's initial uncertainty. Empty when no such GM exists.
+ * (fit --structure WN+GM+GM+GM on 600 s wrote GM(sigma=0.27 m/s^2, T=6e5 s)
+ * into model.yaml without a word.)
+ */
+std::string slowGmNote(const stochastic::Model& m, const WaveletVariance& wv);
 
 /// The fits of a recording.
 struct RecordingFit {
