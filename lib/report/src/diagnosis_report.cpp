@@ -405,12 +405,28 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
     bool any = false;
     for (const auto& s : c.scales) any = any || s.outside95;
     if (any) {
-      r << "\n| tau [s] | measured WV | model WV | 95 % CI | ratio | significant |\n|---|---|---|---|---|---|\n";
-      for (const auto& s : c.scales)
-        if (s.outside95)
-          r << "| " << formatNumber(s.tau_s, 4) << " | " << formatNumber(s.measured, 3) << " | " << formatNumber(s.model, 3) << " | "
-            << formatNumber(s.ci_low, 3) << "–" << formatNumber(s.ci_high, 3) << " | " << formatNumber(s.ratio, 3) << " | "
-            << (s.significant ? "yes" : "no") << " |\n";
+      // The table is the raw record against the model before; the findings
+      // describe the cleaned record (outliers, shifts and lines taken out).
+      // Where cleaning changed the WV, its column stands beside the raw one so
+      // that a finding's "N scales outside the 95 % CI" can be read here.
+      bool cleaned = c.wv_cleaned.size() == c.scales.size();
+      bool differs = false;
+      for (std::size_t j = 0; cleaned && j < c.scales.size(); ++j)
+        differs = differs || std::abs(c.wv_cleaned[j] - c.scales[j].measured) > 1e-9 * std::abs(c.scales[j].measured);
+      cleaned = cleaned && differs;
+      if (cleaned)
+        r << "\nScales where the raw record leaves the model's 95 % CI; the findings above are on the cleaned "
+             "record (its WV beside the raw one).\n";
+      r << "\n| tau [s] | measured WV" << (cleaned ? " (raw) | cleaned WV" : "") << " | model WV | 95 % CI | ratio"
+        << (cleaned ? " (raw)" : "") << " | significant |\n|---|---|" << (cleaned ? "---|" : "") << "---|---|---|---|\n";
+      for (std::size_t j = 0; j < c.scales.size(); ++j) {
+        const auto& s = c.scales[j];
+        if (!s.outside95) continue;
+        r << "| " << formatNumber(s.tau_s, 4) << " | " << formatNumber(s.measured, 3) << " | ";
+        if (cleaned) r << formatNumber(c.wv_cleaned[j], 3) << " | ";
+        r << formatNumber(s.model, 3) << " | " << formatNumber(s.ci_low, 3) << "–" << formatNumber(s.ci_high, 3) << " | "
+          << formatNumber(s.ratio, 3) << " | " << (s.significant ? "yes" : "no") << " |\n";
+      }
     }
     r << "\n";
   }
