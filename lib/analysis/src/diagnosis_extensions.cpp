@@ -365,13 +365,28 @@ int assembledIndex(const Model& base, const std::vector<Candidate>& cs, std::siz
   return k;
 }
 
-Model merged(const Model& base, const std::vector<Candidate>& cs) {
+Model merged(const Model& base, const std::vector<Candidate>& cs, bool keep_places) {
   Model m = base;
-  for (int pass = 0; pass < 2; ++pass)
-    for (const auto& c : cs) {
-      Process p = c.proc;
-      if (c.retune == (pass == 0) && mainParam(p) > 0) m = applyCandidate(m, c);
-    }
+  // Retunes first, a retune to zero included: the model's term is not in the
+  // data (it used to be skipped, which kept the overstated term: an RW of the
+  // model retuned to 0 on the first half stayed at its old gamma there, and
+  // the held-out gain compared the model with itself).
+  std::vector<int> vanished;
+  for (const auto& c : cs) {
+    if (!c.retune) continue;
+    Process p = c.proc;
+    m = applyCandidate(m, c);
+    if (!(mainParam(p) > 0)) vanished.push_back(c.term);
+  }
+  if (!keep_places) {
+    std::sort(vanished.rbegin(), vanished.rend());
+    vanished.erase(std::unique(vanished.begin(), vanished.end()), vanished.end());
+    for (int t : vanished) m.terms.erase(m.terms.begin() + t);
+  }
+  for (const auto& c : cs) {
+    Process p = c.proc;
+    if (!c.retune && mainParam(p) > 0) m = applyCandidate(m, c);
+  }
   return m;
 }
 

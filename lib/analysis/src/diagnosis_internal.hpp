@@ -151,8 +151,11 @@ Model assemble(const Model& base, const std::vector<Candidate>& cs, int skip = -
 int assembledIndex(const Model& base, const std::vector<Candidate>& cs, std::size_t i);
 
 /// The same set as in the model file: retunes, then additions merged into a
-/// term of the same kind (applyCandidate); vanishing terms are left out.
-Model merged(const Model& base, const std::vector<Candidate>& cs);
+/// term of the same kind (applyCandidate); vanishing additions are left out,
+/// and so is a term retuned to zero unless @p keep_places (then it stays, at
+/// zero, so that retune indices still refer to base's terms; such a model is
+/// for its WV only: simulate() refuses a zero parameter).
+Model merged(const Model& base, const std::vector<Candidate>& cs, bool keep_places = false);
 
 /// AIC penalty of a set (from its term @p from on): 2 per parameter; retuning
 /// a term of the user's model discards what they had and is charged as two

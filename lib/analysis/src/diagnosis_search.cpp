@@ -589,9 +589,9 @@ void restateInJointFit(const ChannelContext& ctx, const WvCheck& w, const std::v
     std::vector<Candidate> others;
     for (std::size_t q = 0; q < S.size(); ++q)
       if (q != i) others.push_back(S[q]);
-    // The other terms as the model file has them (retune indices refer to
-    // m0n's terms, which merged() leaves in place).
-    const Model before = merged(ctx.m0n, others);
+    // The other terms as the model file has them, in m0n's places (retune
+    // indices refer to m0n's terms; one retuned to zero stays there at zero).
+    const Model before = merged(ctx.m0n, others, true);
     const auto chk_i = checkScales(w.cleaned, wvOf(before, w.tau), w.dof, w.p_thr, {}, {});
     Finding nf = broadbandFinding(cd.name, S[i], before, chk_i, w.tau, ctx.rate);
     Finding& f = cd.findings[found_at[i]];
