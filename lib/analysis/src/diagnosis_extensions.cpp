@@ -457,7 +457,10 @@ std::vector<Extension> extensions(const Model& base, const std::vector<Candidate
     for (std::size_t i = 0; i < e.terms.size(); ++i) {
       const Candidate& c = e.terms[i];
       Process p = c.proc;
-      if (!(mainParam(p) > 0)) e.why_not = "a vanishing term";
+      // an added term must be there; a model's term retuned to zero is a finding
+      // (the data show none of it: an overstated RW on white noise was named
+      // quantization noise + white noise when this was refused)
+      if (!(mainParam(p) > 0) && !c.retune) e.why_not = "a vanishing term";
       else if (c.kind == ProcessKind::GM && c.T_bottom) e.why_not = "a GM at one sample (white noise)";
       else if (i >= S.size() && c.kind == ProcessKind::GM && c.T_hi_open) {
         if (c.T_top_only) open_top = true;

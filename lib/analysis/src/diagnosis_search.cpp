@@ -123,7 +123,12 @@ Finding broadbandFinding(const std::string& ch, const Candidate& c, const Model&
   }
   if (c.kind != ProcessKind::GM && std::isfinite(c.p_lo))
     f.intervals.push_back({f.params.front().first, {c.p_lo, c.p_hi}});
-  if (c.retune) {
+  const bool absent = c.retune && !(mainParam(p) > 0);
+  if (absent) {
+    Process old = before.terms[c.term];
+    ex << "the model's " << stochastic::formatTerms({old}, 3)
+       << " is overstated: the data show none of it (its best fit is zero)";
+  } else if (c.retune) {
     Process old = before.terms[c.term];
     ex << "the model's " << stochastic::formatTerms({old}, 3) << " is "
        << (c.scale < 1 ? "overstated" : "understated") << "; the data fit "
@@ -139,7 +144,8 @@ Finding broadbandFinding(const std::string& ch, const Candidate& c, const Model&
   }
   ex << ".";
   f.explanation = ex.str();
-  f.action = c.retune ? "retune it in the model (model_extended.yaml)"
+  f.action = absent     ? "remove it from the model (model_extended.yaml leaves it out)"
+             : c.retune ? "retune it in the model (model_extended.yaml)"
                       : "add it to the model (model_extended.yaml); the filter takes it as " +
                             std::string(c.kind == ProcessKind::WN || c.kind == ProcessKind::QN
                                             ? "measurement noise"

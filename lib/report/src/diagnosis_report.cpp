@@ -225,6 +225,7 @@ std::string paramText(const Finding& f, const std::string& key, double v) {
   else if (key != "count") u = " " + unit;
   std::string name = key == "t_s" ? "t" : key == "freq_hz" ? "f" : key;
   std::string s = name + " = " + formatNumber(v, key == "t_s" || key == "freq_hz" ? 6 : 3);
+  if (v == 0 && f.direction == "overstated") return s + u + " (none in the data)";  // a model term retuned to zero
   for (const auto& kv : f.intervals)
     if (kv.first == key) {
       const std::string lo = formatNumber(kv.second.first, 2), hi = formatNumber(kv.second.second, 2);
@@ -235,6 +236,8 @@ std::string paramText(const Finding& f, const std::string& key, double v) {
 }
 
 std::string shortAction(const Finding& f) {
+  // a model term whose best fit is zero: the data show none of it
+  if (f.direction == "overstated" && !f.params.empty() && f.params.front().second == 0) return "remove the term";
   switch (f.cause) {
     case Cause::WhiteNoise:
     case Cause::QuantizationNoise: return f.direction == "overstated" ? "lower it in the model" : "raise it in the model";
