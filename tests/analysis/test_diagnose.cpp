@@ -91,6 +91,22 @@ pw::Case whiteNoiseUnderGyroRandomWalk(double gamma, std::uint64_t seed) {
   return c;
 }
 
+/// The diagnosis of whiteNoiseUnderGyroRandomWalk(gamma, data_seed) with root
+/// seed @p seed, its summary printed under "trial @p trial".
+na::Diagnosis diagnoseWhiteNoiseUnderRw(int trial, double gamma, std::uint64_t data_seed, std::uint64_t seed) {
+  const na::Diagnosis d = diagnoseCase(whiteNoiseUnderGyroRandomWalk(gamma, data_seed), seed);
+  std::printf("trial %d: gyro model WN(1e-3) + RW(gamma=%.4g) on white noise:\n%s", trial, gamma,
+              navimpact::report::diagnosisSummary(d).c_str());
+  return d;
+}
+
+/// Scales of @p ch the WV test rejects a factor 2 below the model.
+int rejectedBelowModel(const na::ChannelDiagnosis& ch) {
+  int rejected = 0;
+  for (const auto& sc : ch.scales) rejected += sc.significant && sc.ratio < 0.5 ? 1 : 0;
+  return rejected;
+}
+
 struct Tally {
   int total = 0, detected = 0, right = 0;
 };
@@ -843,14 +859,10 @@ TEST(Diagnose, AnOverstatedModelIsNeverAdequate) {
   int checked = 0;
   for (int trial = 0; trial < 4; ++trial) {
     const double gamma = std::pow(10.0, std::uniform_real_distribution<double>(-6.0, -2.0)(g));
-    const pw::Case c = whiteNoiseUnderGyroRandomWalk(gamma, rootSeed() + 100 + trial);
-    const na::Diagnosis d = diagnoseCase(c, 9 + trial);
-    std::printf("trial %d: gyro model WN(1e-3) + RW(gamma=%.4g) on white noise:\n%s", trial, gamma,
-                navimpact::report::diagnosisSummary(d).c_str());
+    const na::Diagnosis d = diagnoseWhiteNoiseUnderRw(trial, gamma, rootSeed() + 100 + trial, 9 + trial);
     for (int k = 0; k < 3; ++k) {
       const auto& ch = d.channels[k];
-      int rejected = 0;  // scales the WV test rejects, a factor 2 below the model
-      for (const auto& sc : ch.scales) rejected += sc.significant && sc.ratio < 0.5 ? 1 : 0;
+      const int rejected = rejectedBelowModel(ch);
       if (rejected > 0) {
         ++checked;
         EXPECT_FALSE(ch.adequate) << ch.name << ": " << rejected << " scale(s) rejected";
@@ -875,14 +887,10 @@ TEST(Diagnose, AnOverstatedTermIsRetunedOnTheHeldOutHalfToo) {
   int checked = 0;
   for (int trial = 0; trial < 4; ++trial) {
     const double gamma = std::pow(10.0, std::uniform_real_distribution<double>(-5.0, -2.0)(g));
-    const pw::Case c = whiteNoiseUnderGyroRandomWalk(gamma, rootSeed() + 200 + trial);
-    const na::Diagnosis d = diagnoseCase(c, 13 + trial);
-    std::printf("trial %d: gyro model WN(1e-3) + RW(gamma=%.4g) on white noise:\n%s", trial, gamma,
-                navimpact::report::diagnosisSummary(d).c_str());
+    const na::Diagnosis d = diagnoseWhiteNoiseUnderRw(trial, gamma, rootSeed() + 200 + trial, 13 + trial);
     for (int k = 0; k < 3; ++k) {
       const auto& ch = d.channels[k];
-      int rejected = 0;  // scales the WV test rejects, a factor 2 below the model
-      for (const auto& sc : ch.scales) rejected += sc.significant && sc.ratio < 0.5 ? 1 : 0;
+      const int rejected = rejectedBelowModel(ch);
       bool overstated = false;
       for (const auto& f : ch.findings) {
         overstated = overstated || (f.cause == na::Cause::RandomWalk && f.direction == "overstated");
