@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 
@@ -67,6 +68,17 @@ CLI::Validator knownUnit(units::Quantity q) {
         }
       },
       "UNIT");
+}
+
+CLI::Validator zeroOrAtLeast(double min, std::string why) {
+  return CLI::Validator(
+      [min, why](std::string& s) {
+        double v = 0.0;  // the range check before has read it as a number
+        return parseDouble(s, v) && v > 0.0 && v < min
+                   ? "must be 0 or at least " + formatNumber(min) + " (" + why + "), got " + printable(s, 40)
+                   : std::string();
+      },
+      "0 or >= " + formatNumber(min));
 }
 
 CLI::Validator robustEfficiency() {

@@ -71,6 +71,11 @@ CLI::Validator knownUnit(units::Quantity q);
 /// 2^64 - 1, a silent wrap), the same seeds as a configuration's seed keys.
 CLI::Validator seedValue();
 
+/// A count that is 0 (off) or at least @p min, after a within() range check:
+/// "must be 0 or at least 2 (one simulation has no spread), got 1", @p why in
+/// the brackets (diagnose --simulations, fit --bootstrap).
+CLI::Validator zeroOrAtLeast(double min, std::string why);
+
 /// A robust WV efficiency --eff: a number the biweight reaches (about
 /// 0.0124 .. 0.999985, gmwm::checkRobustEfficiency); 0.9999999 passed a (0, 1)
 /// check and failed after the file was read, blaming the file.

@@ -21,7 +21,6 @@
 #include "navimpact/analysis/diagnosis.hpp"
 #include "navimpact/analysis/run_diagnosis.hpp"
 #include "navimpact/core/error.hpp"
-#include "navimpact/core/text_io.hpp"
 #include "navimpact/core/output.hpp"
 #include "navimpact/gmwm/channels.hpp"
 #include "navimpact/report/diagnosis_report.hpp"
@@ -284,14 +283,7 @@ navimpact::cli::Registrar reg(
        app.add_option("--simulations", o->simulations, "Monte-Carlo simulations per channel (0, or 2 and more)")
            ->capture_default_str()
            ->check(navimpact::cli::within({0.0, double(navimpact::limits::kMaxMonteCarloRuns), false, ""}))
-           ->check(CLI::Validator(
-               [](std::string& s) {
-                 double v = 0.0;  // the range check before has read it as a number
-                 return navimpact::parseDouble(s, v) && v == 1.0
-                            ? std::string("must be 0 or at least 2 (one simulation has no spread), got 1")
-                            : std::string();
-               },
-               "0 or >= 2"));
+           ->check(navimpact::cli::zeroOrAtLeast(2.0, "one simulation has no spread"));
        app.add_option("--seed", o->seed, "root seed")->capture_default_str()->check(navimpact::cli::seedValue());
        app.add_option("--alpha", o->alpha, "family-wise level for the whole record")
            ->capture_default_str()

@@ -16,7 +16,6 @@
 #include "input.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
-#include "navimpact/core/text_io.hpp"
 #include "navimpact/gmwm/channels.hpp"
 #include "navimpact/report/fit_report.hpp"
 
@@ -91,15 +90,7 @@ navimpact::cli::Registrar reg({
       auto* bootstrap = app.add_option("--bootstrap", o->fit.bootstrap,
                                        "parametric bootstrap replicates for the intervals (0: --intervals; else 39 .. 10000)")
           ->check(navimpact::cli::within({0.0, 10000.0, false, ""}))
-          ->check(CLI::Validator(
-              [](std::string& s) {
-                double v = 0.0;  // the range check before has read it as a number
-                return navimpact::parseDouble(s, v) && v > 0.0 && v < gm::kMinBootstrap
-                           ? "must be 0 or at least " + std::to_string(gm::kMinBootstrap) +
-                                 " (a 95 % percentile interval needs (N + 1) * 0.025 >= 1), got " + s
-                           : std::string();
-              },
-              "0 or >= 39"));
+          ->check(navimpact::cli::zeroOrAtLeast(gm::kMinBootstrap, "a 95 % percentile interval needs (N + 1) * 0.025 >= 1"));
       app.add_flag("--allow-large", o->fit.allow_large,
                    "bootstrap above the simulated-sample budget (README \"Ranges and budgets\")");
       auto* intervals = app.add_option("--intervals", o->fit.intervals,
