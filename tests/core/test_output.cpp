@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <grp.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -98,6 +99,75 @@ TEST(OutputSet, OverwriteReplacesTheFolderWhole) {
   out.commit();
   EXPECT_EQ(entries(dir), std::vector<std::string>{"summary.json"});
   EXPECT_EQ(stagingCount(dir.parent_path()), 0);
+}
+
+namespace {
+
+/// Replace @p dir whole with one new file as the user @p uid (a forked child
+/// that drops root to it; this process when @p uid is ours). Returns the
+/// error's message, or "(no error)" when the replacement was committed.
+std::string replaceAs(uid_t uid, const fs::path& dir) {
+  auto job = [&dir] {
+    return test::errorOf([&dir] {
+      OutputSet out(dir, Overwrite::Replace);
+      out.writeText("summary.json", "{\"new\": true}");
+      out.commit();
+    });
+  };
+  if (uid == ::geteuid()) return job();
+  int pipeFd[2];
+  if (::pipe(pipeFd) != 0) return "pipe failed";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::close(pipeFd[0]);
+    std::string msg = "cannot drop to the user";
+    if (::setgroups(0, nullptr) == 0 && ::setgid(uid) == 0 && ::setuid(uid) == 0) msg = job();
+    const ssize_t w = ::write(pipeFd[1], msg.data(), msg.size());
+    ::_exit(w == static_cast<ssize_t>(msg.size()) ? 0 : 1);
+  }
+  ::close(pipeFd[1]);
+  std::string msg;
+  char buf[512];
+  for (ssize_t r; (r = ::read(pipeFd[0], buf, sizeof buf)) > 0;) msg.append(buf, static_cast<std::size_t>(r));
+  ::close(pipeFd[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return msg;
+}
+
+}  // namespace
+
+// --overwrite over an output holding a folder whose files the user may not
+// delete (e.g. one a container wrote as root) is refused before any work: the
+// old output stays whole. Once the folder is the user's, it is replaced.
+TEST(OutputSet, OverwriteRefusesAnOutputItCouldNotDeleteWhole) {
+  const fs::path base = test::tempDir() / "shared";
+  const fs::path dir = base / "out";
+  touch(dir / "summary.json");
+  touch(dir / "plots" / "old.png");
+  // as root: the output is another user's and its sub-folder stays root's;
+  // as a user: the sub-folder is read-only to its owner
+  const bool root = ::geteuid() == 0;
+  const uid_t user = root ? 65534 : ::geteuid();  // nobody
+  if (root) {
+    fs::permissions(base, fs::perms::all);
+    for (const fs::path& p : {dir, dir / "summary.json"}) ASSERT_EQ(::chown(p.c_str(), user, user), 0);
+  } else {
+    fs::permissions(dir / "plots", fs::perms::owner_read | fs::perms::owner_exec);
+  }
+  const std::string refused = replaceAs(user, dir);
+  EXPECT_NE(refused.find("may not delete the files in " + (dir / "plots").string()), std::string::npos) << refused;
+  EXPECT_EQ(entries(dir), (std::vector<std::string>{"plots", "summary.json"}));
+  EXPECT_TRUE(fs::exists(dir / "plots" / "old.png"));
+  EXPECT_EQ(stagingCount(base), 0);
+
+  if (root)
+    for (const fs::path& p : {dir / "plots", dir / "plots" / "old.png"}) ASSERT_EQ(::chown(p.c_str(), user, user), 0);
+  else
+    fs::permissions(dir / "plots", fs::perms::owner_all);
+  EXPECT_EQ(replaceAs(user, dir), "(no error)");
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"summary.json"});
+  EXPECT_EQ(stagingCount(base), 0);
 }
 
 TEST(OutputSet, OverwriteRefusesFoldersNoOutputLooksLike) {

@@ -51,6 +51,21 @@ bool deeperThanOneLevel(const fs::path& folder) {
   return static_cast<bool>(ec);
 }
 
+/// The first folder of @p folder (itself or a folder in it) whose entries this
+/// process cannot remove (no write and search permission for its effective
+/// ids, e.g. a sub-folder a container left owned by root), or "" when none.
+/// Replacing the output whole deletes them all: checked before any work, as a
+/// delete that stops half-way would leave part of the old output hidden in a
+/// staging folder.
+std::string unremovableIn(const fs::path& folder) {
+  auto blocked = [](const fs::path& p) { return ::faccessat(AT_FDCWD, p.c_str(), W_OK | X_OK, AT_EACCESS) != 0; };
+  if (blocked(folder)) return folder.string();
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(folder, ec))
+    if (e.is_directory(ec) && !e.is_symlink(ec) && blocked(e.path())) return e.path().string();
+  return {};
+}
+
 std::mutex g_inputsMutex;
 std::set<fs::path>& inputs() {
   static std::set<fs::path> s;
@@ -86,6 +101,8 @@ std::string refuseReplace(const fs::path& dest) {
     return "it holds folders of folders, which no navimpact output does; remove it yourself if it is meant";
   if (const std::string in = inputAt(d); !in.empty())
     return "it holds " + in + ", an input of this run (write the output elsewhere)";
+  if (const std::string f = unremovableIn(d); !f.empty())
+    return "this user may not delete the files in " + f + " (no write permission there), so the old output could not be removed whole";
   return {};
 }
 

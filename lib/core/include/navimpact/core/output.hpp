@@ -19,7 +19,10 @@
  * or a folder containing it, a folder that holds anything but files and
  * folders of files (navimpact outputs are at most one level deep), and a
  * folder that holds an input of the run (noteInput(): the readers note every
- * file they open; checked when the OutputSet is made and again at commit()).
+ * file they open; checked when the OutputSet is made and again at commit()),
+ * and a folder this user could not empty whole (it or a folder in it without
+ * write permission, e.g. one a container wrote as root): the old output would
+ * be deleted only in part.
  *
  * A run holds an exclusive flock() on its staging folder while it lives, so
  * a staging folder is stale only when no process holds its lock (a run in
