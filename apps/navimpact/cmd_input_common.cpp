@@ -56,7 +56,10 @@ void addInputOptions(CLI::App& app, InputOpts& o) {
       ->capture_default_str()
       ->each([&o](const std::string&) { o.label_given = true; });
   app.add_option("--time-column", o.time_column,
-                 "CSV: name of the time column in seconds (default: t, time_s or time)");
+                 "CSV: name of the time column (default: t, time_s or time)");
+  app.add_option("--time-unit", o.time_unit,
+                 "CSV: unit of the time column: s, ms, us, ns (default: from the header, e.g. t[ns], else s)")
+      ->check(CLI::IsMember(units::acceptedTimeUnits()));
   app.add_option("--start", o.start_s,
                  "use the record from this time on [s from its first sample, >= 0]");
   app.add_option("--end", o.end_s,
@@ -82,10 +85,11 @@ ImuSeries loadInput(const InputOpts& o, InputFormat* format) {
     c.acc_unit = o.acc_unit;
     c.axes = o.axes;
     c.time_column = o.time_column;
+    c.time_unit = o.time_unit;
     return window(readImuCsv(o.input, c));
   }
-  if (!o.time_column.empty())
-    throw Error(o.input + ": --time-column applies to CSV input; a rawlog's times are its observation timestamps");
+  if (!o.time_column.empty() || !o.time_unit.empty())
+    throw Error(o.input + ": --time-column and --time-unit apply to CSV input; a rawlog's times are its observation timestamps");
   if (!isSi(units::Quantity::AngularRate, o.gyro_unit) ||
       !isSi(units::Quantity::SpecificForce, o.acc_unit))
     throw Error(o.input + ": rawlog IMU data are SI (rad/s, m/s^2); --gyro-unit/--acc-unit "
@@ -110,6 +114,7 @@ ImuSeries loadInput(const InputOpts& o, InputFormat* format) {
 nlohmann::json inputSelectionJson(const InputOpts& o, const ImuSeries& s) {
   nlohmann::json j = nlohmann::json::object();
   if (!s.time_column.empty()) j["time_column"] = s.time_column;
+  if (!s.time_unit.empty()) j["time_unit"] = s.time_unit;
   if (o.start_s) j["start_s"] = *o.start_s;
   if (o.end_s) j["end_s"] = *o.end_s;
   return j;

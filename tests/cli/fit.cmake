@@ -114,8 +114,15 @@ foreach(i RANGE 0 4199)
     set(frac "0${frac}")
   endif()
   string(APPEND _tcsv "${a},${sec}.${frac},0.0${a},9.8${b}\n")
+  string(APPEND _tcsv_ms "${a},${ms},0.0${a},9.8${b}\n")
 endforeach()
 file(WRITE ${_fdir}/stamp.csv "${_tcsv}")
+# the same stamps in milliseconds: read at 200 Hz with --time-unit ms (they were seconds, a 0.2 Hz record)
+file(WRITE ${_fdir}/stamp_ms.csv "t,stamp,gyro_x[rad/s],acc_z[m/s2]\n${_tcsv_ms}")
+navimpact_cli_check(cli_fit_time_unit CHECK run_json
+  ARGS fit --input ${_fdir}/stamp_ms.csv --time-column stamp --time-unit ms --structure WN --out ${_fdir}/tunit
+  DEFINES OUT=${_fdir}/tunit JSON_FILE=fit.json
+  JSON "input/rate_hz=^200(\\.0*)?$" "input/samples=^4200$" "input/time_column=^stamp$" "input/time_unit=^ms$")
 navimpact_cli_check(cli_fit_time_column CHECK run_json
   ARGS fit --input ${_fdir}/stamp.csv --time-column stamp --structure WN --out ${_fdir}/tcol
   DEFINES OUT=${_fdir}/tcol JSON_FILE=fit.json
@@ -127,7 +134,7 @@ file(WRITE ${_fdir}/time_s.csv "${_tcsv_default}")
 navimpact_cli_check(cli_fit_time_column_default CHECK run_json
   ARGS fit --input ${_fdir}/time_s.csv --structure WN --out ${_fdir}/tcol_default
   DEFINES OUT=${_fdir}/tcol_default JSON_FILE=fit.json
-  JSON "input/rate_hz=^200(\\.0*)?$" "input/time_column=^time_s$")
+  JSON "input/rate_hz=^200(\\.0*)?$" "input/time_column=^time_s$" "input/time_unit=^s$")
 
 # Robust GMWM: the estimator is recorded; --eff needs --robust.
 navimpact_cli_check(cli_fit_robust CHECK run_json

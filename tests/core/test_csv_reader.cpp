@@ -278,6 +278,55 @@ TEST(CsvReader, NamedTimeColumn) {
       << two;
 }
 
+// A time column in s, ms, us or ns (header bracket or time_unit) gives the
+// clock's rate and first stamp. Rate log-uniform over the documented [1, 1e4]
+// Hz, start uniform over Unix seconds [1e9, 2e9] (seeded, printed); stamps are
+// whole nanoseconds written exactly in each unit (Unix ns exceed a double's 2^53).
+TEST(CsvReader, TimeStampsInAnyUnitGiveTheClocksRateAndStart) {
+  std::mt19937_64 g(test::envOr("NAVIMPACT_CSV_SEED", 4242));
+  const char* unitNames[] = {"s", "ms", "us", "ns"};
+  const int decimals[] = {9, 6, 3, 0};  // digits after the point of whole ns in each unit
+  for (int trial = 0; trial < 4; ++trial) {
+    const double rate = std::exp(std::uniform_real_distribution<double>(0.0, std::log(1e4))(g));
+    const long long start_ns = std::uniform_int_distribution<long long>(1000000000LL, 2000000000LL)(g) * 1000000000LL +
+                               std::uniform_int_distribution<long long>(0, 999999999LL)(g);
+    const int n = 1500;
+    std::vector<long long> ns(n);
+    for (int k = 0; k < n; ++k) ns[k] = start_ns + std::llround(1e9 * k / rate);
+    const double trueRate = (n - 1) / (1e-9 * static_cast<double>(ns[n - 1] - ns[0]));
+    std::printf("trial %d: %.6f Hz from Unix %lld ns\n", trial, rate, start_ns);
+    for (int u = 0; u < 4; ++u)
+      for (const bool inHeader : {true, false}) {
+        std::string text = std::string("t") + (inHeader ? std::string("[") + unitNames[u] + "]" : "") + ",gyro_x[rad/s]\n";
+        for (int k = 0; k < n; ++k) {
+          const long long p10 = static_cast<long long>(std::llround(std::pow(10.0, decimals[u])));
+          const std::string frac = std::to_string(p10 + ns[k] % p10).substr(1);  // zero-padded
+          text += std::to_string(ns[k] / p10) + (decimals[u] ? "." + frac : "") + ",0.1\n";
+        }
+        CsvImuOptions o;
+        if (!inHeader) o.time_unit = unitNames[u];
+        const ImuSeries s = readImuCsv(writeFile("stamps.csv", text), o);
+        SCOPED_TRACE(std::string(unitNames[u]) + (inHeader ? " in the header" : " as time_unit"));
+        // a nanosecond over the record's span (a double's 0.24 us at 2e9 s would not do)
+        EXPECT_NEAR(s.rate_hz, trueRate, 1e-9 / ((n - 1) / trueRate) * trueRate);
+        EXPECT_NEAR(s.t0_s, 1e-9 * static_cast<double>(start_ns), 5e-7);  // a double's resolution at 2e9 s
+        EXPECT_EQ(s.size(), static_cast<std::size_t>(n));
+      }
+  }
+  const std::string unknown = errorOf(writeFile("min.csv", "t[min],gyro_x[rad/s]\n0,1\n1,1\n"), CsvImuOptions{});
+  EXPECT_NE(unknown.find("min.csv:1: time column 't': unknown time unit 'min' (expected one of: s, ms, us, ns)"),
+            std::string::npos) << unknown;
+  CsvImuOptions ns;
+  ns.time_unit = "ns";
+  const std::string clash = errorOf(writeFile("ms.csv", "t[ms],gyro_x[rad/s]\n0,1\n10,1\n"), ns);
+  EXPECT_NE(clash.find("ms.csv:1: time column 't' is in ms by its header, but --time-unit says ns"), std::string::npos)
+      << clash;
+  ns.rate_hz = 100.0;
+  const std::string none = errorOf(writeFile("none.csv", "gyro_x[rad/s]\n1\n1\n"), ns);
+  EXPECT_NE(none.find("none.csv:1: time unit 'ns' given, but the header has no time column"), std::string::npos)
+      << none;
+}
+
 // cutWindow keeps the samples at k / rate in [start, end) and moves t0; the
 // window is drawn at random (seeded, printed) over the record; a window outside
 // the record names the source, the flag and the record's extent.

@@ -2,6 +2,7 @@
 #include "navimpact/core/recording.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 
@@ -10,6 +11,7 @@
 #include "navimpact/core/limits.hpp"
 #include "navimpact/core/gz_input.hpp"
 #include "navimpact/core/text_io.hpp"
+#include "navimpact/core/units.hpp"
 
 namespace navimpact {
 
@@ -44,6 +46,16 @@ struct Column {
   double factor = 1.0;
 };
 
+/// A time stamp in long double (64-bit mantissa: Unix nanoseconds exact);
+/// false for no number or a non-finite one.
+bool parseStamp(std::string_view s, long double& out) {
+  s = trim(s);
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  if (s.empty()) return false;
+  const auto res = std::from_chars(s.data(), s.data() + s.size(), out);
+  return res.ec == std::errc() && res.ptr == s.data() + s.size() && std::isfinite(out);
+}
+
 }  // namespace
 
 ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
@@ -69,6 +81,8 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
   std::vector<Column> cols(names.size());
   int timeCol = -1;
   std::string timeName;
+  double timeFactor = 1.0;  // seconds per unit of the time column
+  std::string timeUnit = "s";
   int present[6] = {-1, -1, -1, -1, -1, -1};
   for (std::size_t c = 0; c < names.size(); ++c) {
     std::string_view n = trim(names[c]);
@@ -91,6 +105,17 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
       timeCol = static_cast<int>(c);
       timeName = name;
       cols[c].channel = -2;
+      // the stamps' unit: the header's, or time_unit; both given, they must agree
+      if (!unit.empty() && !opt.time_unit.empty() && unit != opt.time_unit)
+        throw fileError(path, 1, "time column '" + printable(name) + "' is in " + printable(unit) +
+                                     " by its header, but --time-unit says " + printable(opt.time_unit) +
+                                     ": drop the flag or correct the header");
+      timeUnit = unit.empty() ? (opt.time_unit.empty() ? std::string("s") : opt.time_unit) : unit;
+      try {
+        timeFactor = units::secondsPer(timeUnit);
+      } catch (const Error& e) {
+        throw fileError(path, 1, "time column '" + printable(name) + "': " + e.what());
+      }
       continue;
     }
     const int idx = channelIndex(name);
@@ -145,7 +170,8 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
       lines.input().statedSize() / std::max<std::size_t>(header.size(), 8) + 16, std::uint64_t(1) << 26));
   for (int i = 0; i < 6; ++i)
     if (present[i] >= 0) data[i].reserve(approxRows);
-  std::vector<double> times;
+  std::vector<double> times;  // [s] from the first stamp
+  long double firstStamp = 0.0L, prevStamp = 0.0L;  // in the column's unit
   if (timeCol >= 0) times.reserve(approxRows);
 
   const std::size_t ncol = cols.size();
@@ -160,7 +186,23 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
       if (last) comma = line.size();
       if (c >= ncol)
         throw fileError(path, lineNo, "more fields than the " + std::to_string(ncol) + " header columns");
-      if (cols[c].channel != -1) {
+      if (cols[c].channel == -2) {
+        // a stamp, read in long double and kept relative to the first: Unix
+        // nanoseconds (~1.7e18) lose 256 ns in a double, Unix seconds 0.24 us
+        long double v;
+        const std::string_view field = line.substr(start, comma - start);
+        if (!parseStamp(field, v))
+          throw fileError(path, lineNo, "column " + std::to_string(c + 1) + " ('" +
+                                            printable(trim(names[c])) + "'): '" + printable(field) +
+                                            "' is not a finite number");
+        if (times.empty()) firstStamp = v;
+        else if (!(v > prevStamp))
+          throw fileError(path, lineNo, "time " + formatNumber(static_cast<double>(v), 10) + " " + timeUnit +
+                                            " is not after the previous " + formatNumber(static_cast<double>(prevStamp), 10) +
+                                            " " + timeUnit);
+        prevStamp = v;
+        times.push_back(static_cast<double>((v - firstStamp) * timeFactor));
+      } else if (cols[c].channel != -1) {
         double v;
         const std::string_view field = line.substr(start, comma - start);
         if (!parseDouble(field, v))
@@ -171,9 +213,7 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
           throw fileError(path, lineNo, "column " + std::to_string(c + 1) + " ('" +
                                             printable(trim(names[c])) + "'): value is " +
                                             printable(trim(field)));
-        if (cols[c].channel == -2) {
-          times.push_back(v);
-        } else {
+        {
           const double si = v * cols[c].factor;
           const double lim = maxAbsSample(channelQuantity(kChannelNames[cols[c].channel]));
           if (!(std::abs(si) <= lim))
@@ -201,12 +241,16 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
   out.source = path;
   if (timeCol >= 0) {
     if (n < 2) throw fileError(path, 0, "need at least two rows to derive the rate from 't'");
+    // stamp k as the file has it (its unit), for messages
+    auto stampText = [&](std::size_t k) {
+      return formatNumber(static_cast<double>(firstStamp + times[k] / timeFactor), 10) + " " + timeUnit;
+    };
     std::vector<double> dts(n - 1);
     for (std::size_t k = 1; k < n; ++k) {
       dts[k - 1] = times[k] - times[k - 1];
       if (!(dts[k - 1] > 0.0))
-        throw fileError(path, k + 2, "time " + formatNumber(times[k], 10) + " s is not after the previous " +
-                                         formatNumber(times[k - 1], 10) + " s");
+        throw fileError(path, k + 2, "time " + stampText(k) + " is not after the previous " + stampText(k - 1) +
+                                         " (step " + formatNumber(dts[k - 1]) + " s)");
     }
     // The nominal step (the median; the mean where quantised or alternating
     // stamps move the median: 400 Hz stamped in ms, nominalStep). A step is
@@ -230,9 +274,13 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
       throw fileError(path, 0, "--rate " + formatNumber(*opt.rate_hz) +
                                    " Hz disagrees with the time column (" + formatNumber(rate) + " Hz)");
     out.rate_hz = opt.rate_hz ? *opt.rate_hz : rate;
-    out.t0_s = times[0];
+    out.t0_s = static_cast<double>(firstStamp * timeFactor);
     out.time_column = timeName;
+    out.time_unit = timeUnit;
   } else {
+    if (!opt.time_unit.empty())
+      throw fileError(path, 1, "time unit '" + printable(opt.time_unit) +
+                                   "' given, but the header has no time column (t, time_s, time or --time-column NAME)");
     if (!opt.rate_hz)
       throw fileError(path, 1, "no time column (t, time_s, time or --time-column NAME): the sampling rate must be given (--rate HZ)");
     if (!(*opt.rate_hz > 0.0) || !std::isfinite(*opt.rate_hz))

@@ -17,7 +17,20 @@ constexpr UnitEntry kRateUnits[] = {
     {"rad/s", 1.0}, {"deg/s", kDeg}, {"deg/h", kDeg / kHour}, {"mrad/s", 1e-3}};
 constexpr UnitEntry kForceUnits[] = {
     {"m/s2", 1.0}, {"m/s^2", 1.0}, {"g", kG0}, {"mg", 1e-3 * kG0}, {"ug", 1e-6 * kG0}};
+constexpr UnitEntry kTimeUnits[] = {{"s", 1.0}, {"ms", 1e-3}, {"us", 1e-6}, {"ns", 1e-9}};
 }  // namespace
+
+std::vector<std::string> acceptedTimeUnits() {
+  std::vector<std::string> out;
+  for (const auto& e : kTimeUnits) out.emplace_back(e.name);
+  return out;
+}
+
+double secondsPer(std::string_view unit) {
+  for (const auto& e : kTimeUnits)
+    if (unit == e.name) return e.factor;
+  throw Error("unknown time unit '" + printable(unit, 40) + "' (expected one of: s, ms, us, ns)");
+}
 
 double toSiFactor(Quantity q, std::string_view unit) {
   if (q == Quantity::AngularRate) {

@@ -116,8 +116,8 @@ StreamSpec streamSpec(const Keys& k, const ConfigNode& n, const std::string& nam
     k.map(t, tk, {"column", "unit"}, {"column", "unit"});
     s.time_column = true;
     s.column = k.text(t["column"], tk + ".column");
-    static const double f[] = {1.0, 1e-3, 1e-6, 1e-9};
-    s.time_factor = f[k.oneOf(t["unit"], tk + ".unit", {"s", "ms", "us", "ns"})];
+    const auto names = units::acceptedTimeUnits();
+    s.time_factor = units::secondsPer(names[k.oneOf(t["unit"], tk + ".unit", names)]);
   }
   if (n["max_gap_s"]) s.max_gap_s = n["max_gap_s"].asNumber(limits::kDurationS);
   return s;

@@ -4,8 +4,10 @@
  *
  * Format: one header line naming the columns, comma separated. Recognised
  * columns are the canonical channels `gyro_x gyro_y gyro_z acc_x acc_y acc_z`
- * and an optional time column in seconds: `t`, `time_s` or `time`, or the one
- * named by CsvImuOptions::time_column; other columns are ignored. A column name may carry its unit in brackets, e.g. `gyro_x[deg/s]`,
+ * and an optional time column: `t`, `time_s` or `time`, or the one named by
+ * CsvImuOptions::time_column, in seconds unless its header bracket or
+ * CsvImuOptions::time_unit says ms, us or ns (stamps are read exactly enough
+ * for Unix nanoseconds); other columns are ignored. A column name may carry its unit in brackets, e.g. `gyro_x[deg/s]`,
  * which overrides the option. Without a time column, the rate must be given.
  */
 #pragma once
@@ -36,6 +38,9 @@ struct CsvImuOptions {
   /// Empty: `t`, `time_s` or `time` when present. Set: that column must exist
   /// and the default names are ordinary (ignored) columns.
   std::string time_column;
+  /// Unit of the time column: s, ms, us or ns (units::secondsPer). Empty: the
+  /// header's bracket (e.g. `t[ns]`), else s. Both given: they must agree.
+  std::string time_unit;
   /// Largest accepted relative deviation of a time step from the median step.
   double max_dt_deviation = 0.01;
 };

@@ -50,6 +50,7 @@ struct ImuSeries {
   /// CSV: the header name of the time column read ("" when the rate was given
   /// instead), recorded in the commands' "input" (t, time_s or time by default).
   std::string time_column;
+  std::string time_unit;  ///< CSV: the unit of that column (s, ms, us, ns; "" with no time column)
   std::vector<ImuChannel> channels;
 
   std::size_t size() const { return channels.empty() ? 0 : channels.front().x.size(); }

@@ -41,4 +41,13 @@ double toSiFactor(Quantity q, std::string_view unit);
 /// Accepted unit names for a quantity (for help texts and error messages).
 std::vector<std::string> acceptedUnits(Quantity q);
 
+/// Units of a time stamp column: "s", "ms", "us", "ns" (in this order).
+std::vector<std::string> acceptedTimeUnits();
+
+/**
+ * Seconds per one @p unit of time (e.g. 1e-3 for "ms").
+ * @throws navimpact::Error naming the unit and the accepted names.
+ */
+double secondsPer(std::string_view unit);
+
 }  // namespace navimpact::units
