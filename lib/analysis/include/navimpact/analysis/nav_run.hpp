@@ -157,6 +157,10 @@ struct OutageSummary {
 struct NavRunResult {
   bool has_truth = true;            ///< false: errors, NEES and outage drifts are absent (NaN / 0)
   std::vector<NavEpoch> epochs;     ///< one per truth epoch inside the IMU span (or per record interval); empty when not kept
+  /// Truth epochs inside the IMU span that are not scored because a positive
+  /// time-offset estimate d puts their IMU epoch t + d past the last sample
+  /// (at most d times the truth rate, at the end of the run).
+  std::size_t epochs_past_imu_clock = 0;
   std::vector<OutageSummary> outages;  ///< one per NavRunOptions::outages
   int states = 0;                   ///< EKF state count
   std::size_t steps = 0;            ///< IMU samples processed
