@@ -170,6 +170,23 @@ TEST(OutputSet, OverwriteRefusesAnOutputItCouldNotDeleteWhole) {
   EXPECT_EQ(stagingCount(base), 0);
 }
 
+// In a folder with the sticky bit (/tmp) another user's output cannot be
+// renamed over: refused when the OutputSet is made, not after the work.
+TEST(OutputSet, AnOutputOfAnotherUserInAStickyFolderIsRefusedBeforeAnyWork) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to make an output of another user";
+  const fs::path base = test::tempDir() / "sticky";
+  const fs::path dir = base / "out";
+  touch(dir / "summary.json");
+  fs::permissions(base, fs::perms::all | fs::perms::sticky_bit);
+  fs::permissions(dir, fs::perms::all);  // root's, but open to all: only the sticky bit stands in the way
+  const std::string m = replaceAs(65534, dir);
+  EXPECT_NE(m.find(dir.string() + ": belongs to another user (uid 0) in " + base.string() +
+                   ", a folder with the sticky bit"),
+            std::string::npos) << m;
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"summary.json"});
+  EXPECT_EQ(stagingCount(base), 0);
+}
+
 TEST(OutputSet, OverwriteRefusesFoldersNoOutputLooksLike) {
   const fs::path base = test::tempDir();
   touch(base / "project" / "src" / "lib" / "a.cpp");

@@ -210,6 +210,14 @@ OutputSet::OutputSet(fs::path dest, Overwrite ow, Kind kind) : dest_(std::move(d
                               "--overwrite or not)");
         if (ow_ == Overwrite::Refuse) throw Error(shown + ": output file exists (pass --overwrite to replace it)");
       }
+      // in a folder with the sticky bit (/tmp) only the owner of an entry or
+      // of the folder may rename over it: fail before the work, not at commit
+      struct stat sd {}, sp {};
+      const uid_t me = ::geteuid();
+      if (me != 0 && ::lstat(abs.c_str(), &sd) == 0 && ::stat(parent.c_str(), &sp) == 0 && (sp.st_mode & S_ISVTX) &&
+          sd.st_uid != me && sp.st_uid != me)
+        throw Error(shown + ": belongs to another user (uid " + std::to_string(sd.st_uid) + ") in " + parent.string() +
+                    ", a folder with the sticky bit, so it cannot be replaced (write the output elsewhere)");
     }
     // a name the folder cannot hold fails here, before the work, not at commit
     if (const long most = ::pathconf(parent.c_str(), _PC_NAME_MAX);
