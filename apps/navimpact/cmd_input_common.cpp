@@ -56,7 +56,7 @@ void addInputOptions(CLI::App& app, InputOpts& o) {
       ->capture_default_str()
       ->each([&o](const std::string&) { o.label_given = true; });
   app.add_option("--time-column", o.time_column,
-                 "CSV: name of the time column (default: t, time_s or time)");
+                 "CSV: name of the time column (default: t, t_s, time_s or time)");
   app.add_option("--time-unit", o.time_unit,
                  "CSV: unit of the time column: s, ms, us, ns (default: from the header, e.g. t[ns], else s)")
       ->check(CLI::IsMember(units::acceptedTimeUnits()));

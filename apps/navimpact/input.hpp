@@ -22,7 +22,7 @@ struct InputOpts {
   std::string axes;               ///< sensor -> body FRD remap, e.g. "x,-y,-z"
   std::string label = "IMU";      ///< rawlog sensor label
   bool label_given = false;       ///< --label on the command line (it applies to a rawlog only)
-  std::string time_column;        ///< CSV time column name ("" = t, time_s or time)
+  std::string time_column;        ///< CSV time column name ("" = t, t_s, time_s or time)
   std::string time_unit;          ///< CSV time column unit s/ms/us/ns ("" = the header's, else s)
   std::optional<double> start_s;  ///< window start [s from the record's first sample]
   std::optional<double> end_s;    ///< window end (exclusive) [s from the record's first sample]

@@ -157,8 +157,11 @@ TEST(CsvReader, BadInputsNameFileAndLine) {
     // model at 1e9 Hz that no reader loads), and times printed as numbers, not
     // as 300 digits of %f
     const auto slow = errorOf(writeFile("slow.csv", "t,gyro_x\n0,1\n1e300,1\n2e300,1\n"), t);
-    EXPECT_NE(slow.find("slow.csv: the time column gives a rate of 1e-300 Hz, outside [1, 10000] Hz (is the time unit right?)"),
+    EXPECT_NE(slow.find("slow.csv: time column 't' holds 2e+300 s, outside [-1e+10, 1e+10] s (is the time unit right?)"),
               std::string::npos) << slow;
+    const auto slowSmall = errorOf(writeFile("slow_small.csv", "t,gyro_x\n0,1\n2,1\n4,1\n"), t);
+    EXPECT_NE(slowSmall.find("slow_small.csv: the time column gives a rate of 0.5 Hz, outside [1, 10000] Hz (is the time unit right?)"),
+              std::string::npos) << slowSmall;
     const auto fast = errorOf(writeFile("fast.csv", "t,gyro_x\n0,1\n1e-9,1\n2e-9,1\n"), t);
     EXPECT_NE(fast.find("fast.csv: the time column gives a rate of 1e+09 Hz"), std::string::npos) << fast;
     const auto back = errorOf(writeFile("back300.csv", "t,gyro_x\n1e300,1\n0,1\n"), t);
@@ -325,6 +328,52 @@ TEST(CsvReader, TimeStampsInAnyUnitGiveTheClocksRateAndStart) {
   const std::string none = errorOf(writeFile("none.csv", "gyro_x[rad/s]\n1\n1\n"), ns);
   EXPECT_NE(none.find("none.csv:1: time unit 'ns' given, but the header has no time column"), std::string::npos)
       << none;
+}
+
+// Columns that are not read must not hide a channel or the stamps: a channel
+// written otherwise is an error (a fit modelled it as "none", a perfect
+// sensor), and so is a column of stamps not read as time (--rate would go
+// unchecked: the katwijk IMU's t_s at 125 Hz read at --rate 100). t_s, the
+// emulator's own IMU time column, is a default; other columns stay ignored.
+TEST(CsvReader, AColumnNotReadHidesNoChannelAndNoStamps) {
+  CsvImuOptions r100;
+  r100.rate_hz = 100.0;
+  for (const char* name : {"Gyro_X", "gyrox", "GYRO-X"}) {
+    const std::string m = errorOf(writeFile("case.csv", std::string("t,") + name + "[rad/s],acc_z[m/s2]\n0,1,2\n0.01,1,2\n"),
+                                  CsvImuOptions{});
+    EXPECT_NE(m.find("case.csv:1: column 2 '" + std::string(name) + "' is not a channel name: write it gyro_x"),
+              std::string::npos) << m;
+  }
+  for (const char* name : {"T", "timestamp", "time_ns", "t_imu", "gps_time", "Stamp"}) {
+    const std::string m =
+        errorOf(writeFile("stamps.csv", std::string(name) + ",gyro_x[rad/s]\n0,1\n0.008,1\n0.016,1\n"), r100);
+    EXPECT_NE(m.find("stamps.csv:1: column '" + std::string(name) + "' looks like time stamps but is not read as time: "
+                     "pass --time-column " + name),
+              std::string::npos) << m;
+  }
+  // t_s is read (125 Hz), so a --rate that disagrees is refused
+  const auto ts = writeFile("ts.csv", "t_s,gyro_x[rad/s]\n0,1\n0.008,1\n0.016,1\n");
+  EXPECT_NEAR(readImuCsv(ts, CsvImuOptions{}).rate_hz, 125.0, 1e-9);
+  EXPECT_NE(errorOf(ts, r100).find("--rate 100 Hz disagrees with the time column (125 Hz)"), std::string::npos);
+  // other columns stay ignored
+  const ImuSeries other = readImuCsv(writeFile("temp.csv", "temperature,count,gyro_x[rad/s]\n20,1,1\n21,2,2\n"), r100);
+  EXPECT_EQ(other.channel("gyro_x").x, (std::vector<double>{1, 2}));
+}
+
+// Stamps beyond a file's time axis (±1e10 s) are a unit gone wrong: Unix
+// milliseconds of a 1 kHz IMU under a plain 't' read as seconds were a 1 Hz
+// record in range. Whole nanoseconds of a 100 Hz clock give 100 Hz exactly.
+TEST(CsvReader, StampsOfTheWrongUnitAreRefusedAndExactOnesGiveTheExactRate) {
+  std::string ms = "t,gyro_x[rad/s]\n", ns = "t[ns],gyro_x[rad/s]\n";
+  for (long long k = 0; k < 300; ++k) {
+    ms += std::to_string(1700000000123LL + k) + ",0.1\n";
+    ns += std::to_string(1700000000000000000LL + 10000000LL * k) + ",0.1\n";
+  }
+  const std::string m = errorOf(writeFile("unix_ms.csv", ms), CsvImuOptions{});
+  EXPECT_NE(m.find("unix_ms.csv: time column 't' holds 1.7e+12 s, outside [-1e+10, 1e+10] s"),
+            std::string::npos) << m;
+  EXPECT_NE(m.find("(is the time unit right?)"), std::string::npos) << m;
+  EXPECT_EQ(readImuCsv(writeFile("unix_ns.csv", ns), CsvImuOptions{}).rate_hz, 100.0);
 }
 
 // cutWindow keeps the samples at k / rate in [start, end) and moves t0; the

@@ -2,6 +2,7 @@
 #include "navimpact/core/recording.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -46,6 +47,29 @@ struct Column {
   double factor = 1.0;
 };
 
+/// The time columns read without --time-column.
+bool isDefaultTimeName(const std::string& n) { return n == "t" || n == "t_s" || n == "time_s" || n == "time"; }
+
+/// @p n in lower case without separators ("Gyro_X" -> "gyrox").
+std::string foldName(const std::string& n) {
+  std::string f;
+  for (const char ch : n)
+    if (std::isalnum(static_cast<unsigned char>(ch))) f += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return f;
+}
+
+/// A column name of time stamps: t, time..., t_..., ...stamp..., ..._time, in any case.
+bool looksLikeTime(const std::string& n) {
+  std::string l;
+  for (const char ch : n) l += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  auto ends = [&l](const char* suf) {
+    const std::size_t k = std::strlen(suf);
+    return l.size() >= k && l.compare(l.size() - k, k, suf) == 0;
+  };
+  return l == "t" || l.rfind("time", 0) == 0 || l.rfind("t_", 0) == 0 || l.find("stamp") != std::string::npos ||
+         ends("_time") || ends("_t");
+}
+
 /// A time stamp in long double (64-bit mantissa: Unix nanoseconds exact);
 /// false for no number or a non-finite one.
 bool parseStamp(std::string_view s, long double& out) {
@@ -80,7 +104,7 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
   const auto names = splitView(header, ',');
   std::vector<Column> cols(names.size());
   int timeCol = -1;
-  std::string timeName;
+  std::string timeName, timeLike;  // the time column read; a column that looks like one
   double timeFactor = 1.0;  // seconds per unit of the time column
   std::string timeUnit = "s";
   int present[6] = {-1, -1, -1, -1, -1, -1};
@@ -97,7 +121,7 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
       n = trim(n.substr(0, lb));
     }
     const std::string name(n);
-    if (opt.time_column.empty() ? (name == "t" || name == "time_s" || name == "time") : name == opt.time_column) {
+    if (opt.time_column.empty() ? isDefaultTimeName(name) : name == opt.time_column) {
       if (timeCol >= 0)
         throw fileError(path, 1, "column " + std::to_string(c + 1) + " '" + printable(name) +
                                      "': a second time column (the first is column " + std::to_string(timeCol + 1) +
@@ -119,7 +143,18 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
       continue;
     }
     const int idx = channelIndex(name);
-    if (idx < 0) continue;
+    if (idx < 0) {
+      // a channel's name written otherwise (Gyro_X, gyrox) would leave the
+      // channel out without a word, and a fit would model it as "none"
+      const std::string folded = foldName(name);
+      for (const char* ch : kChannelNames)
+        if (folded == foldName(ch))
+          throw fileError(path, 1, "column " + std::to_string(c + 1) + " '" + printable(name) +
+                                       "' is not a channel name: write it " + ch +
+                                       " (names are exact: gyro_x gyro_y gyro_z acc_x acc_y acc_z)");
+      if (timeLike.empty() && looksLikeTime(name)) timeLike = name;
+      continue;
+    }
     if (present[idx] >= 0)
       throw fileError(path, 1, "column '" + name + "' appears twice");
     present[idx] = static_cast<int>(c);
@@ -154,6 +189,12 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
     }
     cols[c].channel = idx;
   }
+  // stamps in a column that is not read as time: the rate would come from
+  // --rate unchecked (the katwijk IMU's t_s at 125 Hz read at --rate 100)
+  if (timeCol < 0 && opt.time_column.empty() && !timeLike.empty())
+    throw fileError(path, 1, "column '" + printable(timeLike) +
+                                 "' looks like time stamps but is not read as time: pass --time-column " +
+                                 printable(timeLike) + " (the default time columns are t, t_s, time_s, time)");
   if (!opt.time_column.empty() && timeCol < 0)
     throw fileError(path, 1,
                     "no time column '" + printable(opt.time_column) + "' (--time-column) in header '" +
@@ -265,7 +306,17 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
         throw fileError(path, k + 3, "time step " + formatNumber(dts[k]) + " s differs from the nominal " +
                                          formatNumber(med) + " s (gap or jitter); resample or split the recording");
     }
-    const double rate = (n - 1) / (times[n - 1] - times[0]);
+    // stamps on a file's time axis (Unix seconds at most): a unit 1000x off
+    // in Unix time (ms read as s) is 1.7e12 "s", a 1 Hz record in range
+    for (const long double v : {firstStamp, prevStamp})
+      if (!(std::fabs(static_cast<double>(v * timeFactor)) <= limits::kFileTimeS.hi))
+        throw fileError(path, 0, "time column '" + printable(timeName) + "' holds " + formatNumber(static_cast<double>(v), 10) +
+                                     " " + timeUnit +
+                                     (timeUnit == "s" ? "" : " = " + formatNumber(static_cast<double>(v * timeFactor), 10) + " s") +
+                                     ", outside " + limits::describe(limits::kFileTimeS) + " (is the time unit right?)");
+    // from the stamps in their unit (1, 1e3, 1e6, 1e9 per second: exact), one rounding
+    const long double perSecond = std::round(1.0L / timeFactor);
+    const double rate = static_cast<double>((n - 1) * perSecond / (prevStamp - firstStamp));
     // the documented range of IMU rates (a time column in the wrong unit: a step of 1e300 s or 1 ns)
     if (!(rate >= limits::kImuRateHz.lo && rate <= limits::kImuRateHz.hi))
       throw fileError(path, 0, "the time column gives a rate of " + formatNumber(rate) + " Hz, outside " +
@@ -280,9 +331,9 @@ ImuSeries readImuCsv(const std::string& path, const CsvImuOptions& opt) {
   } else {
     if (!opt.time_unit.empty())
       throw fileError(path, 1, "time unit '" + printable(opt.time_unit) +
-                                   "' given, but the header has no time column (t, time_s, time or --time-column NAME)");
+                                   "' given, but the header has no time column (t, t_s, time_s, time or --time-column NAME)");
     if (!opt.rate_hz)
-      throw fileError(path, 1, "no time column (t, time_s, time or --time-column NAME): the sampling rate must be given (--rate HZ)");
+      throw fileError(path, 1, "no time column (t, t_s, time_s, time or --time-column NAME): the sampling rate must be given (--rate HZ)");
     if (!(*opt.rate_hz > 0.0) || !std::isfinite(*opt.rate_hz))
       throw Error("rate must be a positive number of Hz");
     out.rate_hz = *opt.rate_hz;

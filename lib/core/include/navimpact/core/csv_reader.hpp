@@ -4,10 +4,14 @@
  *
  * Format: one header line naming the columns, comma separated. Recognised
  * columns are the canonical channels `gyro_x gyro_y gyro_z acc_x acc_y acc_z`
- * and an optional time column: `t`, `time_s` or `time`, or the one named by
+ * and an optional time column: `t`, `t_s`, `time_s` or `time`, or the one named by
  * CsvImuOptions::time_column, in seconds unless its header bracket or
  * CsvImuOptions::time_unit says ms, us or ns (stamps are read exactly enough
- * for Unix nanoseconds); other columns are ignored. A column name may carry its unit in brackets, e.g. `gyro_x[deg/s]`,
+ * for Unix nanoseconds, on a file's time axis of at most 1e10 s); other
+ * columns are ignored, except a channel's name written otherwise (`Gyro_X`)
+ * and, with no time column read, a column that looks like time stamps
+ * (`T`, `time...`, `t_...`, `...stamp...`): both are errors naming the column.
+ * A column name may carry its unit in brackets, e.g. `gyro_x[deg/s]`,
  * which overrides the option. Without a time column, the rate must be given.
  */
 #pragma once
@@ -34,8 +38,8 @@ struct CsvImuOptions {
    * sensor mounted forward-left-up. Empty: identity.
    */
   std::string axes;
-  /// Name of the time column [s] (its header name without a [unit] part).
-  /// Empty: `t`, `time_s` or `time` when present. Set: that column must exist
+  /// Name of the time column (its header name without a [unit] part).
+  /// Empty: `t`, `t_s`, `time_s` or `time` when present. Set: that column must exist
   /// and the default names are ordinary (ignored) columns.
   std::string time_column;
   /// Unit of the time column: s, ms, us or ns (units::secondsPer). Empty: the
