@@ -127,6 +127,7 @@ navimpact_cli_check(cli_fit_time_column CHECK run_json
   ARGS fit --input ${_fdir}/stamp.csv --time-column stamp --structure WN --out ${_fdir}/tcol
   DEFINES OUT=${_fdir}/tcol JSON_FILE=fit.json
   JSON "input/rate_hz=^200(\\.0*)?$" "input/samples=^4200$" "input/time_column=^stamp$"
+       "unfitted_channels/0=^gyro_y$" "unfitted_channels/3=^acc_y$"
   FILES model.yaml)
 # the default time column is recorded too (it was left out without --time-column)
 string(REPLACE "t,stamp,gyro_x" "n,time_s,gyro_x" _tcsv_default "${_tcsv}")

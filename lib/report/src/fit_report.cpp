@@ -31,6 +31,27 @@ std::vector<st::ProcessKind> kindsOf(const st::Model& m) {
   return k;
 }
 
+/// The channels of the model no fit gave a term (absent from the input, or
+/// left out by --channels): "none" in model.yaml, a perfect sensor in a simulation.
+std::vector<std::string> unfitted(const gm::RecordingFit& f) {
+  std::vector<std::string> out;
+  for (const char* name : kChannelNames) {
+    bool fitted = false;
+    for (const auto& c : f.channels) fitted = fitted || c.name == name;
+    if (!fitted) out.emplace_back(name);
+  }
+  return out;
+}
+
+std::string unfittedNote(const gm::RecordingFit& f) {
+  const auto u = unfitted(f);
+  if (u.empty()) return {};
+  std::string list;
+  for (const auto& n : u) list += (list.empty() ? "" : ", ") + n;
+  return list + (u.size() == 1 ? " was" : " were") +
+         " not fitted (not in the input, or left out by --channels): none in model.yaml, a perfect sensor in a simulation";
+}
+
 std::string structureText(const gm::RecordingFit& f) {
   return f.options.structure == "auto" ? std::string("auto")
                                        : st::formatStructure(st::parseStructure(f.options.structure));
@@ -117,6 +138,7 @@ std::string fitJson(const gm::RecordingFit& f, const std::string& input_json) {
     j["negligible_rule"] = rule.str();
   }
   j["structure"] = structureText(f);
+  j["unfitted_channels"] = unfitted(f);
   j["conventions"] =
       "SI units; WN sigma, QN Q, RW gamma, DR omega per sample at input.rate_hz; GM sigma stationary, "
       "T in s; DR sign not identified by the WV (|omega|)";
@@ -227,6 +249,7 @@ void writeFitOutputs(const gm::RecordingFit& f, const std::string& input_json,
           << structureText(f) << ", seed " << f.options.seed;
   for (const auto& c : f.channels)  // what model.yaml alone would not say
     if (!c.slow_gm_note.empty()) comment << "\nnote, " << c.name << ": " << c.slow_gm_note;
+  if (const std::string u = unfittedNote(f); !u.empty()) comment << "\nnote: " << u;
   out.writeText("model.yaml", st::toYaml(f.model, comment.str()));
   out.writeText("fit.json", fitJson(f, input_json));
   for (int sensor = 0; sensor < 2; ++sensor) {
@@ -271,6 +294,7 @@ std::string fitSummary(const gm::RecordingFit& f) {
     std::string l;
     while (std::getline(lines, l)) os << "    " << l << "\n";
   }
+  if (const std::string u = unfittedNote(f); !u.empty()) os << "note: " << u << "\n";
   return os.str();
 }
 
