@@ -115,8 +115,8 @@ nlohmann::json inputSelectionJson(const InputOpts& o, const ImuSeries& s) {
   nlohmann::json j = nlohmann::json::object();
   if (!s.time_column.empty()) j["time_column"] = s.time_column;
   if (!s.time_unit.empty()) j["time_unit"] = s.time_unit;
-  if (o.start_s) j["start_s"] = *o.start_s;
-  if (o.end_s) j["end_s"] = *o.end_s;
+  if (o.start_s) j["start_s"] = *o.start_s + 0.0;  // + 0.0: --start -0 is recorded as 0
+  if (o.end_s) j["end_s"] = *o.end_s + 0.0;
   return j;
 }
 

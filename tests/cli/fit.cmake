@@ -86,6 +86,12 @@ navimpact_cli_check(cli_fit_window CHECK run_json
   DEFINES OUT=${_fdir}/window JSON_FILE=fit.json QUIET=1
   JSON "input/samples=^100000$" "input/start_s=^100(\\.0*)?$" "input/end_s=^1100(\\.0*)?$" "estimator/wv=^classical"
   FILES model.yaml)
+# --start -0 is the record's start, recorded as 0 (it was -0.0)
+navimpact_cli_check(cli_fit_window_minus_zero CHECK run_json
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --channels gyro_x
+       --start -0 --end 100 --out ${_fdir}/window0
+  DEFINES OUT=${_fdir}/window0 JSON_FILE=fit.json QUIET=1
+  JSON "input/samples=^10000$" "input/start_s=^0(\\.0*)?$")
 navimpact_cli_fail(cli_fit_start_beyond_record EXIT 1 NOOUT ${_fdir}/bad_start
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --start 3000 --out ${_fdir}/bad_start
   REGEX "^navimpact: .*adis16405_static_excerpt.csv.gz: --start 3000 s is not before the end of the record \\(the record has 262144 samples, 0 to 2621.44 s at 100 Hz\\)")
