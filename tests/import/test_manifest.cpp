@@ -436,6 +436,25 @@ TEST(ImportManifest, DataErrorsNameFileLineAndKey) {
       // an aiding stream wholly outside the IMU's time span (a time offset or unit gone wrong)
       {kImu, kGnss, std::string(kManifest) + "time_offset_s: {gnss: 10000}\n",
        "gnss.csv: no record of stream gnss lies within the IMU's time span [0, 0.03] s (it spans [10000, 10000.02] s"},
+      // ... or around it with none inside: the spans overlapping passed two fixes at -5 s and 30 s
+      {kImu, "t_s,lat,lon,h\n-5,46.5,6.6,400\n30,46.5,6.6,400\n", kManifest,
+       "gnss.csv: no record of stream gnss lies within the IMU's time span [0, 0.03] s (it spans [-5, 30] s"},
+      // a unit in the header that the manifest contradicts was read in the manifest's (deg/s taken as rad/s: 57x)
+      {replaced(kImu, "gx,", "gx[deg/s],"), kGnss, kManifest,
+       "imu.csv:1: column 'gx' is in deg/s by its header, but imu.gyro.unit says rad/s: correct the header or the manifest"},
+      {replaced(kImu, "t_s,", "t_s[ms],"), kGnss, kManifest, "imu.csv:1: column 't_s' is in ms by its header, but imu.time.unit says s"},
+      // one column named twice (also as "gx" and "gx[rad/s]": that read the time column as gy, or crashed)
+      {replaced(kImu, "gx,", "gx[rad/s],"), kGnss, replaced(kManifest, "[gx, gy, gz]", "[gx, \"gx[rad/s]\", gz]"),
+       "imu.csv:1: keys imu.gyro.columns[0] and imu.gyro.columns[1] name the same column 'gx[rad/s]'"},
+      {"idx,t_s,gx[rad/s],gy,gz,ax,ay,az\n1,0.00,0.1,0.2,0.3,0.1,0.2,9.8\n2,0.01,0.1,0.2,0.3,0.1,0.2,9.8\n", kGnss, replaced(kManifest, "[gx, gy, gz]", "[gx, \"gx[rad/s]\", gz]"),
+       "imu.csv:1: keys imu.gyro.columns[0] and imu.gyro.columns[1] name the same column"},
+      {kImu, kGnss, replaced(kManifest, "[ax, ay, az]", "[ax, ay, gz]"),
+       "imu.csv:1: keys imu.gyro.columns[2] and imu.acc.columns[2] name the same column 'gz'"},
+      // a time unit 1000x off: an IMU rate outside [1, 1e4] Hz, GNSS fixes faster than any receiver
+      {kImu, kGnss, replaced(kManifest, "{column: t_s, unit: s}", "{column: t_s, unit: ms}"),
+       "imu.csv:2: the time column 't_s' gives a rate of 100000 Hz, outside [1, 10000] Hz (is imu.time.unit right?)"},
+      {kImu, kGnss, replaced(kManifest, "  file: gnss.csv\n  time: {column: t_s, unit: s}", "  file: gnss.csv\n  time: {column: t_s, unit: ms}"),
+       "gnss.csv:2: the GNSS fixes come every 2e-05 s (median), faster than the 100 Hz of any receiver (is gnss.time.unit right?)"},
   };
   for (const auto& c : cases) {
     const std::string e = importError(c.manifest, c.imu, c.gnss);

@@ -42,7 +42,9 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
   header = headerText;
   const auto names = splitView(header, delimiter);
   const std::size_t ncol = names.size();
-  std::vector<int> slot(ncol, -1);
+  std::vector<int> slot(ncol, -1);             // the request that parses column c, -1 = not parsed
+  std::vector<std::size_t> colOf(req.size());  // the column of request r
+  std::vector<std::string> headerUnit(req.size());
   for (std::size_t r = 0; r < req.size(); ++r) {
     int at = -1;
     for (int pass = 0; pass < 2 && at < 0; ++pass)
@@ -63,14 +65,16 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
     if (at < 0)
       throw fileError(path, headerLine, "no column '" + printable(req[r].name) + "' (key " + req[r].key +
                                             ") in the header '" + printable(trim(header), 100) + "'");
-    if (slot[at] >= 0 && req[slot[at]].name != req[r].name) continue;
-    slot[at] = static_cast<int>(r);
+    // several requests may name one column, also as "x" and "x[unit]": the
+    // first parses it (a second name of it used to be mapped to column 0)
+    colOf[r] = static_cast<std::size_t>(at);
+    if (slot[at] < 0) slot[at] = static_cast<int>(r);
+    const std::string_view full = cleanName(names[at]);
+    if (const auto lb = full.find('['); lb != std::string_view::npos) {
+      const auto rb = full.find(']', lb);
+      headerUnit[r] = std::string(trim(full.substr(lb + 1, rb == std::string_view::npos ? std::string_view::npos : rb - lb - 1)));
+    }
   }
-  // several requests may name one column: map each request to its column
-  std::vector<std::size_t> colOf(req.size());
-  for (std::size_t r = 0; r < req.size(); ++r)
-    for (std::size_t c = 0; c < ncol; ++c)
-      if (slot[c] >= 0 && req[slot[c]].name == req[r].name) colOf[r] = c;
 
   // --- rows -----------------------------------------------------------------
   ColumnTable t;
@@ -119,6 +123,9 @@ ColumnTable readColumns(const std::string& path, const std::vector<ColumnRequest
     t.line.push_back(static_cast<std::uint32_t>(reader.lineNo()));
   }
   if (t.line.empty()) throw fileError(path, headerLine, "no data rows after the header");
+  t.header_line = headerLine;
+  t.header_unit = std::move(headerUnit);
+  t.column = colOf;
   t.columns.resize(req.size());
   for (std::size_t r = 0; r < req.size(); ++r) {
     std::size_t first = r;

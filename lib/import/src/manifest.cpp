@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <set>
 
 #include "navimpact/core/config.hpp"
@@ -81,6 +82,9 @@ struct Keys {
 // Streams
 // ---------------------------------------------------------------------------
 
+/// The shortest median step of a GNSS stream [s]: receivers give at most 100 Hz.
+constexpr double kMinGnssStepS = 0.01 * (1.0 - 1e-9);
+
 /// A stream's file, delimiter, time and gap rule.
 struct StreamSpec {
   std::string name;   // imu, gnss, baro, reference
@@ -89,6 +93,7 @@ struct StreamSpec {
   bool time_column = false;
   std::string column;
   double time_factor = 1.0;  // column unit -> s
+  std::string time_unit;     // the manifest's name of it
   double rate_hz = 0.0;
   double start_s = 0.0;
   double offset_s = 0.0;
@@ -117,10 +122,31 @@ StreamSpec streamSpec(const Keys& k, const ConfigNode& n, const std::string& nam
     s.time_column = true;
     s.column = k.text(t["column"], tk + ".column");
     const auto names = units::acceptedTimeUnits();
-    s.time_factor = units::secondsPer(names[k.oneOf(t["unit"], tk + ".unit", names)]);
+    s.time_unit = names[k.oneOf(t["unit"], tk + ".unit", names)];
+    s.time_factor = units::secondsPer(s.time_unit);
   }
   if (n["max_gap_s"]) s.max_gap_s = n["max_gap_s"].asNumber(limits::kDurationS);
   return s;
+}
+
+/// The unit the header of @p file writes for request @p i of @p tab (e.g.
+/// "gyro_x[deg/s]") must be the one the manifest's @p key tells, @p told:
+/// compared by their factors (@p factorOf, which throws for a unit it does not
+/// know). A header in deg/s under a manifest in rad/s was read 57x too large.
+void headerUnitAgrees(const std::string& file, const ColumnTable& tab, std::size_t i, const std::string& column,
+                      const std::string& key, const std::string& told,
+                      const std::function<double(const std::string&)>& factorOf) {
+  const std::string& hu = tab.header_unit.at(i);
+  if (hu.empty()) return;
+  bool same = false;
+  try {
+    same = factorOf(hu) == factorOf(told);
+  } catch (const Error&) {
+  }
+  if (!same)
+    throw fileError(file, tab.header_line, "column '" + printable(column) + "' is in " + printable(hu, 40) +
+                                               " by its header, but " + key + " says " + told +
+                                               ": correct the header or the manifest");
 }
 
 /// Times of a stream (file time * unit + offset), checked increasing and within the gap rule.
@@ -128,6 +154,8 @@ std::vector<double> streamTimes(const StreamSpec& s, const ColumnTable& tab, std
   const std::size_t n = tab.rows();
   std::vector<double> t(n);
   if (s.time_column) {
+    headerUnitAgrees(s.file, tab, timeCol, s.column, s.name + ".time.unit", s.time_unit,
+                     [](const std::string& u) { return units::secondsPer(u); });
     const auto& c = tab.columns[timeCol];
     for (std::size_t i = 0; i < n; ++i) t[i] = c[i] * s.time_factor + s.offset_s;
     // on the recording's axis (with time_offset_s) within the documented range of times
@@ -406,6 +434,8 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     std::size_t sc[2][3];
     double factor[2];
     bool increments[2];
+    std::string told[2];                                       // the manifest's unit or increments
+    std::function<double(const std::string&)> unitFactor[2];  // a unit of its kind -> SI
     const char* sensor[2] = {"gyro", "acc"};
     for (int q = 0; q < 2; ++q) {
       const std::string key = std::string("imu.") + sensor[q];
@@ -420,6 +450,8 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       if (!increments[q]) {
         const auto quantity = q == 0 ? units::Quantity::AngularRate : units::Quantity::SpecificForce;
         const std::string u = k.text(g["unit"], key + ".unit");
+        told[q] = u;
+        unitFactor[q] = [quantity](const std::string& x) { return units::toSiFactor(quantity, x); };
         try {
           factor[q] = units::toSiFactor(quantity, u);
         } catch (const Error& e) {
@@ -428,13 +460,35 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
       } else if (q == 0) {
         static const double f[] = {1.0, kDeg, 1e-3};
         factor[q] = f[k.oneOf(g["increments"], key + ".increments", {"rad", "deg", "mrad"})];
+        told[q] = k.text(g["increments"], key + ".increments");
+        unitFactor[q] = [](const std::string& x) {
+          if (x == "rad") return 1.0;
+          if (x == "deg") return kDeg;
+          if (x == "mrad") return 1e-3;
+          throw Error("not an angle increment");
+        };
       } else {
         factor[q] = 1.0;
         k.oneOf(g["increments"], key + ".increments", {"m/s"});
+        told[q] = "m/s";
+        unitFactor[q] = [](const std::string& x) {
+          if (x == "m/s") return 1.0;
+          throw Error("not a velocity increment");
+        };
       }
     }
     const Eigen::Matrix3d C_FtoB = axesMatrix(k, n["axes"], "imu.axes");
     const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
+    for (int a = 0; a < 6; ++a)  // six channels from six columns (a column named twice made a copied axis)
+      for (int b = 0; b < a; ++b)
+        if (tab.column[sc[a / 3][a % 3]] == tab.column[sc[b / 3][b % 3]])
+          throw fileError(s.file, tab.header_line, "keys " + r.req[sc[b / 3][b % 3]].key + " and " + r.req[sc[a / 3][a % 3]].key +
+                                                       " name the same column '" + printable(r.req[sc[a / 3][a % 3]].name) +
+                                                       "' (each axis needs its own column)");
+    for (int q = 0; q < 2; ++q)
+      for (int i = 0; i < 3; ++i)
+        headerUnitAgrees(s.file, tab, sc[q][i], r.req[sc[q][i]].name,
+                         std::string("imu.") + sensor[q] + (increments[q] ? ".increments" : ".unit"), told[q], unitFactor[q]);
     if (tab.rows() < 2) throw fileError(s.file, tab.line[0], "the IMU stream needs at least 2 samples");
     // the nominal step: the rate, or nominalStep() of the time steps (the default gap limit is 1.5 of it)
     std::vector<double> t;
@@ -451,6 +505,11 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     } else {
       d.imu_rate_hz = s.rate_hz;
     }
+    // the documented IMU rates (a time unit 1000x off gave a "200000 Hz" run that replay could not plot)
+    if (!(d.imu_rate_hz >= limits::kImuRateHz.lo && d.imu_rate_hz <= limits::kImuRateHz.hi))
+      throw fileError(s.file, tab.line[0], "the time column '" + printable(s.column) + "' gives a rate of " +
+                                               formatNumber(d.imu_rate_hz) + " Hz, outside " + limits::describe(limits::kImuRateHz) +
+                                               " (is imu.time.unit right?)");
     t = streamTimes(s, tab, tc);
     const double dtNominal = 1.0 / d.imu_rate_hz;
     d.imu.resize(tab.rows());
@@ -492,6 +551,15 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     }
     const ColumnTable tab = readColumns(s.file, r.req, s.delimiter);
     const std::vector<double> t = streamTimes(s, tab, tc);
+    // receivers give at most 100 fixes a second: a median step below 10 ms is
+    // a time unit gone wrong (seconds read as ms put 20 s of fixes into 20 ms)
+    if (t.size() >= 2) {
+      std::vector<double> steps(t.size() - 1);
+      for (std::size_t i = 1; i < t.size(); ++i) steps[i - 1] = t[i] - t[i - 1];
+      if (const double step = nominalStep(steps); step < kMinGnssStepS)
+        throw fileError(s.file, tab.line[0], "the GNSS fixes come every " + formatNumber(step) + " s (median), faster than " +
+                                                 "the 100 Hz of any receiver (is gnss.time.unit right?)");
+    }
     d.gnss.resize(tab.rows());
     for (std::size_t i = 0; i < tab.rows(); ++i) {
       GnssFix& f = d.gnss[i];
@@ -595,16 +663,17 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
   // --- every aiding stream overlaps the IMU's time span --------------------------
   {
     const double a = d.imu.front().t, b = d.imu.back().t;
-    auto overlaps = [&](const std::string& file, const char* key, double first, double last) {
-      if (last >= a && first <= b) return;
+    // a record inside the span, not spans that overlap (two fixes at -5 s and 30 s around a 20 s IMU passed)
+    auto overlaps = [&](const std::string& file, const char* key, const auto& recs) {
+      if (recs.empty() || std::any_of(recs.begin(), recs.end(), [&](const auto& x) { return x.t >= a && x.t <= b; })) return;
       throw fileError(file, 0, std::string("no record of stream ") + key + " lies within the IMU's time span [" +
                                    formatNumber(a, 10) + ", " + formatNumber(b, 10) + "] s (it spans [" +
-                                   formatNumber(first, 10) + ", " + formatNumber(last, 10) +
+                                   formatNumber(recs.front().t, 10) + ", " + formatNumber(recs.back().t, 10) +
                                    "] s: are the time units and time_offset_s right?)");
     };
-    if (!d.gnss.empty()) overlaps(rep.gnss_file, "gnss", d.gnss.front().t, d.gnss.back().t);
-    if (!d.baro.empty()) overlaps(rep.baro_file, "baro", d.baro.front().t, d.baro.back().t);
-    if (!d.reference.empty()) overlaps(rep.reference_file, "reference", d.reference.front().t, d.reference.back().t);
+    overlaps(rep.gnss_file, "gnss", d.gnss);
+    overlaps(rep.baro_file, "baro", d.baro);
+    overlaps(rep.reference_file, "reference", d.reference);
   }
 
   // --- time base --------------------------------------------------------------

@@ -27,6 +27,12 @@ struct ColumnRequest {
 struct ColumnTable {
   std::vector<std::vector<double>> columns;  ///< columns[i][row]
   std::vector<std::uint32_t> line;           ///< 1-based file line of each row
+  std::size_t header_line = 0;               ///< 1-based file line of the header
+  /// The unit the header writes in brackets for each request's column
+  /// ("deg/s" for "gyro_x[deg/s]"), "" when none: the caller checks it
+  /// against the unit it was told.
+  std::vector<std::string> header_unit;
+  std::vector<std::size_t> column;  ///< 0-based header column of each request (two names may be one column)
   std::size_t rows() const { return line.size(); }
 };
 
