@@ -46,6 +46,18 @@ _cov_bad(duplicate_set_name "model_file: ${_models}\n${_base}model_sets: [{name:
          "model_sets\\[1\\]\\.name.*'a' is used by an earlier model set")
 _cov_bad(negative_baro_sigma "model_file: ${_models}\n${_base}baro: {rate_hz: 10, sigma_m: -1}\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
          "baro\\.sigma_m.*must be in .0.0001, 10000. m, got -1")
+# rows every k-th IMU step (k whole) and summary times on those rows, in order: 3 Hz at 200 Hz
+# gave rows every 0.335 s and summary "5 s" at 4.69 s; a model twice in a set, its rows twice
+_cov_bad(output_rate_not_dividing "model_file: ${_models}\n${_base}imu_rate_hz: 200\noutput_rate_hz: 3\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
+         "key 'output_rate_hz': must divide imu_rate_hz = 200 Hz \\(a row every k-th IMU step, k whole\\), got 3 Hz$")
+_cov_bad(baro_rate_not_dividing "model_file: ${_models}\n${_base}imu_rate_hz: 200\nbaro: {rate_hz: 3, sigma_m: 0.01}\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
+         "key 'baro.rate_hz': must divide imu_rate_hz = 200 Hz")
+_cov_bad(summary_unordered "model_file: ${_models}\n${_base}summary_times_s: [2, 1]\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
+         "key 'summary_times_s': must increase strictly, got 1 s after 2 s$")
+_cov_bad(summary_off_rows "model_file: ${_models}\n${_base}output_rate_hz: 10\nsummary_times_s: [1.03]\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
+         "key 'summary_times_s': 1.03 s is not a time of the results \\(every 0.1 s from 0, or duration_s\\)$")
+_cov_bad(model_twice "model_file: ${_models}\n${_base}model_sets: [{name: a, models: [acc_ref, acc_ref]}]\n"
+         "model_sets\\[0\\]\\.models\\[1\\].*'acc_ref' is listed twice in this model set")
 # one value cannot make a run spin or exhaust memory: ranges at load, work budget before the run
 _cov_bad(huge_rate "model_file: ${_models}\n${_base}imu_rate_hz: 1e12\nmodel_sets: [{name: a, models: [acc_ref]}]\n"
          "key 'imu_rate_hz': must be in \\[1, 10000\\] Hz, got 1e\\+12")

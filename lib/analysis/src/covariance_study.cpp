@@ -1,6 +1,7 @@
 // Covariance analysis in static conditions (paper Figures 5 and 6).
 #include "navimpact/analysis/covariance_study.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -48,6 +49,14 @@ CovarianceStudyConfig loadCovarianceStudyConfig(const std::string& path) {
   return loadConfigFile(path, &CovarianceStudyConfig::source);
 }
 
+namespace {
+/// @p rate_hz is imu_rate_hz / k, k whole (to 1e-9).
+bool dividesImuRate(double rate_hz, double imu_rate_hz) {
+  const double k = imu_rate_hz / rate_hz;
+  return std::abs(k - std::round(k)) <= 1e-9 * k;
+}
+}  // namespace
+
 void CovarianceStudyConfig::loadFrom(const ConfigNode& root) {
   CovarianceStudyConfig& c = *this;
   const std::string& path = root.file();
@@ -65,6 +74,11 @@ void CovarianceStudyConfig::loadFrom(const ConfigNode& root) {
   root.read("imu_rate_hz", c.imu_rate_hz, limits::kImuRateHz);
   root.read("output_rate_hz", c.output_rate_hz, limits::kAidingRateHz);
   if (c.output_rate_hz > c.imu_rate_hz) throw root.error("output_rate_hz", "must not exceed imu_rate_hz");
+  // rows come every k-th IMU step, k whole: a rate that does not divide the
+  // IMU's gave rows every 0.335 s for 3 Hz at 200 Hz and moved the summary times
+  if (!dividesImuRate(c.output_rate_hz, c.imu_rate_hz))
+    throw root.error("output_rate_hz", "must divide imu_rate_hz = " + formatNumber(c.imu_rate_hz) +
+                                           " Hz (a row every k-th IMU step, k whole), got " + formatNumber(c.output_rate_hz) + " Hz");
   echo["duration_s"] = c.duration_s;
   echo["imu_rate_hz"] = c.imu_rate_hz;
   echo["output_rate_hz"] = c.output_rate_hz;
@@ -72,6 +86,16 @@ void CovarianceStudyConfig::loadFrom(const ConfigNode& root) {
   if (root.has("summary_times_s")) {
     c.summary_times_s.clear();
     root.read("summary_times_s", c.summary_times_s, limits::Range{0.0, c.duration_s, false, "s (within duration_s)"});
+    // each a row of the results (an output time, or the end), in increasing order
+    for (std::size_t i = 0; i < c.summary_times_s.size(); ++i) {
+      const double t = c.summary_times_s[i], k = t * c.output_rate_hz;
+      if (i > 0 && !(t > c.summary_times_s[i - 1]))
+        throw root.error("summary_times_s", "must increase strictly, got " + formatNumber(t) + " s after " +
+                                                formatNumber(c.summary_times_s[i - 1]) + " s");
+      if (std::abs(k - std::round(k)) > 1e-9 * std::max(1.0, k) && t != c.duration_s)
+        throw root.error("summary_times_s", formatNumber(t) + " s is not a time of the results (every " +
+                                                formatNumber(1.0 / c.output_rate_hz) + " s from 0, or duration_s)");
+    }
   }
   echo["summary_times_s"] = c.summary_times_s;
 
@@ -114,6 +138,9 @@ void CovarianceStudyConfig::loadFrom(const ConfigNode& root) {
     if (c.baro_rate_hz > 0.0) limits::check(path, b->keyPath("rate_hz"), c.baro_rate_hz, limits::kAidingRateHz);
     b->read("sigma_m", c.baro_sigma_m, limits::kPositionSigmaM);
     if (c.baro_rate_hz > c.imu_rate_hz) throw b->error("rate_hz", "must not exceed imu_rate_hz");
+    if (c.baro_rate_hz > 0.0 && !dividesImuRate(c.baro_rate_hz, c.imu_rate_hz))
+      throw b->error("rate_hz", "must divide imu_rate_hz = " + formatNumber(c.imu_rate_hz) +
+                                    " Hz (an update every k-th IMU step, k whole), got " + formatNumber(c.baro_rate_hz) + " Hz");
   }
   echo["baro"] = {{"rate_hz", c.baro_rate_hz}, {"sigma_m", c.baro_sigma_m}};
 
@@ -142,6 +169,8 @@ void CovarianceStudyConfig::loadFrom(const ConfigNode& root) {
     set.read("title", ms.title);
     for (const ConfigNode& m : set.list("models", 1, SIZE_MAX, "a non-empty list of model names")) {
       const std::string name = m.asText();
+      if (std::find(ms.models.begin(), ms.models.end(), name) != ms.models.end())
+        throw m.error("'" + name + "' is listed twice in this model set (its rows would appear twice)");
       try {
         (void)stochastic::loadImuModel(c.model_file + ":" + name);  // validates early
       } catch (const Error& e) {
@@ -238,7 +267,7 @@ CovarianceStudyResult runAlong(const CovarianceStudyConfig& cfg, long n, const N
         nominal(k, xk, w_B, f_B);
         ekf.predictCovariance(xk, w_B, f_B, dt);
         if (every_baro > 0 && k % every_baro == 0) ekf.update(dz0, ekf.H_baro(), Rb, /*feedback=*/false);
-        if (k % every_out == 0) record(k * dt);
+        if (k % every_out == 0 || k == n) record(k * dt);  // and the end, also off the output grid
       }
     } catch (const Error& e) {  // say which model of which set (the filter knows neither)
       throw Error(cfg.source + ": model set " + cm.model_set + ", model " + name + ": " + e.what());
