@@ -392,6 +392,7 @@ TEST(ImportManifest, ManifestErrorsNameTheKey) {
       {replaced(kManifest, "{column: t_s, unit: s}", "{column: t_s, unit: h}"), "key 'imu.time.unit'"},
       {std::string(kManifest) + "time_offset_s: {gnss: abc}\n", "key 'time_offset_s.gnss': must be a number in [-1e+06, 1e+06] s, got 'abc'"},
       {std::string(kManifest) + "gnss2: {}\n", "key 'gnss2': unknown key"},
+      {std::string(kManifest) + "time_offset_s: {baro: 1000}\n", "key 'time_offset_s.baro': the manifest has no baro stream"},
       {replaced(kManifest, "  file: gnss.csv\n", "  file: gnss.csv\n  lever_arm_m: [0, 0]\n"), "key 'gnss.lever_arm_m'"},
       {replaced(kManifest, "imu:", "imu: [\n"), "m.yaml:"},
   };

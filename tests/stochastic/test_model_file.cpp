@@ -136,6 +136,11 @@ TEST(ModelFile, ErrorsNameFileAndKey) {
   EXPECT_NE(errorOf([&] { loadImuModel(numeric); }).find("expected a model string"),
             std::string::npos);
 
+  // an empty value loaded as a perfect sensor; "none" says so on purpose
+  const auto empty = write("empty.yaml", "rate_hz: 200\ngyroscope: \"WN(sigma=1)\"\naccelerometer:\n");
+  EXPECT_NE(errorOf([&] { loadImuModel(empty); }).find("key 'accelerometer': is empty: write a model string"),
+            std::string::npos);
+
   EXPECT_NE(errorOf([] { loadImuModel("/nonexistent/x.yaml"); }).find("cannot open"),
             std::string::npos);
 }

@@ -117,6 +117,8 @@ TEST(ModelText, ErrorsNamePositionExpectedAndFound) {
   EXPECT_EQ(parseError("WN(sigma=)"),
             "model 'WN(sigma=)': at position 10: expected a number, found ')'");
   EXPECT_NE(parseError("WN(sigma=inf)").find("expected a finite number"), std::string::npos);
+  // decimal only: strtod took hex, so sigma=0x10 loaded as 16
+  EXPECT_EQ(parseError("WN(sigma=0x10)"), "model 'WN(sigma=0x10)': at position 10: expected a number, found '0x10'");
   // missing parentheses
   EXPECT_EQ(parseError("WN sigma=1"),
             "model 'WN sigma=1': at position 4: expected '(' after WN, found 'sigma'");

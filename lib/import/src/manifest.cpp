@@ -390,7 +390,11 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
     k.map(o, "time_offset_s", {"imu", "gnss", "baro", "reference"});
     const char* names[] = {"imu", "gnss", "baro", "reference"};
     for (int i = 0; i < 4; ++i)
-      if (o[names[i]]) offset[i] = k.number(o[names[i]], std::string("time_offset_s.") + names[i], -1e6, 1e6, "s");
+      if (o[names[i]]) {
+        if (!root[names[i]])  // an offset for a stream the run lacks was ignored without a word
+          throw k.err(std::string("time_offset_s.") + names[i], std::string("the manifest has no ") + names[i] + " stream");
+        offset[i] = k.number(o[names[i]], std::string("time_offset_s.") + names[i], -1e6, 1e6, "s");
+      }
   }
   const bool timeBaseKnown = static_cast<bool>(root["time_zero_unix_s"]);
   // its whole seconds and their fraction, exactly as written ("1448546404.917"):

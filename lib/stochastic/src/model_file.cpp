@@ -42,7 +42,8 @@ ImuModel readModel(const ConfigNode& node, double default_rate) {
 
   auto parseAt = [&](const std::string& key) {
     const ConfigNode v = node.child(key);
-    if (v.isNull()) return std::vector<Process>{};
+    // an empty value (`accelerometer:`) loaded as a perfect sensor without a word
+    if (v.isNull()) throw node.error(key, "is empty: write a model string such as \"WN(sigma=1e-3)\", or \"none\" for no error");
     if (!v.isScalar()) throw node.error(key, "expected a model string such as \"WN(sigma=1e-3)\"");
     try {
       return parseTerms(v.asText(), m.rate_hz);

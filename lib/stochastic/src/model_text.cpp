@@ -12,6 +12,7 @@
 
 #include "kind.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/text_io.hpp"
 #include "navimpact/core/limits.hpp"
 #include "navimpact/stochastic/process_kind.hpp"
 
@@ -118,7 +119,7 @@ class Parser {
     return id;
   }
 
-  /// A finite number (strtod syntax); the whole token up to a delimiter must parse.
+  /// A finite decimal number; the whole token up to a delimiter must parse.
   double number() {
     skipWs();
     const std::size_t start = i_;
@@ -131,10 +132,9 @@ class Parser {
     }
     const std::string tok = s_.substr(start, j - start);
     if (tok.empty()) failHere("a number");
-    errno = 0;
-    char* end = nullptr;
-    const double v = std::strtod(tok.c_str(), &end);
-    if (end != tok.c_str() + tok.size()) fail(start, "a number", "'" + printable(tok, 40) + "'");
+    // decimal only (std::from_chars): strtod also took hex, so sigma=0x10 was 16
+    double v = 0.0;
+    if (!parseDouble(tok, v)) fail(start, "a number", "'" + printable(tok, 40) + "'");
     if (!std::isfinite(v)) fail(start, "a finite number", "'" + printable(tok, 40) + "'");
     i_ = j;
     return v;
