@@ -108,6 +108,13 @@ TEST(SweepConfig, EveryBadKeyIsNamed) {
   expectError(load(baseYaml("sweep: {outage: {start_s: 6, durations_s: [5]}, gnss: [{name: a, sigma_pos_h_m: 0}]}\n")),
               "sweep.gnss[0].sigma_pos_h_m");
   expectError(load(baseYaml("sweep: {outage: {start_s: 6, durations_s: [5]}, baro: [maybe]}\n")), "sweep.baro[0]");
+  // a "95 %" interval of one resample; an IMU rate below the record rates (epochs fall on samples)
+  expectError(load(baseYaml("sweep: {outage: {start_s: 6, durations_s: [5]}, bootstrap: 1}\n")),
+              "key 'sweep.bootstrap': must be 0 or at least 39 resamples");
+  expectError(load(baseYaml("record: {rate_hz: 10, outage_rate_hz: 50}\nsweep: {outage: {start_s: 6, durations_s: [5]}, imu_rate_hz: [100, 20]}\n")),
+              "sweep.imu_rate_hz[1]");
+  expectError(load(baseYaml("record: {outage_rate_hz: 500}\nsweep: {outage: {start_s: 6, durations_s: [5]}}\n")),
+              "key 'record.outage_rate_hz': must not exceed imu.rate_hz (100 Hz)");
   expectError(load(baseYaml("sweep: {outage: {start_s: 6, durations_s: [5]}}\n", "1")), "monte_carlo.runs");
   // Outage past the trajectory: refused before any run, naming the column.
   const auto cfg = an::loadSweepConfig(writeConfig(baseYaml("sweep: {outage: {start_s: 90, durations_s: [5, 20]}}\n")));

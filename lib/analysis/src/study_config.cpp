@@ -7,6 +7,7 @@
 #include "navimpact/analysis/study.hpp"
 #include "navimpact/core/config.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/format.hpp"
 #include "navimpact/core/limits.hpp"
 #include "navimpact/core/text_io.hpp"
 #include "navimpact/core/units.hpp"
@@ -172,6 +173,10 @@ void StudyConfig::loadFrom(const ConfigNode& root, const std::vector<std::string
     r->allowKeys({"rate_hz", "outage_rate_hz"});
     r->read("rate_hz", record_rate_hz, limits::kAidingRateHz);
     r->read("outage_rate_hz", outage_record_rate_hz, limits::kAidingRateHz);
+    // epochs fall on IMU samples: a faster record was recorded at the IMU rate without a word
+    if (record_rate_hz > imu_rate_hz) throw r->error("rate_hz", "must not exceed imu.rate_hz (" + formatNumber(imu_rate_hz) + " Hz)");
+    if (outage_record_rate_hz > imu_rate_hz)
+      throw r->error("outage_rate_hz", "must not exceed imu.rate_hz (" + formatNumber(imu_rate_hz) + " Hz)");
   }
   if (const auto r = root.optMap("report")) {
     r->allowKeys({"margin", "plot_before_s", "plot_after_s"});

@@ -1,4 +1,5 @@
 // Sweep configuration: a study config plus a `sweep:` block with the axes.
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -84,6 +85,9 @@ SweepConfig loadSweepConfig(const std::string& path) {
       const double v = r.asNumber(limits::kImuRateHz);
       for (double x : cfg.imu_rates_hz)
         if (x == v) throw r.error("repeated");
+      if (v < std::max(cfg.study.record_rate_hz, cfg.study.outage_record_rate_hz))
+        throw r.error("must not be below the study's record rates (record.rate_hz, record.outage_rate_hz: " +
+                      formatNumber(std::max(cfg.study.record_rate_hz, cfg.study.outage_record_rate_hz)) + " Hz)");
       cfg.imu_rates_hz.push_back(v);
     }
   } else {
@@ -91,6 +95,10 @@ SweepConfig loadSweepConfig(const std::string& path) {
   }
   sw.read("alpha", cfg.alpha, kAlpha);
   sw.read("bootstrap", cfg.bootstrap, 0, 100000);
+  // (B + 1) 0.025 >= 1 for a 95 % percentile interval (Davison & Hinkley 5.2.2): with 1 it was one value twice
+  if (cfg.bootstrap > 0 && cfg.bootstrap < static_cast<std::size_t>(limits::kMinBootstrap))
+    throw keyError(path, "sweep.bootstrap", "must be 0 or at least " + std::to_string(limits::kMinBootstrap) +
+                                               " resamples (a 95 % percentile interval needs them), got " + std::to_string(cfg.bootstrap));
   if (!(cfg.study.margin >= 0.0 && cfg.study.margin <= 1.0))
     throw keyError(path, "report.margin", "must be in [0, 1] for a sweep (a relative margin)");
   return cfg;

@@ -173,6 +173,11 @@ void checkBudget(const std::initializer_list<BudgetEstimate>& estimates, bool al
  */
 unsigned budgetWorkers(double most, double samples, double fixed_bytes_per_sample, double worker_bytes_per_sample);
 
+/// Fewest bootstrap resamples or replicates: a 95 % percentile interval needs
+/// (B + 1) * 0.025 >= 1 so that its ends are order statistics inside the
+/// resamples (Davison & Hinkley 1997, section 5.2.2: B = 39 is the smallest).
+inline constexpr int kMinBootstrap = 39;
+
 /// Text of a range, e.g. "(0, 1e+04] m".
 std::string describe(const Range& r);
 

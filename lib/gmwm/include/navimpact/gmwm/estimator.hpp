@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "navimpact/core/limits.hpp"
 #include "navimpact/gmwm/wavelet_variance.hpp"
 #include "navimpact/stochastic/process.hpp"
 
@@ -54,12 +55,9 @@ enum class Weighting {
   Efficient,
 };
 
-/// Fewest parametric bootstrap replicates: a 95 % percentile interval needs
-/// (B + 1) * 0.025 >= 1 so that its ends are order statistics inside the
-/// replicates (Davison & Hinkley 1997, section 5.2.2: B = 39 is the smallest);
-/// with 5 the "95 %" interval was nearly the range of 5 values and could exclude
-/// the estimate.
-inline constexpr int kMinBootstrap = 39;
+/// Fewest parametric bootstrap replicates (limits::kMinBootstrap); with 5 the
+/// "95 %" interval was nearly the range of 5 values and could exclude the estimate.
+inline constexpr int kMinBootstrap = limits::kMinBootstrap;
 
 struct FitOptions {
   Weighting weighting = Weighting::Fast;  ///< see Weighting
