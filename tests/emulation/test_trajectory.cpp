@@ -99,6 +99,14 @@ TEST(Trajectory, BadInputNamesFileAndLine) {
   for (int i = 0; i < 10; ++i) lat += std::to_string(i * 0.01) + (i == 2 ? ",1e300" : ",0.8") + ",0.1,500,0,0,0\n";
   geo.file = writeCsv("lat.csv", lat);
   EXPECT_EQ(errorOf(geo), geo.file + ":4: column 'lat_rad': 1e+300 (5.72958e+301 deg) is out of [-89.9, 89.9] deg");
+  // a column twice in the header, or one column for two quantities: one of them was taken without a word
+  std::string dup = "time_s,lat_rad,lon_rad,alt_m,roll_rad,pitch_rad,yaw_rad,lat_rad\n";
+  for (int i = 0; i < 10; ++i) dup += std::to_string(i * 0.01) + ",0.8,0.1,500,0,0,0,0.2\n";
+  geo.file = writeCsv("dup.csv", dup);
+  EXPECT_EQ(errorOf(geo), geo.file + ":1: column 'lat_rad' appears more than once in the header");
+  geo.file = writeCsv("ok3.csv", lat);
+  geo.col_lon = "lat_rad";
+  EXPECT_EQ(errorOf(geo), geo.file + ":1: column 'lat_rad' is named for two quantities (trajectory.columns: each needs its own)");
 }
 
 // The window's keys name the configuration that gave them (the CSV alone was

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <set>
 #include <algorithm>
 
 #include <Eigen/Geometry>
@@ -67,7 +68,9 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
   const std::string_view header(headerText);
   const auto names = splitView(header, ',');
   std::map<std::string, int> colIndex;
-  for (std::size_t i = 0; i < names.size(); ++i) colIndex[std::string(trim(names[i]))] = int(i);
+  std::set<std::string> twice;  // a name in the header more than once: which one is meant?
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (!colIndex.emplace(std::string(trim(names[i])), int(i)).second) twice.insert(std::string(trim(names[i])));
   const std::vector<std::string> want =
       geo ? std::vector<std::string>{spec.col_time, spec.col_lat, spec.col_lon, spec.col_height,
                                      spec.col_roll, spec.col_pitch, spec.col_yaw}
@@ -78,6 +81,11 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
     auto it = colIndex.find(want[k]);
     if (it == colIndex.end())
       throw fileError(path, 1, "column '" + want[k] + "' not found in the header (set it in trajectory.columns)");
+    if (twice.count(want[k]))
+      throw fileError(path, 1, "column '" + printable(want[k]) + "' appears more than once in the header");
+    for (int j = 0; j < k; ++j)
+      if (want[j] == want[k])
+        throw fileError(path, 1, "column '" + printable(want[k]) + "' is named for two quantities (trajectory.columns: each needs its own)");
     idx[k] = it->second;
   }
 
