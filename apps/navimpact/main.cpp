@@ -7,6 +7,8 @@
 //   0 success; 1 bad input, configuration or a refused budget (navimpact::Error,
 //   and parse errors of yaml-cpp); 2 command line not understood (CLI11);
 //   3 out of memory; 4 internal error (a bug: please report it).
+#include <signal.h>
+
 #include <algorithm>
 #include <iostream>
 #include <new>
@@ -15,6 +17,7 @@
 #include "cli_common.hpp"
 #include "navimpact/core/build_info.hpp"
 #include "navimpact/core/error.hpp"
+#include "navimpact/core/output.hpp"
 
 namespace {
 
@@ -24,6 +27,26 @@ int fail(int code, const std::string& msg) {
   std::cout.flush();
   std::cerr << navimpact::oneLine("navimpact: " + msg) << "\n";
   return code;
+}
+
+/// SIGINT, SIGTERM, SIGHUP: remove the staging folders of the live jobs, then
+/// die of the signal as before (exit status 128 + signal for the shell).
+extern "C" void onTerminate(int sig) {
+  navimpact::removeLiveStaging();
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+void cleanUpOnTermination() {
+  struct sigaction sa {};
+  sa.sa_handler = onTerminate;
+  sigemptyset(&sa.sa_mask);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    // a signal the caller ignores (nohup) stays ignored
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &sa, nullptr);
+  }
 }
 
 /// The input being processed when a non-navimpact exception left it, or the command.
@@ -51,6 +74,7 @@ std::string yamlLocation(const std::string& what) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  cleanUpOnTermination();
   CLI::App app{"navimpact — IMU error models judged by their impact on GNSS/INS navigation"};
   std::string version = std::string("navimpact ") + NAVIMPACT_VERSION + "\nbuilt with:";
   for (const auto& [name, ver] : navimpact::buildVersions())

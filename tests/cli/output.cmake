@@ -31,3 +31,16 @@ navimpact_cli_check(cli_reproducible_diagnose_run CHECK reproducible
   ARGS diagnose --run ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog
        --model ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref --durations 20 --reconverge 30
        --realisations 4 --folds 3 --out @OUT@)
+
+# A run killed by SIGTERM removes its staging folder before it dies (it stayed
+# until the next run in that folder): once the staging folder exists, TERM; the
+# exit status must say the signal ended it (128 + 15) and no staging folder remains.
+set(_sig ${CMAKE_CURRENT_BINARY_DIR}/output_signal)
+add_test(NAME cli_output_killed_run_removes_its_staging
+  COMMAND bash -c "rm -rf '${_sig}'; mkdir -p '${_sig}' || exit 1; \
+'$<TARGET_FILE:navimpact>' fit --input '${CMAKE_SOURCE_DIR}/datasets/adis16405_static_excerpt.csv.gz' --rate 100 \
+--gyro-unit deg/s --acc-unit g --structure WN+GM+GM+DR --bootstrap 2000 --allow-large --out '${_sig}/o' >/dev/null 2>&1 & \
+pid=$!; for i in $(seq 1 600); do ls -A '${_sig}' | grep -q navimpact-staging && break; sleep 0.05; done; \
+ls -A '${_sig}' | grep -q navimpact-staging || { echo 'no staging folder appeared'; exit 1; }; \
+kill -TERM $pid; wait $pid; rc=$?; [ $rc -eq 143 ] || { echo \"exit status $rc, not 143\"; exit 1; }; \
+left=$(ls -A '${_sig}'); [ -z \"$left\" ] || { echo \"left behind: $left\"; exit 1; }")

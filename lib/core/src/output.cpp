@@ -5,9 +5,12 @@
 #include <stdio.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <cstdint>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -66,6 +69,72 @@ std::string unremovableIn(const fs::path& folder) {
   return {};
 }
 
+// The staging folders of this process's live jobs, for removeLiveStaging()
+// (a signal handler): fixed slots of plain bytes, a slot published by its flag.
+constexpr int kLiveSlots = 32;
+constexpr std::size_t kLivePathMax = 4096;
+char g_livePath[kLiveSlots][kLivePathMax];
+std::atomic<bool> g_liveUsed[kLiveSlots];
+
+int registerLive(const fs::path& p) noexcept {
+  const std::string& s = p.native();
+  if (s.size() >= kLivePathMax) return -1;
+  for (int i = 0; i < kLiveSlots; ++i) {
+    bool expected = false;
+    if (!g_liveUsed[i].load() && g_liveUsed[i].compare_exchange_strong(expected, true)) {
+      g_livePath[i][0] = '\0';  // written, then published below
+      std::memcpy(g_livePath[i], s.c_str(), s.size() + 1);
+      std::atomic_thread_fence(std::memory_order_release);
+      return i;
+    }
+  }
+  return -1;  // more than 32 at once: the next run in the folder removes it
+}
+
+void unregisterLive(int slot) noexcept {
+  if (slot >= 0) {
+    g_livePath[slot][0] = '\0';
+    g_liveUsed[slot].store(false);
+  }
+}
+
+/// Remove the entries of the folder open at @p fd, then close it; a folder
+/// inside is emptied the same way (staging folders are at most two levels
+/// deep). Only async-signal-safe calls (getdents64, unlinkat, openat, lseek).
+void emptyFolderFd(int fd, int depth) noexcept {
+  struct Dirent64 {
+    std::uint64_t d_ino;
+    std::int64_t d_off;
+    unsigned short d_reclen;
+    unsigned char d_type;
+    char d_name[1];
+  };
+  alignas(8) char buf[4096];
+  for (int pass = 0; pass < 1000; ++pass) {  // entries removed while listing: list again from the start
+    if (::lseek(fd, 0, SEEK_SET) != 0) break;
+    bool removed = false;
+    for (;;) {
+      const long n = ::syscall(SYS_getdents64, fd, buf, sizeof buf);
+      if (n <= 0) break;
+      for (long off = 0; off < n;) {
+        const auto* d = reinterpret_cast<const Dirent64*>(buf + off);
+        off += d->d_reclen;
+        const char* name = d->d_name;
+        if (name[0] == '.' && (name[1] == '\0' || (name[1] == '.' && name[2] == '\0'))) continue;
+        if (::unlinkat(fd, name, 0) == 0) {
+          removed = true;
+        } else if (errno == EISDIR && depth > 0) {
+          const int sub = ::openat(fd, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+          if (sub >= 0) emptyFolderFd(sub, depth - 1);
+          if (::unlinkat(fd, name, AT_REMOVEDIR) == 0) removed = true;
+        }
+      }
+    }
+    if (!removed) break;
+  }
+  ::close(fd);
+}
+
 std::mutex g_inputsMutex;
 std::set<fs::path>& inputs() {
   static std::set<fs::path> s;
@@ -116,6 +185,16 @@ bool lockedByLiveJob(const fs::path& p) {
 }
 
 }  // namespace
+
+void removeLiveStaging() noexcept {
+  std::atomic_thread_fence(std::memory_order_acquire);
+  for (int i = 0; i < kLiveSlots; ++i) {
+    if (!g_liveUsed[i].load() || g_livePath[i][0] == '\0') continue;
+    const int fd = ::open(g_livePath[i], O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd >= 0) emptyFolderFd(fd, 2);
+    ::rmdir(g_livePath[i]);
+  }
+}
 
 void noteInput(const fs::path& path) {
   std::error_code ec;
@@ -242,6 +321,7 @@ OutputSet::OutputSet(fs::path dest, Overwrite ow, Kind kind) : dest_(std::move(d
     stagingFd_ = ::open(staging_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (stagingFd_ < 0 || ::flock(stagingFd_, LOCK_EX | LOCK_NB) != 0)
       throw Error(staging_.string() + ": cannot lock the staging folder (" + std::strerror(errno) + ")");
+    liveSlot_ = registerLive(staging_);
   } catch (...) {
     if (!staging_.empty()) {
       fs::remove_all(staging_, ec);
@@ -259,6 +339,7 @@ OutputSet::OutputSet(OutputSet&& o) noexcept
       target_(std::move(o.target_)),
       staging_(std::move(o.staging_)),
       stagingFd_(o.stagingFd_),
+      liveSlot_(o.liveSlot_),
       createdParents_(std::move(o.createdParents_)),
       names_(std::move(o.names_)),
       ow_(o.ow_),
@@ -267,6 +348,7 @@ OutputSet::OutputSet(OutputSet&& o) noexcept
       mayReplaceInput_(o.mayReplaceInput_) {
   o.staging_.clear();
   o.stagingFd_ = -1;
+  o.liveSlot_ = -1;
   o.createdParents_.clear();
   o.committed_ = true;
 }
@@ -281,6 +363,8 @@ OutputSet::~OutputSet() {
 }
 
 void OutputSet::releaseStaging() noexcept {
+  unregisterLive(liveSlot_);
+  liveSlot_ = -1;
   if (stagingFd_ >= 0) ::close(stagingFd_);  // and its lock
   stagingFd_ = -1;
 }

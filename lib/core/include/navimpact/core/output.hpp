@@ -43,6 +43,12 @@ namespace navimpact {
 /// file): Overwrite::Replace refuses a destination that holds one. Thread-safe.
 void noteInput(const std::filesystem::path& path);
 
+/// Remove the staging folders of this process's live jobs (and their files),
+/// for an application's SIGINT/SIGTERM handler before it dies: async-signal-
+/// safe (system calls only). Without it a killed run's staging folder stays
+/// until the next run in that folder removes it.
+void removeLiveStaging() noexcept;
+
 /// What to do when the destination exists and is not empty.
 enum class Overwrite { Refuse, Replace };
 
@@ -96,6 +102,7 @@ class OutputSet {
   std::filesystem::path target_;  ///< absolute, normalised (file operations)
   std::filesystem::path staging_;
   int stagingFd_ = -1;  ///< the staging folder, open and flock()ed while the job lives
+  int liveSlot_ = -1;   ///< its slot among the live staging folders (removeLiveStaging), -1: none
   std::vector<std::filesystem::path> createdParents_;  ///< folders we created, deepest last
   std::vector<std::string> names_;
   Overwrite ow_ = Overwrite::Refuse;
