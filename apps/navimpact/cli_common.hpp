@@ -76,8 +76,8 @@ CLI::Validator seedValue();
 /// the brackets (diagnose --simulations, fit --bootstrap).
 CLI::Validator zeroOrAtLeast(double min, std::string why);
 
-/// A robust WV efficiency --eff: a number the biweight reaches (about
-/// 0.0124 .. 0.999985, gmwm::checkRobustEfficiency); 0.9999999 passed a (0, 1)
+/// A robust WV efficiency --eff: a number the biweight reaches (0.05 ..
+/// 0.999985, gmwm::checkRobustEfficiency); 0.9999999 passed a (0, 1)
 /// check and failed after the file was read, blaming the file.
 CLI::Validator robustEfficiency();
 

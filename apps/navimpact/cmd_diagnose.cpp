@@ -259,7 +259,7 @@ navimpact::cli::Registrar reg(
            ->required();
        auto* robust = app.add_flag("--robust", o->robust,
                                    "with fit:SPEC: robust GMWM (fit the robust WV, Tukey biweight)");
-       app.add_option("--eff", o->eff, "--robust: efficiency of the robust WV at the Gaussian, in [0.0124, 0.99998]")
+       app.add_option("--eff", o->eff, "--robust: efficiency of the robust WV at the Gaussian, in [0.05, 0.99998]")
            ->capture_default_str()
            ->check(navimpact::cli::robustEfficiency())
            ->needs(robust);

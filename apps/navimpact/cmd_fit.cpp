@@ -111,7 +111,7 @@ navimpact::cli::Registrar reg({
       auto* robust = app.add_flag("--robust", o->fit.robust,
                    "robust GMWM: replace isolated spikes, then fit the robust WV (Tukey biweight M-scale, "
                    "Guerrier, Molinari & Victoria-Feser 2014) with its own CI and weights; for records with outliers");
-      app.add_option("--eff", o->fit.eff, "--robust: efficiency of the robust WV at the Gaussian, in [0.0124, 0.99998]")
+      app.add_option("--eff", o->fit.eff, "--robust: efficiency of the robust WV at the Gaussian, in [0.05, 0.99998]")
           ->capture_default_str()
           ->check(navimpact::cli::robustEfficiency())
           ->needs(robust);

@@ -61,7 +61,7 @@ navimpact::cli::Registrar reg({"wv",
                                  auto* robust = app.add_flag("--robust", o->robust,
                                               "robust WV (Tukey biweight M-estimator of scale)");
                                  app.add_option("--eff", o->eff,
-                                                "--robust: efficiency of the robust estimator at the Gaussian, in [0.0124, 0.99998]")
+                                                "--robust: efficiency of the robust estimator at the Gaussian, in [0.05, 0.99998]")
                                      ->capture_default_str()
                                      ->check(navimpact::cli::robustEfficiency())
                                      ->needs(robust);

@@ -71,7 +71,7 @@ wv_expect_fail(rawlog_label
                --input ${CMAKE_SOURCE_DIR}/tests/data/imu_label_xsens.rawlog)
 # --eff is checked against what the biweight reaches before the file is read
 # (0.9999999 passed a (0, 1) check and failed late, blaming the file), and needs --robust
-wv_expect_fail(eff_unreachable "^navimpact: --eff: robust wavelet variance: efficiency 0\\.9999999 is outside what the biweight reaches \\(0\\.01237 \\.\\. 0\\.999985, .*\\) \\(see 'navimpact wv --help'\\)$"
+wv_expect_fail(eff_unreachable "^navimpact: --eff: robust wavelet variance: efficiency 0\\.9999999 is outside what the biweight reaches \\(0\\.05 \\.\\. 0\\.999985, .*\\) \\(see 'navimpact wv --help'\\)$"
                --input ${_wv_data} ${_u} --robust --eff 0.9999999)
 wv_expect_fail(eff_without_robust "^navimpact: --eff requires --robust \\(see 'navimpact wv --help'\\)$"
                --input ${_wv_data} ${_u} --eff 0.9)

@@ -58,9 +58,17 @@ double biweightEfficiency(double c) {
   return 0.5 * m * m / q;
 }
 
-constexpr double kTuningLo = 0.05, kTuningHi = 60.0;  // bracket of the tuning constant c
+// Bracket of the tuning constant c. eff(c) is not monotone: it vanishes at
+// c0 ~ 2.42, where E[Z chi'(Z)] = E[(Z^2 - 1) chi(Z)] changes sign, and has a
+// second branch below it (0.23 at c ~ 1). Below c0 the Gaussian root t = 1 of
+// mean chi(t x) = a lies beyond the maximum of the scale equation, not on its
+// rising branch where robustScale looks: --eff 0.03 gave c on that branch and a
+// WV 2e4 times too large. So c >= 2.5, where eff increases with c, and the
+// efficiencies accepted start at kMinEfficiency.
+constexpr double kTuningLo = 2.5, kTuningHi = 60.0;
+constexpr double kMinEfficiency = 0.05;  // c ~ 2.77
 
-/// Tuning constant c with biweightEfficiency(c) = eff (eff increases with c).
+/// Tuning constant c with biweightEfficiency(c) = eff (eff increases with c on the bracket).
 double biweightConstant(double eff) {
   checkRobustEfficiency(eff);  // an efficiency the bracket does not reach is an input error, not the solver's exception
   boost::uintmax_t it = 200;
@@ -83,10 +91,11 @@ double scaleEquation(const double* x, std::size_t m, double t, double c, double 
 }  // namespace
 
 void checkRobustEfficiency(double eff) {
-  static const double lo = biweightEfficiency(kTuningLo), hi = biweightEfficiency(kTuningHi);
-  if (!(eff >= lo && eff <= hi))
+  static const double hi = biweightEfficiency(kTuningHi);
+  if (!(eff >= kMinEfficiency && eff <= hi))
     throw Error("robust wavelet variance: efficiency " + formatNumber(eff, 10) + " is outside what the biweight reaches (" +
-                formatNumber(lo, 4) + " .. " + formatNumber(hi, 6) + ", tuning constants 0.05 .. 60)");
+                formatNumber(kMinEfficiency, 4) + " .. " + formatNumber(hi, 6) +
+                ", tuning constants 2.77 .. 60; below, its scale equation has no consistent root where it is solved)");
 }
 
 namespace detail {

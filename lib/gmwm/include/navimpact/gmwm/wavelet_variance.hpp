@@ -74,7 +74,9 @@ WaveletVariance robustWaveletVariance(const double* x, std::size_t n, double rat
 
 /**
  * The efficiencies the biweight reaches with tuning constants c in
- * [0.05, 60] (about 0.0124 .. 0.999985): what robustWaveletVariance accepts.
+ * [2.77, 60] (0.05 .. 0.999985): what robustWaveletVariance accepts. Smaller
+ * c (below c0 ~ 2.42 the efficiency rises again) put the Gaussian root of the
+ * scale equation on the branch that is not solved: the WV came out 1e4-1e5 too large.
  * @throws navimpact::Error "efficiency E is outside what the biweight reaches
  *         (lo .. hi)" for any other @p eff (NaN included); a CLI checks --eff
  *         with it before reading a file.
