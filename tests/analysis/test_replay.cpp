@@ -100,6 +100,30 @@ std::string errorOf(const an::ReplayConfig& c) {
   return navimpact::test::errorOf([&] { an::runReplay(c); });
 }
 
+/// @p c (one explicit outage besides a pattern) as it is, or, where the
+/// pattern lays a window over the explicit outage (the replay refuses that:
+/// checked here), with the explicit outage moved into the GNSS time before
+/// the first window (period - duration after the filter start). The windows come from the replay of the pattern alone (the filter
+/// start does not depend on the outages).
+an::ReplayConfig laidApart(an::ReplayConfig c) {
+  an::ReplayConfig alone = c;
+  alone.outages.clear();
+  alone.outage_names.clear();
+  const auto windows = an::runReplay(alone).cfg.outages;
+  const navimpact::Outage o = c.outages.at(0);
+  for (const auto& w : windows)
+    if (w.start_s < o.end_s && o.start_s < w.end_s) {
+      const std::string e = errorOf(c);
+      EXPECT_NE(e.find("overlaps the outage " + navimpact::outageText(o) + " given by itself"), std::string::npos) << e;
+      const double gap = c.outages_every->period_s - c.outages_every->duration_s;
+      c.outages = {navimpact::Outage::fromStartDuration(windows.front().start_s - 0.7 * gap, std::min(o.duration_s(), 0.4 * gap))};
+      c.outage_names.clear();
+      std::printf("  the explicit outage overlaps a window: moved to %s\n", navimpact::outageText(c.outages[0]).c_str());
+      return c;
+    }
+  return c;
+}
+
 }  // namespace
 
 TEST(Replay, PerfectImuStaysWithinItsPredictedSigmaThroughAnOutage) {
@@ -685,7 +709,7 @@ TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) 
   for (const PatternDraw& d : drawPatterns(3, 30.0, 0.0, 40.0, "explicit 5 s outage from [s]")) {
     for (const auto& path : {withGt, noGt}) {
       SCOPED_TRACE(path + " " + d.trace);
-      const an::ReplayConfig c = patternReplay(path, navimpact::Outage::fromStartDuration(d.value, 5.0), d.pattern);
+      const an::ReplayConfig c = laidApart(patternReplay(path, navimpact::Outage::fromStartDuration(d.value, 5.0), d.pattern));
       const an::ReplayResult whole = an::runReplay(c);
       std::ostringstream csv;
       navimpact::report::ReplayWriter writer(csv);
@@ -706,6 +730,33 @@ TEST(Replay, StreamedReplayWritesWhatTheWholeResultWritesAndLaysTheSameOutages) 
   }
 }
 
+// An outage given by itself (--outage, outages:) and the pattern's
+// (--outages-every, outages_every:) may be combined, but one GNSS gap is laid
+// once: an explicit outage over a window of the pattern is refused naming both
+// (it was scored twice: 7 outages, two the same 15 s from 25 s); one between
+// the windows is scored beside them. Pattern and places drawn at random (seed printed).
+TEST(Replay, OutagesOfAPatternNeverOverlapOnesGivenByThemselves) {
+  const auto path = writeWithAndWithoutGt(navimpact::test::tempDir(), "ovl_").first;
+  for (const PatternDraw& d : drawPatterns(2, 25.0, 0.0, 1.0, "place (share)")) {
+    SCOPED_TRACE(d.trace);
+    an::ReplayConfig alone = refReplay(path);
+    alone.outages_every = d.pattern;
+    const auto windows = an::runReplay(alone).cfg.outages;
+    ASSERT_FALSE(windows.empty());
+    const auto& w = windows.front();
+    // inside the first window
+    const auto over = navimpact::Outage::fromStartDuration(w.start_s + d.value * w.duration_s(), 0.5 * w.duration_s());
+    EXPECT_NE(errorOf(patternReplay(path, over, d.pattern)).find("overlaps the outage " + navimpact::outageText(over)),
+              std::string::npos);
+    // in the GNSS time before the first window (period - duration > 0.5 s from the filter start)
+    const double gap = d.pattern.period_s - d.pattern.duration_s;
+    const auto between = navimpact::Outage::fromStartDuration(w.start_s - (0.5 + 0.4 * d.value) * gap, 0.4 * gap);
+    const an::ReplayResult r = an::runReplay(patternReplay(path, between, d.pattern));
+    ASSERT_EQ(r.cfg.outages.size(), 1 + windows.size());
+    EXPECT_EQ(r.cfg.outages.front().start_s, between.start_s);
+  }
+}
+
 // The replay from the records read into memory once (diagnose --run replays
 // one run many times) is the replay; stopped early, it is the same up to the
 // stop: epochs, and the outages that end by then, with the same score (the
@@ -717,7 +768,7 @@ TEST(Replay, ReplayFromRecordsInMemoryIsTheReplayAndStopsWhereAsked) {
     const double u = d.value;
     for (const auto& path : {withGt, noGt}) {
       SCOPED_TRACE(path + " " + d.trace);
-      const an::ReplayConfig c = patternReplay(path, navimpact::Outage::fromStartDuration(2.0, 3.0), d.pattern);
+      const an::ReplayConfig c = laidApart(patternReplay(path, navimpact::Outage::fromStartDuration(2.0, 3.0), d.pattern));
       const an::ReplayResult whole = an::runReplay(c);
       const double stop = whole.aided_from_s + 1.0 + u * (55.0 - whole.aided_from_s);
       const navimpact::rawlog::RawlogRecords data = navimpact::rawlog::readRawlogRecords(path);

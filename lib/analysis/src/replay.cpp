@@ -564,6 +564,12 @@ void ReplayDriver::decideWindows(double t_now) {
       throw Error(cfg_.rawlog + ": outages every " + formatNumber(p.period_s, 10) + ":" + formatNumber(p.duration_s, 10) +
                   " s make more than " + formatNumber(double(limits::kMaxOutagesPerRun)) +
                   " outages over the run (at most that many per run): a longer period");
+    // an outage laid twice was scored twice (7 outages, two the same 15 s from 25 s)
+    for (const Outage& o : cfg_.outages)
+      if (a - r_.t_zero < o.end_s && o.start_s < b - r_.t_zero)
+        throw Error(cfg_.rawlog + ": the outage every " + formatNumber(p.period_s, 10) + ":" + formatNumber(p.duration_s, 10) +
+                    " s at " + outageText({a - r_.t_zero, b - r_.t_zero}) + " overlaps the outage " + outageText(o) +
+                    " given by itself (each GNSS gap once: move that outage between the pattern's)");
     runner_->addOutage({a, b});
     r_.cfg.outages.push_back({a - r_.t_zero, b - r_.t_zero});
     ++nextWindow_;
