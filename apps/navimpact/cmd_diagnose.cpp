@@ -290,6 +290,15 @@ navimpact::cli::Registrar reg(
            ->check(navimpact::cli::within(navimpact::cli::kAlpha, true));
        app.add_option("--threads", o->threads, "worker threads (0 = all cores)")
            ->check(navimpact::cli::within(navimpact::cli::kThreads));
+       // a flag of the other mode was ignored without a word (diagnose --run
+       // --outage 100:10 --end 50 gave the run's result, exit 0)
+       for (const char* name : {"--rate", "--gyro-unit", "--acc-unit", "--axes", "--label", "--time-column", "--time-unit",
+                                "--start", "--end", "--robust", "--eff", "--trajectory", "--trajectory-system", "--outage",
+                                "--nav-runs", "--simulations"})
+         app.get_option(name)->excludes(runOpt);
+       for (const char* name : {"--durations", "--reconverge", "--realisations", "--folds"}) app.get_option(name)->needs(runOpt);
+       for (const char* name : {"--static-rate", "--static-gyro-unit", "--static-acc-unit", "--static-axes"})
+         app.get_option(name)->needs("--static");
        return [o]() { return run(*o); };
      }});
 

@@ -29,6 +29,14 @@ navimpact_cli_fail(cli_diagnose_bad_structure EXIT 1 NOOUT ${_dg_out}/bad2
 navimpact_cli_fail(cli_diagnose_outage_without_trajectory EXIT 1 NOOUT ${_dg_out}/bad3
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --outage 100:30 --out ${_dg_out}/bad3
   REGEX "^navimpact: --outage needs --trajectory")
+# a flag of the other mode is a command-line error (it was ignored, exit 0)
+navimpact_cli_fail(cli_diagnose_run_with_static_flag EXIT 2 NOOUT ${_dg_out}/bad_mode1
+  ARGS diagnose --run ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog --model ${CMAKE_SOURCE_DIR}/config/models/navchip_table1.yaml:ref
+       --end 50 --out ${_dg_out}/bad_mode1
+  REGEX "^navimpact: --end excludes --run \\(see 'navimpact diagnose --help'\\)$")
+navimpact_cli_fail(cli_diagnose_input_with_run_flag EXIT 2 NOOUT ${_dg_out}/bad_mode2
+  ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --realisations 5 --out ${_dg_out}/bad_mode2
+  REGEX "^navimpact: --realisations requires --run \\(see 'navimpact diagnose --help'\\)$")
 navimpact_cli_fail(cli_diagnose_bad_outage EXIT 2 NOOUT ${_dg_out}/bad4
   ARGS diagnose --input ${_dg_data} ${_dg_u} --model fit:WN --trajectory ${_dg_data} --outage abc --out ${_dg_out}/bad4
   REGEX "^navimpact: --outage: 'abc': expected START:DURATION")
