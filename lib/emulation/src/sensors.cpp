@@ -232,7 +232,7 @@ void GnssOptions::loadFrom(const ConfigNode& n, bool with_seed) {
                                 "lever_arm_B_m"};
   if (with_seed) keys.push_back("seed");
   n.allowKeys(keys);
-  n.read("rate_hz", rate_hz, limits::kAidingRateHz);
+  n.read("rate_hz", rate_hz, limits::kGnssRateHz);
   n.read("sigma_pos_h_m", sigma_pos_h_m, limits::kPositionSigmaM);
   n.read("sigma_pos_v_m", sigma_pos_v_m, limits::kPositionSigmaM);
   n.read("sigma_vel_h_mps", sigma_vel_h_mps, limits::kVelocitySigmaMps);

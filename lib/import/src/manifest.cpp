@@ -83,7 +83,7 @@ struct Keys {
 // ---------------------------------------------------------------------------
 
 /// The shortest median step of a GNSS stream [s]: receivers give at most 100 Hz.
-constexpr double kMinGnssStepS = 0.01 * (1.0 - 1e-9);
+constexpr double kMinGnssStepS = (1.0 / limits::kGnssRateHz.hi) * (1.0 - 1e-9);
 
 /// A stream's file, delimiter, time and gap rule.
 struct StreamSpec {

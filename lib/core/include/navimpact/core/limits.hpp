@@ -49,6 +49,9 @@ struct Range {
 
 inline constexpr Range kImuRateHz{1.0, 1.0e4, false, "Hz"};
 inline constexpr Range kAidingRateHz{1.0e-3, 1.0e4, false, "Hz"};
+/// GNSS fix rates: receivers give at most 100 Hz (import reads a faster stream
+/// as a time unit gone wrong, so emulate writes none it could not read back).
+inline constexpr Range kGnssRateHz{1.0e-3, 100.0, false, "Hz"};
 /// Position and altitude sigmas (GNSS, barometer, replay noise, initial
 /// sigmas) [m]: from 0.1 mm, a tenth of the best survey-grade fix (RTK, laser
 /// tracker ~1 mm); below it the variance is no sensor's and the Kalman gain is
