@@ -964,3 +964,47 @@ TEST(Diagnose, ChannelsQuantisedBelowTheirQuantumAreNotAllOutliers) {
   }
   EXPECT_EQ(right, R);
 }
+
+// A record with no white noise at all, a random walk only, under a model of
+// white noise as large as the record's spread (what fit:WN gives it): the
+// white noise is overstated (retuned to nothing) and the random walk missing.
+// Restated in their joint fit, the walk is compared with the model holding the
+// other term found, a white noise of zero: its text said "the measured WV is
+// infx above the model". Every explanation is finite and says what it compares
+// with. gamma drawn log-uniform over [1e-5, 1e-2] (seeded, printed).
+TEST(Diagnose, ExplanationsAreFiniteAndSayWhatTheyCompareWith) {
+  std::mt19937_64 g(navimpact::test::envOr("NAVIMPACT_DIAGNOSE_SEED", 20261124) + 77);
+  const double gamma = std::exp(std::uniform_real_distribution<double>(std::log(1e-5), std::log(1e-2))(g));
+  std::printf("random walk gamma %.3g per sample, no white noise\n", gamma);
+  pw::Case c;
+  c.data.source = "simulated";
+  c.data.rate_hz = c.model.rate_hz = 100.0;
+  for (int k = 0; k < 6; ++k) {
+    navimpact::ImuChannel ch;
+    ch.name = navimpact::kChannelNames[k];
+    ch.quantity = navimpact::channelQuantity(ch.name);
+    ns::Model w;
+    w.rate_hz = 100.0;
+    w.terms = {ns::Process::rw(gamma)};
+    ch.x = ns::simulate(w, 1 << 14, ns::deriveSeed(g(), k));
+    double m = 0, s = 0;
+    for (double v : ch.x) m += v / ch.x.size();
+    for (double v : ch.x) s += (v - m) * (v - m) / (ch.x.size() - 1);
+    c.model.axis[k].rate_hz = 100.0;
+    c.model.axis[k].terms = {ns::Process::wn(std::sqrt(s))};
+    c.data.channels.push_back(std::move(ch));
+  }
+  const na::Diagnosis d = diagnoseCase(c, 5);
+  int joint = 0;
+  for (const auto& ch : d.channels)
+    for (const auto& f : ch.findings) {
+      SCOPED_TRACE(ch.name + ": " + f.explanation);
+      EXPECT_EQ(f.explanation.find("inf"), std::string::npos);
+      EXPECT_EQ(f.explanation.find("nan"), std::string::npos);
+      if (ch.findings.size() > 1 && f.cause == na::Cause::RandomWalk && f.explanation.find("the measured WV") != std::string::npos) {
+        EXPECT_NE(f.explanation.find("the model with the other terms found"), std::string::npos);
+        ++joint;
+      }
+    }
+  std::printf("%d random-walk findings restated in a joint fit\n", joint);
+}

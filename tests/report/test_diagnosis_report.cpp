@@ -52,3 +52,24 @@ TEST(DiagnosisReport, TheScaleTableShowsTheCleanedWvBesideTheRawWhereCleaningCha
   EXPECT_EQ(raw.find("cleaned WV"), std::string::npos) << raw;
   EXPECT_EQ(raw.find("the findings above are on the cleaned record"), std::string::npos) << raw;
 }
+
+// An undecided finding names the two explanations the data leave open; where
+// the runner-up is the same cause alone (the winner has another term beside
+// it) it says so, instead of "undecided between random_walk and random_walk".
+TEST(DiagnosisReport, AnUndecidedFindingNamesWhatIsUndecided) {
+  an::Diagnosis d = withScales({4e-5, 2e-5});
+  an::Finding f;
+  f.channel = "gyro_x";
+  f.cause = an::Cause::RandomWalk;
+  f.decided = false;
+  f.explanation = "x";
+  f.runner_up = "random_walk";
+  f.runner_up_detail = "RW(gamma=1e-3)";
+  d.channels[0].findings.push_back(f);
+  f.cause = an::Cause::Drift;
+  d.channels[0].findings.push_back(f);
+  const std::string r = rp::diagnosisReport(d, {});
+  EXPECT_EQ(r.find("undecided between random_walk and random_walk"), std::string::npos) << r;
+  EXPECT_NE(r.find("random_walk, undecided: with or without the other terms found"), std::string::npos) << r;
+  EXPECT_NE(r.find("undecided between drift and random_walk"), std::string::npos) << r;
+}

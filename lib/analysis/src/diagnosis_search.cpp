@@ -82,9 +82,11 @@ void explainedRange(const std::vector<ScaleCheck>& chk, const std::vector<double
   }
 }
 
+/// @p jointly: @p before is the model with the other terms found (their joint
+/// fit), not the model as given: the text says which it compares with.
 Finding broadbandFinding(const std::string& ch, const Candidate& c, const Model& before,
                          const std::vector<ScaleCheck>& chk, const std::vector<double>& tau,
-                         double rate) {
+                         double rate, bool jointly = false) {
   Finding f;
   f.channel = ch;
   f.cause = causeOf(c.kind);
@@ -102,12 +104,16 @@ Finding broadbandFinding(const std::string& ch, const Candidate& c, const Model&
   const bool above = ratio >= 1;
   f.direction = (c.retune && c.scale < 1) ? "overstated" : "missing";
   const double factor = above ? ratio : 1.0 / ratio;
-  if (count > 0)
+  const char* against = jointly ? "the model with the other terms found" : "the model";
+  if (count > 0 && !std::isfinite(factor))  // the comparison model has no WV there ("infx above" before)
+    ex << "the measured WV is all excess over " << against << ", which has none at " << scaleRange(lo, hi) << " ("
+       << count << " scale" << (count > 1 ? "s" : "") << " outside its 95 % CI); ";
+  else if (count > 0)
     ex << "the measured WV is "
        << (factor < 1.5  // a small excess as a percentage ("1x" says nothing)
                ? formatNumber(100.0 * std::abs(ratio - 1.0), 2) + " % "
                : formatNumber(factor, 2) + "x ")
-       << (above ? "above" : "below") << " the model at " << scaleRange(lo, hi) << " ("
+       << (above ? "above " : "below ") << against << " at " << scaleRange(lo, hi) << " ("
        << count << " scale" << (count > 1 ? "s" : "") << " outside the 95 % CI); ";
   switch (c.kind) {
     case ProcessKind::WN: f.params = {{"sigma", p.sigma}}; break;
@@ -599,7 +605,7 @@ void restateInJointFit(const ChannelContext& ctx, const WvCheck& w, const std::v
     // indices refer to m0n's terms; one retuned to zero stays there at zero).
     const Model before = merged(ctx.m0n, others, true);
     const auto chk_i = checkScales(w.cleaned, wvOf(before, w.tau), w.dof, w.p_thr, {}, {});
-    Finding nf = broadbandFinding(cd.name, S[i], before, chk_i, w.tau, ctx.rate);
+    Finding nf = broadbandFinding(cd.name, S[i], before, chk_i, w.tau, ctx.rate, S.size() > 1);
     Finding& f = cd.findings[found_at[i]];
     nf.statistic = f.statistic;
     nf.threshold = f.threshold;

@@ -22,6 +22,15 @@ using namespace analysis;
 
 namespace {
 
+/// An undecided finding's name: "undecided between A and B", or where the
+/// runner-up is the same cause alone (the winner has another term beside it:
+/// "undecided between random_walk and random_walk" before) "A, with or
+/// without the other terms found".
+std::string undecidedText(const std::string& shown, const std::string& cause, const std::string& runner_up) {
+  if (runner_up == cause) return shown + ", undecided: with or without the other terms found";
+  return "undecided between " + shown + " and " + runner_up;
+}
+
 using nlohmann::json;
 
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
@@ -317,7 +326,7 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
         }
         if (count > 1) cause = std::to_string(count) + " × " + cause;
         if (f0.direction == "overstated") cause += " (overstated)";
-        if (!f0.decided) cause = "undecided between " + cause + " and " + f0.runner_up;
+        if (!f0.decided) cause = undecidedText(cause, causeName(f0.cause), f0.runner_up);
         if (!events.empty()) {
           cause += " [event";
           for (int e : events) cause += " " + std::to_string(e);
@@ -385,7 +394,7 @@ std::string diagnosisReport(const Diagnosis& d, const std::vector<std::string>& 
     r << "## " << c.name << "\n\n`" << modelText(c.model_before) << "` → `" << modelText(c.model_after) << "`\n\n";
     for (const auto& f : c.findings) {
       r << "- **" << (f.decided ? std::string(causeName(f.cause))
-                                : "undecided between " + std::string(causeName(f.cause)) + " and " + f.runner_up)
+                                : undecidedText(causeName(f.cause), causeName(f.cause), f.runner_up))
         << "**: " << f.explanation;
       if (!f.evidence.empty()) r << " *Evidence:* " << f.evidence << ".";
       if (!f.decided) {
