@@ -124,6 +124,11 @@ TEST(Trajectory, AnEmptyWindowNamesItsKey) {
     return s;
   };
   const std::string cfg = (dir / "t.yaml").string();
+  // a window past the file's times (it was cut to the data without a word)
+  EXPECT_EQ(errorOf(load(", end_s: 1000")), cfg + ": key 'trajectory.end_s': end_s 1000 s is after the trajectory's last time "
+                                                  "(the file spans 0 to 0.19 s) of " + csv);
+  EXPECT_EQ(errorOf(load(", start_s: -50, end_s: 0.1")), cfg + ": key 'trajectory.start_s': start_s -50 s is before the "
+                                                               "trajectory's first time (the file spans 0 to 0.19 s) of " + csv);
   EXPECT_EQ(errorOf(load(", end_s: 0.02")),
             cfg + ": key 'trajectory.end_s': only 3 samples in the selected window (need >= 8) of " + csv + " (rows 20)");
   try {

@@ -122,7 +122,18 @@ SampledTrajectory readTrajectoryCsv(const TrajectorySpec& spec) {
     rows.push_back(r);
     lines.push_back(reader.lineNo());
   }
-  // window
+  // window: inside the file's times (a window past them was cut to the data
+  // without a word: end_s 1000 on a 260 s file emulated 260 s)
+  if (!rows.empty()) {
+    auto outside = [&](const char* key, double v, const std::string& why) {
+      const std::string what = std::string(key) + " " + formatNumber(v, 10) + " s is " + why + " (the file spans " +
+                               formatNumber(rows.front()[0], 10) + " to " + formatNumber(rows.back()[0], 10) + " s)";
+      if (!spec.config_file.empty()) throw keyError(spec.config_file, keyPrefix + "." + key, what + " of " + printable(path, 120));
+      throw fileError(path, 0, what);
+    };
+    if (spec.start_s && *spec.start_s < rows.front()[0] - 1e-9) outside("start_s", *spec.start_s, "before the trajectory's first time");
+    if (spec.end_s && *spec.end_s > rows.back()[0] + 1e-9) outside("end_s", *spec.end_s, "after the trajectory's last time");
+  }
   std::size_t first = 0, last = rows.size();
   while (first < rows.size() && spec.start_s && rows[first][0] < *spec.start_s) ++first;
   while (last > first && spec.end_s && rows[last - 1][0] > *spec.end_s) --last;
