@@ -9,6 +9,12 @@ set_tests_properties(cli_replay_default PROPERTIES PASS_REGULAR_EXPRESSION
   "52000 IMU steps at 200 Hz, 201 GNSS and 2601 baro updates.*outage 1 \\(60 s from 200 s\\): horizontal error at end")
 navimpact_cli_check(cli_replay_default_outputs CHECK replay_outputs DEFINES DIR=${_rdir}/default)
 set_tests_properties(cli_replay_default_outputs PROPERTIES DEPENDS cli_replay_default)
+# an outage between two GNSS fixes (1 Hz) withholds none: said, not scored as a GNSS gap silently
+add_test(NAME cli_replay_outage_between_fixes
+  COMMAND ${NI} replay --rawlog ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog --outage 100.2:0.5
+          --out ${_rdir}/between --overwrite)
+set_tests_properties(cli_replay_outage_between_fixes PROPERTIES PASS_REGULAR_EXPRESSION
+  "notice: outage 100.2:0.5 withheld no GNSS fix \\(none falls inside it\\)")
 
 set(_rlog ${CMAKE_SOURCE_DIR}/datasets/uav_flight_260s_ref.rawlog)
 navimpact_cli_fail(cli_replay_outage_outside_data

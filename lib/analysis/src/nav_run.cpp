@@ -82,7 +82,13 @@ struct NavRunner::Impl {
       const GnssFix f = std::move(gnss.front());
       gnss.pop_front();
       if (f.t < x0.t - half_dt) continue;  // before the run
-      if (inOutage(f.t, opt.outages)) continue;
+      bool withheld = false;
+      for (std::size_t i = 0; i < opt.outages.size(); ++i)
+        if (opt.outages[i].covers(f.t)) {
+          ++res.outages[i].gnss_dropped;
+          withheld = true;
+        }
+      if (withheld) continue;
       if (!f.cov_pos_N) throw Error("navigation run: GNSS fix at " + formatNumber(f.t, 10) + " s has no position covariance");
       // the fix's own epoch relative to the filter time (0 when on a sample)
       const double dt_meas = epochOffset(f.t, t_now);

@@ -908,6 +908,11 @@ void ReplayDriver::run() {
     r.notices.push_back("outages every " + formatNumber(cfg.outages_every->period_s, 10) + ":" +
                         formatNumber(cfg.outages_every->duration_s, 10) + " s: none fits in the data after the filter start");
   for (auto& n : modelNotices) r.notices.push_back(std::move(n));
+  // an outage between two fixes withholds none: scored, it is an aided run's error
+  for (const auto& o : r.run.outages)
+    if (o.gnss_dropped == 0)
+      r.notices.push_back("outage " + outageText({o.window.start_s - r.t_zero, o.window.end_s - r.t_zero}) +
+                          " withheld no GNSS fix (none falls inside it): its errors are those of the aided filter");
   if (scorer_) r.score = scorer_->finish(r.run, r.t_zero, refInfo_);
 }
 

@@ -151,6 +151,7 @@ struct OutageSummary {
   double max_drift_h = 0.0;         ///< max horizontal position error over the epochs in (start, end] [m]
   double max_drift_v = 0.0;         ///< max |vertical position error| over the same epochs [m]
   double max_drift_3d = 0.0;        ///< max 3-D position error over the same epochs [m]
+  std::size_t gnss_dropped = 0;     ///< GNSS fixes the outage withheld (0: no fix fell inside it)
 };
 
 /// Result of one run.
