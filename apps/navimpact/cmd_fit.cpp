@@ -16,6 +16,7 @@
 #include "input.hpp"
 #include "navimpact/core/error.hpp"
 #include "navimpact/core/output.hpp"
+#include "navimpact/core/text_io.hpp"
 #include "navimpact/gmwm/channels.hpp"
 #include "navimpact/report/fit_report.hpp"
 
@@ -81,11 +82,15 @@ navimpact::cli::Registrar reg({
       auto o = std::make_shared<Opts>();
       navimpact::cli::addInputOptions(app, o->in);
       app.add_option("--channels", o->channels, "comma-separated channels to fit (default: all in the file)")
-          ->check(navimpact::cli::parsedBy([](const std::string& v) { splitList(v); }, "NAMES"));
+          ->check(navimpact::cli::parsedBy([](const std::string& v) {
+            // an empty list fitted every channel, as if the flag were not given
+            if (navimpact::trim(v).empty()) throw navimpact::Error("names no channel (leave the flag out to fit all)");
+            splitList(v);
+          }, "NAMES"));
       app.add_option("--structure", o->fit.structure,
                      "model structure for every channel, e.g. WN+GM+GM+DR, or 'auto' (WIC selection)")
           ->required();
-      app.add_option("--max-gm", o->fit.max_gm, "auto: largest number of GM terms among the candidates (0..3)")
+      auto* maxGm = app.add_option("--max-gm", o->fit.max_gm, "auto: largest number of GM terms among the candidates (0..3)")
           ->check(navimpact::cli::within({0.0, 3.0, false, ""}));
       auto* bootstrap = app.add_option("--bootstrap", o->fit.bootstrap,
                                        "parametric bootstrap replicates for the intervals (0: --intervals; else 39 .. 10000)")
@@ -99,10 +104,14 @@ navimpact::cli::Registrar reg({
           ->check(CLI::IsMember({"profile", "asymptotic"}));
       // --intervals with a bootstrap was ignored without a word (the bootstrap's
       // percentile intervals were written); one of the two, as the help says
-      app.parse_complete_callback([o, bootstrap, intervals]() {
+      app.parse_complete_callback([o, bootstrap, intervals, maxGm]() {
         if (intervals->count() > 0 && bootstrap->count() > 0 && o->fit.bootstrap > 0)
           throw CLI::ValidationError("--intervals", "applies without --bootstrap (a bootstrap gives its own percentile "
                                                     "intervals); drop one of the two");
+        // with a structure given, the candidates' GM count means nothing (it was ignored without a word)
+        if (maxGm->count() > 0 && o->fit.structure != "auto")
+          throw CLI::ValidationError("--max-gm", "applies to --structure auto (the structure " + o->fit.structure +
+                                                     " fixes its GM terms)");
       });
       app.add_option("--weights", o->fit.weights,
                      "GMWM weights: r (default, the R package's 1/(CI_hi-CI_lo)^2), model (iterated "

@@ -187,6 +187,13 @@ navimpact_cli_fail(cli_fit_intervals_with_bootstrap EXIT 2
 navimpact_cli_fail(cli_fit_intervals_unknown EXIT 2
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --intervals foo --out ${_fdir}/int_foo
   REGEX "^navimpact: --intervals: foo not in {profile,asymptotic} \\(see 'navimpact fit --help'\\)$" NOOUT ${_fdir}/int_foo)
+# flags that meant nothing: --max-gm beside a fixed structure, --channels naming none ("" or blank: it fitted all)
+navimpact_cli_fail(cli_fit_max_gm_fixed_structure EXIT 2
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN+RW --max-gm 2 --out ${_fdir}/maxgm
+  REGEX "^navimpact: --max-gm: applies to --structure auto \\(the structure WN\\+RW fixes its GM terms\\)" NOOUT ${_fdir}/maxgm)
+navimpact_cli_fail(cli_fit_channels_empty EXIT 2
+  ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --channels " " --out ${_fdir}/chempty
+  REGEX "^navimpact: --channels: names no channel \\(leave the flag out to fit all\\)" NOOUT ${_fdir}/chempty)
 navimpact_cli_fail(cli_fit_eff_unreachable EXIT 2
   ARGS fit --input ${_fdata} --rate 100 --gyro-unit deg/s --acc-unit g --structure WN --robust --eff 0.001 --out ${_fdir}/eff_low
   REGEX "^navimpact: --eff: robust wavelet variance: efficiency 0\\.001 is outside what the biweight reaches" NOOUT ${_fdir}/eff_low)
