@@ -462,13 +462,15 @@ Recording importManifest(const std::string& manifestPath, ImportReport* report) 
           throw k.err(key + ".unit", e.what());
         }
       } else if (q == 0) {
-        static const double f[] = {1.0, kDeg, 1e-3};
-        factor[q] = f[k.oneOf(g["increments"], key + ".increments", {"rad", "deg", "mrad"})];
-        told[q] = k.text(g["increments"], key + ".increments");
+        static const std::vector<std::pair<std::string, double>> kAngleIncrements = {{"rad", 1.0}, {"deg", kDeg}, {"mrad", 1e-3}};
+        std::vector<std::string> names;
+        for (const auto& [name, f] : kAngleIncrements) names.push_back(name);
+        const auto& chosen = kAngleIncrements[k.oneOf(g["increments"], key + ".increments", names)];
+        factor[q] = chosen.second;
+        told[q] = chosen.first;
         unitFactor[q] = [](const std::string& x) {
-          if (x == "rad") return 1.0;
-          if (x == "deg") return kDeg;
-          if (x == "mrad") return 1e-3;
+          for (const auto& [name, f] : kAngleIncrements)
+            if (x == name) return f;
           throw Error("not an angle increment");
         };
       } else {
