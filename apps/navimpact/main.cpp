@@ -40,7 +40,8 @@ extern "C" void onTerminate(int sig) {
 void cleanUpOnTermination() {
   struct sigaction sa {};
   sa.sa_handler = onTerminate;
-  sigemptyset(&sa.sa_mask);
+  sigemptyset(&sa.sa_mask);  // the three wait for one another: one removal at a time
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&sa.sa_mask, sig);
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction old {};
     // a signal the caller ignores (nohup) stays ignored

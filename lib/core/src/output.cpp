@@ -70,21 +70,24 @@ std::string unremovableIn(const fs::path& folder) {
 }
 
 // The staging folders of this process's live jobs, for removeLiveStaging()
-// (a signal handler): fixed slots of plain bytes, a slot published by its flag.
+// (a signal handler): fixed slots of plain bytes. A slot is free (0), being
+// written or cleared (1), or published (2); the handler reads only published
+// slots, so it never sees a path half copied (a prefix such as "/tmp" would
+// have been emptied).
 constexpr int kLiveSlots = 32;
 constexpr std::size_t kLivePathMax = 4096;
+enum : int { kSlotFree = 0, kSlotBusy = 1, kSlotPublished = 2 };
 char g_livePath[kLiveSlots][kLivePathMax];
-std::atomic<bool> g_liveUsed[kLiveSlots];
+std::atomic<int> g_liveState[kLiveSlots];
 
 int registerLive(const fs::path& p) noexcept {
   const std::string& s = p.native();
-  if (s.size() >= kLivePathMax) return -1;
+  if (s.empty() || s.size() >= kLivePathMax) return -1;
   for (int i = 0; i < kLiveSlots; ++i) {
-    bool expected = false;
-    if (!g_liveUsed[i].load() && g_liveUsed[i].compare_exchange_strong(expected, true)) {
-      g_livePath[i][0] = '\0';  // written, then published below
+    int expected = kSlotFree;
+    if (g_liveState[i].compare_exchange_strong(expected, kSlotBusy)) {
       std::memcpy(g_livePath[i], s.c_str(), s.size() + 1);
-      std::atomic_thread_fence(std::memory_order_release);
+      g_liveState[i].store(kSlotPublished, std::memory_order_release);
       return i;
     }
   }
@@ -92,10 +95,10 @@ int registerLive(const fs::path& p) noexcept {
 }
 
 void unregisterLive(int slot) noexcept {
-  if (slot >= 0) {
-    g_livePath[slot][0] = '\0';
-    g_liveUsed[slot].store(false);
-  }
+  if (slot < 0) return;
+  g_liveState[slot].store(kSlotBusy, std::memory_order_release);
+  g_livePath[slot][0] = '\0';
+  g_liveState[slot].store(kSlotFree, std::memory_order_release);
 }
 
 /// Remove the entries of the folder open at @p fd, then close it; a folder
@@ -187,9 +190,8 @@ bool lockedByLiveJob(const fs::path& p) {
 }  // namespace
 
 void removeLiveStaging() noexcept {
-  std::atomic_thread_fence(std::memory_order_acquire);
   for (int i = 0; i < kLiveSlots; ++i) {
-    if (!g_liveUsed[i].load() || g_livePath[i][0] == '\0') continue;
+    if (g_liveState[i].load(std::memory_order_acquire) != kSlotPublished) continue;
     const int fd = ::open(g_livePath[i], O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
     if (fd >= 0) emptyFolderFd(fd, 2);
     ::rmdir(g_livePath[i]);
