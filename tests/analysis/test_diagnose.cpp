@@ -866,7 +866,9 @@ TEST(Diagnose, AnOverstatedModelIsNeverAdequate) {
       if (rejected > 0) {
         ++checked;
         EXPECT_FALSE(ch.adequate) << ch.name << ": " << rejected << " scale(s) rejected";
-        if (ch.findings.empty()) EXPECT_LT(ch.unexplained.ratio, 0.5) << ch.name;  // named below the model
+        if (ch.findings.empty()) {
+          EXPECT_LT(ch.unexplained.ratio, 0.5) << ch.name;  // named below the model
+        }
       }
     }
   }
@@ -897,11 +899,15 @@ TEST(Diagnose, AnOverstatedTermIsRetunedOnTheHeldOutHalfToo) {
         // the cause is the model's RW (a retune to zero included), not noise the record lacks
         EXPECT_NE(f.cause, na::Cause::QuantizationNoise) << ch.name;
       }
-      if (rejected > 0) EXPECT_TRUE(overstated) << ch.name << ": " << rejected << " scale(s) rejected, no overstated RW named";
+      if (rejected > 0) {
+        EXPECT_TRUE(overstated) << ch.name << ": " << rejected << " scale(s) rejected, no overstated RW named";
+      }
       if (!overstated) continue;
       ++checked;
       for (const auto& t : ch.model_after_half.terms)
-        if (t.kind == ns::ProcessKind::RW) EXPECT_LT(t.gamma, 0.5 * gamma) << ch.name << ": the half kept the model's RW";
+        if (t.kind == ns::ProcessKind::RW) {
+          EXPECT_LT(t.gamma, 0.5 * gamma) << ch.name << ": the half kept the model's RW";
+        }
       EXPECT_LT(ch.gain.outside_after, ch.gain.outside_before) << ch.name;
     }
   }

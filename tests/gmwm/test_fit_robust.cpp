@@ -178,6 +178,8 @@ TEST(RobustGmwm, ASpikeOnTheFirstOrLastSampleIsReplacedOnce) {
     EXPECT_LE(replaced, 2u);  // the spike (and at most one clean sample, alpha = 1 %)
     EXPECT_LT(std::abs(x[at]), 6e-3);
     for (std::size_t k = 1; k + 1 < x.size(); ++k)
-      if (x[k] != clean[k]) EXPECT_LT(std::abs(x[k]), 6e-3) << k;
+      if (x[k] != clean[k]) {
+        EXPECT_LT(std::abs(x[k]), 6e-3) << k;
+      }
   }
 }
