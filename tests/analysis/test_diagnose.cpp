@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <cstdint>
 #include <cstdlib>
 #include <iostream>
@@ -72,7 +73,10 @@ na::Diagnosis diagnoseCase(const pw::Case& c, std::uint64_t seed) {
 /// 2^15 samples at 100 Hz of white noise (gyros 1e-3 rad/s, accelerometers
 /// 1e-2 m/s^2) from @p seed, and a model of that noise whose gyros add a
 /// random walk of @p gamma the record lacks.
-pw::Case whiteNoiseUnderGyroRandomWalk(double gamma, std::uint64_t seed) {
+/// A 100 Hz record of the six channels, channel k @p n samples of @p truth(k)
+/// from the seed @p seedOf(k); the model is left to the caller (at 100 Hz).
+pw::Case simulatedCase(const std::function<ns::Model(int)>& truth, std::size_t n,
+                       const std::function<std::uint64_t(int)>& seedOf) {
   pw::Case c;
   c.data.source = "simulated";
   c.data.rate_hz = c.model.rate_hz = 100.0;
@@ -80,12 +84,26 @@ pw::Case whiteNoiseUnderGyroRandomWalk(double gamma, std::uint64_t seed) {
     navimpact::ImuChannel ch;
     ch.name = navimpact::kChannelNames[k];
     ch.quantity = navimpact::channelQuantity(ch.name);
-    ns::Model w;
-    w.rate_hz = 100.0;
-    w.terms = {ns::Process::wn(k < 3 ? 1e-3 : 1e-2)};
-    ch.x = ns::simulate(w, 1 << 15, ns::deriveSeed(seed, k));
+    ch.x = ns::simulate(truth(k), n, seedOf(k));
     c.data.channels.push_back(std::move(ch));
-    c.model.axis[k] = w;
+    c.model.axis[k].rate_hz = 100.0;
+  }
+  return c;
+}
+
+/// A model of one term at 100 Hz.
+ns::Model oneTerm(const ns::Process& p) {
+  ns::Model m;
+  m.rate_hz = 100.0;
+  m.terms = {p};
+  return m;
+}
+
+pw::Case whiteNoiseUnderGyroRandomWalk(double gamma, std::uint64_t seed) {
+  auto wn = [](int k) { return oneTerm(ns::Process::wn(k < 3 ? 1e-3 : 1e-2)); };
+  pw::Case c = simulatedCase(wn, 1 << 15, [seed](int k) { return ns::deriveSeed(seed, k); });
+  for (int k = 0; k < 6; ++k) {
+    c.model.axis[k] = wn(k);
     if (k < 3) c.model.axis[k].terms.push_back(ns::Process::rw(gamma));
   }
   return c;
@@ -982,23 +1000,14 @@ TEST(Diagnose, ExplanationsAreFiniteAndSayWhatTheyCompareWith) {
   std::mt19937_64 g(navimpact::test::envOr("NAVIMPACT_DIAGNOSE_SEED", 20261124) + 77);
   const double gamma = std::exp(std::uniform_real_distribution<double>(std::log(1e-5), std::log(1e-2))(g));
   std::printf("random walk gamma %.3g per sample, no white noise\n", gamma);
-  pw::Case c;
-  c.data.source = "simulated";
-  c.data.rate_hz = c.model.rate_hz = 100.0;
+  pw::Case c = simulatedCase([gamma](int) { return oneTerm(ns::Process::rw(gamma)); }, 1 << 14,
+                             [&g](int k) { return ns::deriveSeed(g(), k); });
   for (int k = 0; k < 6; ++k) {
-    navimpact::ImuChannel ch;
-    ch.name = navimpact::kChannelNames[k];
-    ch.quantity = navimpact::channelQuantity(ch.name);
-    ns::Model w;
-    w.rate_hz = 100.0;
-    w.terms = {ns::Process::rw(gamma)};
-    ch.x = ns::simulate(w, 1 << 14, ns::deriveSeed(g(), k));
+    const auto& x = c.data.channels[k].x;
     double m = 0, s = 0;
-    for (double v : ch.x) m += v / ch.x.size();
-    for (double v : ch.x) s += (v - m) * (v - m) / (ch.x.size() - 1);
-    c.model.axis[k].rate_hz = 100.0;
-    c.model.axis[k].terms = {ns::Process::wn(std::sqrt(s))};
-    c.data.channels.push_back(std::move(ch));
+    for (double v : x) m += v / x.size();
+    for (double v : x) s += (v - m) * (v - m) / (x.size() - 1);
+    c.model.axis[k] = oneTerm(ns::Process::wn(std::sqrt(s)));
   }
   const na::Diagnosis d = diagnoseCase(c, 5);
   int joint = 0;
